@@ -1,0 +1,51 @@
+"""``radartune bench NAME``: run a benchmark, print its figures and write them to a JSON file.
+
+Each benchmark lives in ``core.benchmarks.<name>`` and defines
+``run(quick: bool = False) -> dict`` returning JSON-ready figures, including a plain reference
+implementation measured in the same run and the ratio (this machine is shared and noisy), and
+``summary(result: dict) -> str`` for the terminal.
+"""
+
+from __future__ import annotations
+
+import argparse
+import datetime as dt
+import importlib
+import json
+import platform
+from pathlib import Path
+
+BENCHMARKS = ("sim", "track", "tune", "fidelity")
+
+
+def add_parser(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("bench", help="measure speed (and error against run time)")
+    p.add_argument("name", choices=(*BENCHMARKS, "all"))
+    p.add_argument(
+        "--out-dir", default="bench/results", help="folder for <name>.json (default: %(default)s)"
+    )
+    p.add_argument("--quick", action="store_true", help="short run (smoke test)")
+    p.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    names = BENCHMARKS if args.name == "all" else (args.name,)
+    out_dir = Path(args.out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    for name in names:
+        module = importlib.import_module(f"core.benchmarks.{name}")
+        result = module.run(quick=args.quick)
+        result = {
+            "benchmark": name,
+            "command": f"radartune bench {name}" + (" --quick" if args.quick else ""),
+            "date": dt.datetime.now(dt.UTC).isoformat(timespec="seconds"),
+            "machine": {"python": platform.python_version(), "cpu": platform.processor()},
+            **result,
+        }
+        path = out_dir / f"{name}.json"
+        tmp = path.with_suffix(".json.tmp")
+        tmp.write_text(json.dumps(result, indent=2) + "\n")
+        tmp.replace(path)
+        print(module.summary(result))
+        print(f"written: {path}")
+    return 0

@@ -1,0 +1,68 @@
+"""Point cloud: the radar chain's per-frame output, struct-of-arrays."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+#: Ground-truth labels in ``PointCloud.source`` besides person indices (>= 0).
+SOURCE_CLUTTER = -1
+SOURCE_OTHER = -2
+
+POINT_FIELDS = (
+    "range_m",
+    "azimuth_rad",
+    "elevation_rad",
+    "radial_velocity_mps",
+    "snr_db",
+    "x_m",
+    "y_m",
+    "z_m",
+)
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class PointCloud:
+    """Detections of one frame; every array has shape ``(n_points,)``.
+
+    ``source`` is the ground-truth label: the index of the person the point came from,
+    ``-1`` for clutter, ``-2`` for noise or sidelobe detections that match no reflector.
+    """
+
+    range_m: np.ndarray
+    azimuth_rad: np.ndarray
+    elevation_rad: np.ndarray
+    radial_velocity_mps: np.ndarray
+    snr_db: np.ndarray
+    x_m: np.ndarray
+    y_m: np.ndarray
+    z_m: np.ndarray
+    source: np.ndarray
+
+    def __post_init__(self) -> None:
+        n = len(self.range_m)
+        for name in (*POINT_FIELDS, "source"):
+            if np.shape(getattr(self, name)) != (n,):
+                raise ValueError(f"PointCloud.{name} must have shape ({n},)")
+
+    def __len__(self) -> int:
+        return len(self.range_m)
+
+    @classmethod
+    def empty(cls) -> PointCloud:
+        z = np.zeros(0)
+        return cls(**{f: z for f in POINT_FIELDS}, source=np.zeros(0, dtype=np.int32))
+
+    @classmethod
+    def concatenate(cls, clouds: list[PointCloud]) -> PointCloud:
+        if not clouds:
+            return cls.empty()
+        kw = {f: np.concatenate([getattr(c, f) for c in clouds]) for f in POINT_FIELDS}
+        return cls(**kw, source=np.concatenate([c.source for c in clouds]).astype(np.int32))
+
+    def measurements(self) -> np.ndarray:
+        """Tracker measurements ``z = [r, az, vr]``, shape ``(n_points, 3)``, float64."""
+        return np.column_stack(
+            (self.range_m, self.azimuth_rad, self.radial_velocity_mps)
+        ).astype(np.float64)

@@ -1,0 +1,6 @@
+"""Shared test set-up: Qt runs headless."""
+
+import os
+
+os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
+os.environ.setdefault("MPLBACKEND", "Agg")
