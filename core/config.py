@@ -77,7 +77,8 @@ class RadarConfig:
         for name in ("azimuth_positions", "elevation_positions"):
             if len(getattr(self, name)) != n_virtual:
                 raise InputError(
-                    f"{name} must have n_tx*n_rx={n_virtual} entries, got {len(getattr(self, name))}"
+                    f"{name} must have n_tx*n_rx={n_virtual} entries, "
+                    f"got {len(getattr(self, name))}"
                 )
         if self.chirp_period_s * self.n_tx * self.n_loops > self.frame_period_s:
             raise InputError(
@@ -109,9 +110,7 @@ class RadarConfig:
     @property
     def range_resolution_m(self) -> float:
         """Range bin spacing c*Fs / (2*S*Nadc)."""
-        return SPEED_OF_LIGHT_MPS * self.sample_rate_hz / (
-            2 * self.slope_hz_per_s * self.n_samples
-        )
+        return SPEED_OF_LIGHT_MPS * self.sample_rate_hz / (2 * self.slope_hz_per_s * self.n_samples)
 
     @property
     def max_range_m(self) -> float:
@@ -175,8 +174,9 @@ class RadarConfig:
         known = {f.name for f in dataclasses.fields(cls)}
         unknown = sorted(set(data) - known)
         if unknown:
-            raise InputError(f"unknown radar field(s) {unknown}; expected some of {sorted(known)}",
-                             source)
+            raise InputError(
+                f"unknown radar field(s) {unknown}; expected some of {sorted(known)}", source
+            )
         kwargs = {k: tuple(v) if isinstance(v, list) else v for k, v in data.items()}
         try:
             return cls(**kwargs)

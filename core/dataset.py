@@ -90,9 +90,7 @@ class Dataset:
     @property
     def trajectory_offsets(self) -> np.ndarray:
         """Frame index ranges: frames of trajectory k are ``offsets[k]:offsets[k+1]``."""
-        return np.searchsorted(self.trajectory, np.arange(self.n_trajectories + 1)).astype(
-            np.int64
-        )
+        return np.searchsorted(self.trajectory, np.arange(self.n_trajectories + 1)).astype(np.int64)
 
     def measurements(self) -> np.ndarray:
         """All points as tracker measurements ``[r, az, vr]``, shape (P, 3), float64."""
@@ -173,7 +171,9 @@ class Dataset:
             with np.load(path, allow_pickle=False) as data:
                 missing = [k for k in REQUIRED if k not in data.files]
                 if missing:
-                    raise InputError(f"not a RadarTune data set: missing arrays {missing}", str(path))
+                    raise InputError(
+                        f"not a RadarTune data set: missing arrays {missing}", str(path)
+                    )
                 kw = {k: data[k] for k in (*PER_POINT, *PER_FRAME, "trajectory_class")}
                 kw["scene_json"] = str(data["scene_json"])
                 kw["radar_json"] = str(data["radar_json"])

@@ -63,6 +63,6 @@ class PointCloud:
 
     def measurements(self) -> np.ndarray:
         """Tracker measurements ``z = [r, az, vr]``, shape ``(n_points, 3)``, float64."""
-        return np.column_stack(
-            (self.range_m, self.azimuth_rad, self.radial_velocity_mps)
-        ).astype(np.float64)
+        return np.column_stack((self.range_m, self.azimuth_rad, self.radial_velocity_mps)).astype(
+            np.float64
+        )

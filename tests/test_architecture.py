@@ -15,7 +15,9 @@ QT_MODULES = ("PySide6", "shiboken6", "pyqtgraph", "PyQt5", "PyQt6")
 
 def core_modules() -> list[str]:
     return sorted(
-        m.name for m in pkgutil.walk_packages(core.__path__, prefix="core.") if "__main__" not in m.name
+        m.name
+        for m in pkgutil.walk_packages(core.__path__, prefix="core.")
+        if "__main__" not in m.name
     )
 
 
