@@ -1,0 +1,675 @@
+"""``fast`` fidelity level: the exact chain's range-Doppler spectrum in closed form.
+
+The exact level synthesises every ADC sample of every chirp and channel, draws noise for every
+sample and runs two FFTs over the whole cube. After the range and Doppler FFTs, a point scatterer
+``i`` is separable (for the frame's few centimetres of range migration, see below)::
+
+    X_i[v, k, d] = A_i a_i[v] R_i[k] D_i[slot(v), d]
+
+- ``A_i = Vspp / (2 sqrt 2)``: the complex baseband amplitude (link budget, eqs. 2-4);
+- ``a_i[v] = exp(j pi (p_v sin(az) cos(el) + e_v sin(el)))``: the virtual-array phase;
+- ``R_i[k] = sum_n w_r[n] exp(j theta_i n) exp(-j 2 pi k n / Nadc)``: the range window's response
+  to the beat tone ``theta_i = 2 pi (2 S R_i / c) / Fs`` rad/sample (one 256-point FFT);
+- ``D_i[s, d] = sum_m w_d[m] (y_m - mean_m y) exp(-j 2 pi (d - Nc/2) m / Nc)`` with the slow-time
+  phase of the chirp of slot ``s`` in loop ``m`` at time ``t_c = (m Ntx + s) Tchirp``::
+
+      y_m = exp(j (4 pi R_i(t_c) / lambda + theta_i' (R_i(t_c) - R_i(t_mid)) (Nadc - 1) / 2))
+
+  (static clutter removal subtracts the loop mean; the second term is the beat tone's phase at the
+  middle of the ADC window moving with the range, the exact chain's "carrier at mid-ramp"). The
+  slot's delay carries the TDM-MIMO Doppler coupling exactly.
+
+Noise. Per virtual channel and cell, the exact chain's noise after the two windowed FFTs is
+circular complex Gaussian with variance (``sigma^2`` per ADC sample)::
+
+    s2[d] = sigma^2 sum_n w_r[n]^2 (sum_m w_d[m]^2 - |W_d(d)|^2 / Nc)        (with clutter removal)
+
+(``W_d(d)`` the Doppler window's DFT at bin ``d``: clutter removal lowers the noise at and next to
+zero Doppler). Every cell of the range-Doppler map is the non-coherent
+sum of 12 such exponentials, drawn directly as ``s2[d] Gamma(12)``, except in the patches where
+some scatterer's energy matters (per-channel signal power above ``-30 dB`` of ``s2``): there the
+coherent sum ``s`` of the scatterers (12 channel values) meets the noise, and by the rotation
+invariance of circular Gaussian noise the channel sum ``sum_v |s_v + n_v|^2`` is drawn as
+``|(|s| + n_1)|^2 + s2 Gamma(11)``. Only the detected cells get their 12 channel values, drawn
+from the exact conditional law given those draws (:func:`detected_channels`). The same CFAR,
+angle, SNR and labelling stages as the
+exact chain then run unchanged.
+
+Known approximations (measured in ``docs/fidelity.md``): neighbouring cells of the exact chain's
+noise are correlated through the windows (range |rho|^2 = 0.44 for Hann), here they are
+independent; the beat tone's drift over the frame (<= 0.2 range bins at 1.8 m/s) is reduced to
+its phase term.
+"""
+
+from __future__ import annotations
+
+import functools
+from typing import NamedTuple
+
+import numba
+import numpy as np
+import scipy.fft
+
+from core.config import DEFAULT_PROCESSING, SPEED_OF_LIGHT_MPS, ProcessingSettings, RadarConfig
+from core.pointcloud import SOURCE_OTHER, PointCloud
+from core.processing import (
+    Detections,
+    estimate_angles,
+    label_sources,
+    make_cfar,
+    refine_bins,
+    window,
+)
+from core.simulation.antenna import AntennaGain
+from core.simulation.baseband import chirp_ranges_m, steering_vectors
+from core.simulation.frame import FrameOutput, needs_elevation
+from core.simulation.link import noise_power_v2, received_power_w, signal_amplitude_v
+from core.simulation.scatterers import Scatterers
+
+#: Per-channel signal power, relative to the cell's noise power, above which a cell gets
+#: per-channel noise and the coherent signal (-30 dB: the signal changes the cell's mean power
+#: by less than 0.1 % elsewhere).
+PATCH_THRESHOLD = 1e-3
+
+
+@functools.lru_cache(maxsize=32)
+def _doppler_window_shifted(name: str, n: int) -> np.ndarray:
+    """Doppler window with the fftshift folded in (``w[m] (-1)^m`` for even ``n``), complex128."""
+    w = window(name, n).astype(np.float64)
+    if n % 2 == 0:
+        w = w * np.where(np.arange(n) % 2 == 0, 1.0, -1.0)
+    return w
+
+
+@functools.lru_cache(maxsize=32)
+def cell_noise_power_v2(radar: RadarConfig, settings: ProcessingSettings) -> np.ndarray:
+    """Noise power per virtual channel and range-Doppler cell after both FFTs, ``(n_loops,)`` V².
+
+    ``s2[d] = sigma^2 sum w_r^2 (sum w_d^2 - |W_d(d)|^2 / Nc)`` with static clutter removal,
+    ``sigma^2 sum w_r^2 sum w_d^2`` without; index ``d`` is zero-velocity centred. The same for
+    every range bin.
+    """
+    wr = window(settings.range_window, radar.n_samples).astype(np.float64)
+    wd = window(settings.doppler_window, radar.n_loops).astype(np.float64)
+    n = radar.n_loops
+    gain_d = np.full(n, np.sum(wd**2))
+    if settings.static_clutter_removal:
+        # W_d(d) = sum_m w_m exp(-j 2 pi (d - n/2) m / n)
+        big_w = (
+            np.fft.fftshift(np.fft.fft(wd))
+            if n % 2
+            else np.fft.fft(_doppler_window_shifted(settings.doppler_window, n))
+        )
+        # s2[d] / (sigma^2 sum w_r^2) = sum w_d^2 - |W_d(d)|^2 / Nc
+        gain_d = gain_d - np.abs(big_w) ** 2 / n
+    out = noise_power_v2(radar) * np.sum(wr**2) * gain_d
+    out.flags.writeable = False
+    return out
+
+
+def range_responses(radar: RadarConfig, range_m: np.ndarray, settings: ProcessingSettings):
+    """Range window's response to each scatterer's beat tone, ``(N, n_samples)`` complex128.
+
+    ``R[k] = sum_n w_r[n] exp(j theta n) exp(-j 2 pi k n / Nadc)``,
+    ``theta = 2 pi (2 S R / c) / Fs``.
+    """
+    n = np.arange(radar.n_samples)
+    # theta = 2 pi (2 S R / c) / Fs   (rad per sample)
+    theta = (
+        2
+        * np.pi
+        * 2
+        * radar.slope_hz_per_s
+        * np.asarray(range_m)
+        / (SPEED_OF_LIGHT_MPS * radar.sample_rate_hz)
+    )
+    wr = window(settings.range_window, radar.n_samples).astype(np.float64)
+    tone = wr[None, :] * np.exp(1j * ((theta[:, None] * n[None, :]) % (2 * np.pi)))
+    return scipy.fft.fft(tone, axis=-1)
+
+
+def slow_time_sequences(
+    radar: RadarConfig, scatterers: Scatterers, settings: ProcessingSettings
+) -> np.ndarray:
+    """Slow-time phase sequence ``y`` of each scatterer per TX slot, ``(N, n_tx, n_loops)``.
+
+    After static clutter removal when the settings ask for it (see the module docstring).
+    """
+    r_c = chirp_ranges_m(radar, scatterers)  # (N, n_loops * n_tx), chirp c = m Ntx + s
+    n_ch = r_c.shape[1]
+    r_mid = r_c[:, n_ch // 2 : n_ch // 2 + 1]
+    beat = 2 * np.pi * 2 * radar.slope_hz_per_s / (SPEED_OF_LIGHT_MPS * radar.sample_rate_hz)
+    # phi_c = 4 pi R(t_c) / lambda + theta' (R(t_c) - R(t_mid)) (Nadc - 1) / 2
+    phi = (4 * np.pi / radar.wavelength_m) * r_c + beat * (r_c - r_mid) * (
+        (radar.n_samples - 1) / 2
+    )
+    y = np.exp(1j * (phi % (2 * np.pi))).reshape(len(scatterers), radar.n_loops, radar.n_tx)
+    y = np.ascontiguousarray(y.transpose(0, 2, 1))  # (N, slot, loop)
+    if settings.static_clutter_removal:
+        y -= y.mean(axis=-1, keepdims=True)
+    return y
+
+
+def doppler_responses(
+    radar: RadarConfig, scatterers: Scatterers, settings: ProcessingSettings
+) -> np.ndarray:
+    """Slow-time response of each scatterer per TX slot, ``(N, n_tx, n_loops)`` complex128.
+
+    Index ``d`` is zero-velocity centred. Includes the TDM slot delay, static clutter removal
+    and the beat tone's phase drift with the range (see the module docstring).
+    """
+    r_c = chirp_ranges_m(radar, scatterers)  # (N, n_loops * n_tx), chirp c = m Ntx + s
+    n_ch = r_c.shape[1]
+    r_mid = r_c[:, n_ch // 2 : n_ch // 2 + 1]
+    beat = 2 * np.pi * 2 * radar.slope_hz_per_s / (SPEED_OF_LIGHT_MPS * radar.sample_rate_hz)
+    # phi_c = 4 pi R(t_c) / lambda + theta' (R(t_c) - R(t_mid)) (Nadc - 1) / 2
+    phi = (4 * np.pi / radar.wavelength_m) * r_c + beat * (r_c - r_mid) * (
+        (radar.n_samples - 1) / 2
+    )
+    y = np.exp(1j * (phi % (2 * np.pi))).reshape(len(scatterers), radar.n_loops, radar.n_tx)
+    y = y.transpose(0, 2, 1)  # (N, slot, loop)
+    if settings.static_clutter_removal:
+        y = y - y.mean(axis=-1, keepdims=True)
+    w = _doppler_window_shifted(settings.doppler_window, radar.n_loops)
+    out = scipy.fft.fft(y * w, axis=-1)
+    if radar.n_loops % 2:
+        out = np.fft.fftshift(out, axes=-1)
+    return out
+
+
+@functools.lru_cache(maxsize=32)
+def _cosine_sum_coefficients(name: str, n: int) -> np.ndarray:
+    """``b_j`` (j = -J..J) with ``w[n] = sum_j b_j exp(j 2 pi j n / N)``, complex128 ``(2J+1,)``.
+
+    The library's windows are periodic cosine sums (rect, Hann, Hamming, Blackman), so the
+    window's DFT ``W`` has only these few non-zero coefficients: ``b_j = W[j] / N``.
+    """
+    w = window(name, n).astype(np.float64)
+    big_w = np.fft.fft(w) / n
+    half = 0
+    for j in range(1, n // 2):
+        if abs(big_w[j]) > 1e-6 * abs(big_w[0]):
+            half = j
+    b = np.array([big_w[j % n] for j in range(-half, half + 1)])
+    # the closed form below is exact only for cosine sums: check that nothing else is left
+    rebuilt = np.real(
+        np.sum(
+            b[:, None]
+            * np.exp(2j * np.pi * np.outer(np.arange(-half, half + 1), np.arange(n)) / n),
+            axis=0,
+        )
+    )
+    if half > 4 or np.max(np.abs(rebuilt - w)) > 1e-5:
+        raise ValueError(f"window {name!r} is not a short cosine sum")
+    return b
+
+
+@numba.njit(cache=True, nogil=True)
+def _signal_kernel(
+    amp, theta, slow, wd, b, s2, steer, slot, threshold, tw_r, tw_d
+):  # pragma: no cover
+    """Patch cells and their noise-free channel values (see :func:`fast_spectrum`).
+
+    amp (N,), theta (N,) beat tone rad/sample, slow (N, n_tx, M) slow-time sequences (after
+    clutter removal), wd (M,) Doppler window with the fftshift folded in, b (2J+1,) range
+    window coefficients, s2 (M,) cell noise power, steer (N, L), slot (L,) TX slot of each
+    channel, tw_r (N,) = exp(-j 2 pi k / N), tw_d (M, M) = exp(-j 2 pi d m / M).
+    """
+    n_samples = tw_r.shape[0]
+    n_s = amp.shape[0]
+    n_tx, m = slow.shape[1], slow.shape[2]
+    n_v = steer.shape[1]
+    half = (b.shape[0] - 1) // 2
+    nn = n_samples
+    # range response R_i[k] = sum_j b_j G(theta - 2 pi (k - j) / N),
+    # G(phi) = (1 - exp(j phi N)) / (1 - exp(j phi)), exp(j phi N) = exp(j theta N)
+    rr = np.empty((n_s, nn), dtype=np.complex128)
+    for i in range(n_s):
+        num = 1.0 - np.exp(1j * theta[i] * nn)
+        e = np.exp(1j * theta[i])
+        for k in range(nn):
+            acc = 0.0 + 0.0j
+            for jj in range(-half, half + 1):
+                den = 1.0 - e * tw_r[(k - jj) % nn]
+                if abs(den) < 1e-12:
+                    g = nn + 0.0j
+                else:
+                    g = num / den
+                acc += b[jj + half] * g
+            rr[i, k] = amp[i] * acc
+    # Doppler response D_i[s, d] = sum_m wd[m] y[m] exp(-j 2 pi d m / M)
+    dd = np.empty((n_s, n_tx, m), dtype=np.complex128)
+    for i in range(n_s):
+        for s in range(n_tx):
+            for d in range(m):
+                acc = 0.0 + 0.0j
+                for t in range(m):
+                    acc += wd[t] * slow[i, s, t] * tw_d[d, t]
+                dd[i, s, d] = acc
+    pr = np.abs(rr) ** 2
+    pd = np.zeros((n_s, m))
+    for i in range(n_s):
+        for s in range(n_tx):
+            for d in range(m):
+                pd[i, d] = max(pd[i, d], abs(dd[i, s, d]) ** 2)
+    cells_k = np.empty(nn * m, dtype=np.int64)
+    cells_d = np.empty(nn * m, dtype=np.int64)
+    n_c = 0
+    for k in range(nn):
+        for d in range(m):
+            lim = threshold * s2[d]
+            for i in range(n_s):
+                if pr[i, k] * pd[i, d] > lim:
+                    cells_k[n_c] = k
+                    cells_d[n_c] = d
+                    n_c += 1
+                    break
+    x = np.zeros((n_c, n_v), dtype=np.complex128)
+    for c in range(n_c):
+        k = cells_k[c]
+        d = cells_d[c]
+        for i in range(n_s):
+            for v in range(n_v):
+                # X[c, v] = sum_i A_i R_i[k] D_i[slot(v), d] a_i[v]
+                x[c, v] += rr[i, k] * dd[i, slot[v], d] * steer[i, v]
+    return cells_k[:n_c], cells_d[:n_c], x
+
+
+@functools.lru_cache(maxsize=8)
+def _twiddles(n_r: int, n_d: int) -> tuple[np.ndarray, np.ndarray]:
+    """``exp(-j 2 pi k / Nr)`` ``(Nr,)`` and ``exp(-j 2 pi d m / Nd)`` ``(Nd, Nd)``."""
+    k = np.arange(n_r)
+    m = np.arange(n_d)
+    return np.exp(-2j * np.pi * k / n_r), np.exp(-2j * np.pi * np.outer(m, m) / n_d)
+
+
+class Spectrum(NamedTuple):
+    """The ``fast`` level's range-Doppler map and what it needs to rebuild detected cells.
+
+    Attributes
+    ----------
+    rd_map
+        ``[range bin, Doppler bin]`` float32 power (V²) summed over channels, zero velocity
+        centred.
+    patch
+        ``(n_cells, 2)`` int: range bin and Doppler index of the cells where a scatterer's
+        energy matters.
+    signal
+        ``(n_cells, n_virtual)`` complex128 noise-free Doppler-cube values of those cells.
+    along
+        ``(n_cells,)`` complex128: the noise component along ``signal / |signal|``.
+    ortho
+        ``(n_cells,)`` float64: noise power orthogonal to the signal (V²).
+    """
+
+    rd_map: np.ndarray
+    patch: np.ndarray
+    signal: np.ndarray
+    along: np.ndarray
+    ortho: np.ndarray
+
+
+def fast_spectrum(
+    radar: RadarConfig,
+    scatterers: Scatterers,
+    rng: np.random.Generator,
+    *,
+    antenna: AntennaGain,
+    settings: ProcessingSettings = DEFAULT_PROCESSING,
+    noise: bool = True,
+) -> Spectrum:
+    """Range-Doppler map in closed form (see the module docstring).
+
+    Circular complex Gaussian noise is invariant under rotations of ``C^L``: in a patch cell
+    with signal vector ``s`` the channel sum ``sum_v |s_v + n_v|^2`` has the law of
+    ``|(|s| + n_1)|^2 + s2 Gamma(L - 1)`` (``n_1`` the noise along ``s``), so a cell costs one
+    complex normal and one Gamma draw instead of ``L`` complex normals; the channel values of
+    detected cells are rebuilt from the same draws by :func:`detected_channels`.
+    """
+    n_r, n_d, n_v = radar.n_samples, radar.n_loops, radar.n_virtual
+    s2 = cell_noise_power_v2(radar, settings)  # (n_d,)
+    if noise:
+        # noise-only cell: sum of L exponentials of mean s2[d] ~ s2[d] Gamma(L)
+        rd = rng.standard_gamma(float(n_v), (n_r, n_d), dtype=np.float32)
+        rd *= s2.astype(np.float32)[None, :]
+    else:
+        rd = np.zeros((n_r, n_d), dtype=np.float32)
+    if len(scatterers) == 0:
+        e = np.zeros(0)
+        return Spectrum(rd, np.zeros((0, 2), dtype=np.int64), np.zeros((0, n_v), complex), e, e)
+    power = received_power_w(
+        radar, scatterers.range_m, scatterers.azimuth_rad, scatterers.rcs_dbsm, antenna
+    )
+    amp = signal_amplitude_v(radar, power)  # (N,)
+    r_mid = np.linalg.norm(
+        scatterers.position_m
+        + scatterers.velocity_mps * (0.5 * radar.n_loops * radar.n_tx * radar.chirp_period_s),
+        axis=1,
+    )
+    # theta = 2 pi (2 S R / c) / Fs   (rad per sample)
+    theta = (
+        2 * np.pi * 2 * radar.slope_hz_per_s / (SPEED_OF_LIGHT_MPS * radar.sample_rate_hz)
+    ) * r_mid
+    k_idx, d_idx, x = _signal_kernel(
+        amp,
+        theta,
+        slow_time_sequences(radar, scatterers, settings),
+        _doppler_window_shifted(settings.doppler_window, n_d),
+        _cosine_sum_coefficients(settings.range_window, n_r),
+        s2,
+        steering_vectors(radar, scatterers),
+        np.arange(n_v) // radar.n_rx,
+        PATCH_THRESHOLD,
+        *_twiddles(n_r, n_d),
+    )
+    n_c = len(k_idx)
+    norm = np.sqrt(np.sum(x.real**2 + x.imag**2, axis=1))
+    if noise:
+        sd = np.sqrt(s2[d_idx] / 2)
+        along = sd * (rng.standard_normal(n_c) + 1j * rng.standard_normal(n_c))
+        ortho = s2[d_idx] * rng.standard_gamma(float(n_v - 1), n_c)
+    else:
+        along, ortho = np.zeros(n_c, dtype=complex), np.zeros(n_c)
+    # P = |(|s| + n_1)|^2 + |n_perp|^2
+    rd[k_idx, d_idx] = np.abs(norm + along) ** 2 + ortho
+    return Spectrum(rd, np.column_stack((k_idx, d_idx)).astype(np.int64), x, along, ortho)
+
+
+def simulate_frame_fast(
+    radar: RadarConfig,
+    scatterers: Scatterers,
+    rng: np.random.Generator,
+    *,
+    antenna: AntennaGain,
+    settings: ProcessingSettings = DEFAULT_PROCESSING,
+    keep_rd_map: bool = False,
+    elevation: bool | None = None,
+    noise: bool = True,
+) -> FrameOutput:
+    """One frame at the ``fast`` level: closed-form spectrum, then the exact chain's detection.
+
+    Same signature and output as :func:`core.simulation.simulate_frame`; see the module
+    docstring for the model. ``rng`` draws the noise (a different stream from the exact level's,
+    so the same seed gives statistically equivalent, not identical, frames).
+    """
+    spec = fast_spectrum(radar, scatterers, rng, antenna=antenna, settings=settings, noise=noise)
+    rd = spec.rd_map
+    det = two_stage_cfar_compiled(rd, radar, settings)
+    if elevation is None:
+        elevation = needs_elevation(radar, scatterers)
+    pc = PointCloud.empty()
+    if len(det):
+        ch = detected_channels(radar, spec, det, rng)
+        pc = label_points(
+            radar, points_from_channels(radar, settings, rd, det, ch, elevation), scatterers
+        )
+    rd_db = None
+    if keep_rd_map:
+        rd_db = (10 * np.log10(np.maximum(rd, np.finfo(np.float32).tiny))).astype(np.float32)
+    return FrameOutput(
+        point_cloud=pc,
+        rd_map_db=rd_db,
+        detections=np.column_stack((det.range_bin, det.doppler_index)).astype(np.int64),
+    )
+
+
+def detected_channels(
+    radar: RadarConfig, spec: Spectrum, det: Detections, rng: np.random.Generator
+) -> np.ndarray:
+    """Per-channel values ``(n_det, n_virtual)`` complex128 of the detected cells.
+
+    Patch cell: ``x = s + n_1 u + w`` with ``u = s / |s|`` and ``w`` a uniformly random vector
+    orthogonal to ``u`` with ``|w|^2`` the drawn orthogonal power. Noise-only cell: ``P^(1/2)``
+    times a uniformly random unit vector of ``C^L`` (``P`` the cell's summed power). Both are the
+    exact conditional laws of i.i.d. circular Gaussian channels given the drawn map.
+    """
+    rd = spec.rd_map
+    n_v = radar.n_virtual
+    n_det = len(det)
+    index = np.full(rd.shape, -1, dtype=np.int64)
+    index[spec.patch[:, 0], spec.patch[:, 1]] = np.arange(len(spec.patch))
+    j = index[det.range_bin, det.doppler_index]
+    z = rng.standard_normal((n_det, n_v)) + 1j * rng.standard_normal((n_det, n_v))
+    out = np.empty((n_det, n_v), dtype=np.complex128)
+    inside = j >= 0
+    if np.any(inside):
+        s = spec.signal[j[inside]]
+        norm = np.linalg.norm(s, axis=1, keepdims=True)
+        u = np.where(norm > 0, s / np.where(norm > 0, norm, 1.0), np.eye(1, n_v))
+        w = z[inside]
+        w -= u * np.sum(np.conj(u) * w, axis=1, keepdims=True)  # project out u
+        w *= np.sqrt(spec.ortho[j[inside]] / np.sum(np.abs(w) ** 2, axis=1))[:, None]
+        out[inside] = s + spec.along[j[inside], None] * u + w
+    if not np.all(inside):
+        p = rd[det.range_bin[~inside], det.doppler_index[~inside]].astype(np.float64)
+        zo = z[~inside]
+        out[~inside] = zo * np.sqrt(p / np.sum(np.abs(zo) ** 2, axis=1))[:, None]
+    return out
+
+
+def points_from_channels(
+    radar: RadarConfig,
+    settings: ProcessingSettings,
+    rd: np.ndarray,
+    det: Detections,
+    channels: np.ndarray,
+    elevation: bool,
+) -> PointCloud:
+    """Point cloud from detections and their channel values: the exact chain's steps 6-7.
+
+    The same refinement (:func:`core.processing.refine_bins`) and angle estimation
+    (:func:`core.processing.estimate_angles`) as :func:`core.processing.build_point_cloud`,
+    without building the Doppler cube. ``source`` is left at ``SOURCE_OTHER``.
+    """
+    r_bin, d_bin = refine_bins(rd, det)
+    az, el = estimate_angles(
+        channels, d_bin, radar, fft_size=settings.angle_fft_size, elevation=elevation
+    )
+    rng_m = r_bin * radar.range_resolution_m
+    horiz = rng_m * np.cos(el)
+    return PointCloud(
+        range_m=rng_m,
+        azimuth_rad=az,
+        elevation_rad=el,
+        radial_velocity_mps=d_bin * radar.velocity_resolution_mps,
+        snr_db=det.snr_db,
+        x_m=horiz * np.sin(az),
+        y_m=horiz * np.cos(az),
+        z_m=rng_m * np.sin(el),
+        source=np.full(len(det), SOURCE_OTHER, dtype=np.int32),
+    )
+
+
+def label_points(radar: RadarConfig, pc: PointCloud, scatterers: Scatterers) -> PointCloud:
+    """Ground-truth labels as the exact chain sets them: nearest reflector at mid-frame."""
+    if not len(pc) or not len(scatterers):
+        return pc
+    t_mid = 0.5 * radar.n_loops * radar.n_tx * radar.chirp_period_s
+    pos = scatterers.position_m + scatterers.velocity_mps * t_mid
+    r_mid = np.linalg.norm(pos, axis=1)
+    vr = np.einsum("ij,ij->i", pos, scatterers.velocity_mps) / r_mid
+    src = label_sources(pc.range_m, pc.radial_velocity_mps, r_mid, vr, scatterers.source, radar)
+    return PointCloud(
+        range_m=pc.range_m,
+        azimuth_rad=pc.azimuth_rad,
+        elevation_rad=pc.elevation_rad,
+        radial_velocity_mps=pc.radial_velocity_mps,
+        snr_db=pc.snr_db,
+        x_m=pc.x_m,
+        y_m=pc.y_m,
+        z_m=pc.z_m,
+        source=src,
+    )
+
+
+# ---- the exact chain's two-stage CFAR, compiled ------------------------------------------------
+# The same decisions as core.processing.two_stage_cfar (same thresholds from
+# core.processing.make_cfar, same edge rules, same peak grouping, same output order); it only
+# avoids numpy's per-call overhead on a 256 x 32 map. tests/core/fidelity checks the equality.
+_METHOD_CODE = {"ca": 0, "caso": 1, "cago": 2}
+
+
+@numba.njit(cache=True, nogil=True)
+def _cfar_line(p, n, g, cyclic, method, alpha_both, alpha_one, mask, mu, cs):  # pragma: no cover
+    size = p.shape[0]
+    pad = n + g if cyclic else 0
+    # prefix sums over the (cyclically padded) line: cs[j] = sum of the first j padded cells
+    cs[0] = 0.0
+    for j in range(size + 2 * pad):
+        cs[j + 1] = cs[j] + p[(j - pad) % size]
+    for i in range(size):
+        c = i + pad
+        if cyclic:
+            ok_l = True
+            ok_r = True
+            left = cs[c - g] - cs[c - g - n]
+            right = cs[c + g + 1 + n] - cs[c + g + 1]
+        else:
+            ok_l = i - g - n >= 0
+            ok_r = i + g + n <= size - 1
+            left = cs[max(0, i - g)] - cs[max(0, i - g - n)]
+            right = cs[min(size, i + g + 1 + n)] - cs[min(size, i + g + 1)]
+        if ok_l and ok_r:
+            if method == 0:
+                m = (left + right) / (2 * n)
+            elif method == 1:
+                m = min(left, right) / n
+            else:
+                m = max(left, right) / n
+            a = alpha_both
+        elif ok_l:
+            m = left / n
+            a = alpha_one
+        elif ok_r:
+            m = right / n
+            a = alpha_one
+        else:
+            mu[i] = np.nan
+            mask[i] = False
+            continue
+        mu[i] = m
+        mask[i] = p[i] > a * m
+
+
+@numba.njit(cache=True, nogil=True)
+def _two_stage_kernel(
+    rd,
+    lo,
+    hi,
+    a,
+    b,
+    rn,
+    rg,
+    rcyc,
+    rmeth,
+    ralpha,
+    ralpha1,
+    dn,
+    dg,
+    dcyc,
+    dmeth,
+    dalpha,
+    dalpha1,
+    peak,
+):  # pragma: no cover
+    n_r, n_d = rd.shape
+    size = b - a
+    mask_r = np.zeros((size, n_d), dtype=np.bool_)
+    noise_r = np.empty((size, n_d), dtype=np.float64)
+    col = np.empty(size, dtype=np.float64)
+    mcol = np.empty(size, dtype=np.bool_)
+    ncol = np.empty(size, dtype=np.float64)
+    cs = np.empty(2 * (size + n_d) + 2 * (rn + rg + dn + dg) + 2, dtype=np.float64)
+    for d in range(n_d):
+        for i in range(size):
+            col[i] = rd[a + i, d]
+        _cfar_line(col, rn, rg, rcyc, rmeth, ralpha, ralpha1, mcol, ncol, cs)
+        for i in range(size):
+            mask_r[i, d] = mcol[i] and (lo <= a + i <= hi)
+            noise_r[i, d] = ncol[i]
+    out_r = np.empty(size * n_d, dtype=np.int64)
+    out_d = np.empty(size * n_d, dtype=np.int64)
+    out_n = np.empty(size * n_d, dtype=np.float64)
+    n_out = 0
+    row = np.empty(n_d, dtype=np.float64)
+    mrow = np.empty(n_d, dtype=np.bool_)
+    nrow = np.empty(n_d, dtype=np.float64)
+    for i in range(size):
+        any_r = False
+        for d in range(n_d):
+            any_r = any_r or mask_r[i, d]
+        if not any_r:
+            continue
+        for d in range(n_d):
+            row[d] = rd[a + i, d]
+        _cfar_line(row, dn, dg, dcyc, dmeth, dalpha, dalpha1, mrow, nrow, cs)
+        r = a + i
+        for d in range(n_d):
+            if not (mask_r[i, d] and mrow[d]):
+                continue
+            if peak:
+                keep = True
+                for dr in range(-1, 2):
+                    rr = r + dr
+                    if rr < 0 or rr >= n_r:
+                        continue
+                    for dd in range(-1, 2):
+                        if (dr != 0 or dd != 0) and rd[r, d] < rd[rr, (d + dd) % n_d]:
+                            keep = False
+                if not keep:
+                    continue
+            out_r[n_out] = r
+            out_d[n_out] = d
+            out_n[n_out] = noise_r[i, d]
+            n_out += 1
+    return out_r[:n_out], out_d[:n_out], out_n[:n_out]
+
+
+def two_stage_cfar_compiled(
+    rd_map: np.ndarray,
+    radar: RadarConfig,
+    settings: ProcessingSettings = DEFAULT_PROCESSING,
+    *,
+    n_channels: int | None = None,
+) -> Detections:
+    """:func:`core.processing.two_stage_cfar`, compiled: the same detections, in the same order.
+
+    Parameters and returns as there (``rd_map`` ``[range bin, Doppler bin]``, Doppler zero
+    velocity centred).
+    """
+    rd = np.ascontiguousarray(rd_map)
+    L = radar.n_virtual if n_channels is None else n_channels
+    args = _cfar_arguments(radar, settings, L, rd.shape[0])
+    if args is None:
+        return _no_detections()
+    r, d, noise = _two_stage_kernel(rd, *args)
+    return Detections(
+        range_bin=r, doppler_index=d, power=rd[r, d].astype(np.float64), noise_power=noise
+    )
+
+
+@functools.lru_cache(maxsize=64)
+def _cfar_arguments(radar: RadarConfig, settings: ProcessingSettings, n_channels: int, n_r: int):
+    """Range limits, training windows and threshold factors of the two stages (cached)."""
+    k = np.arange(n_r) * radar.range_resolution_m
+    in_range = (k >= settings.min_range_m) & (k <= settings.max_range_m)
+    if not in_range.any():
+        return None
+    lo, hi = (int(i) for i in np.flatnonzero(in_range)[[0, -1]])
+    rc, dc = settings.range_cfar, settings.doppler_cfar
+    margin = rc.n_train + rc.n_guard
+    a, b = max(0, lo - margin), min(n_r, hi + 1 + margin)
+    rcf, dcf = make_cfar(rc, n_channels), make_cfar(dc, n_channels)
+    return (
+        lo, hi, a, b,
+        rc.n_train, rc.n_guard, rc.cyclic, _METHOD_CODE[rc.method], rcf.alpha(),
+        rcf.alpha_one_side(),
+        dc.n_train, dc.n_guard, dc.cyclic, _METHOD_CODE[dc.method], dcf.alpha(),
+        dcf.alpha_one_side(),
+        settings.peak_grouping,
+    )  # fmt: skip
+
+
+def _no_detections() -> Detections:
+    e = np.zeros(0, dtype=np.int64)
+    return Detections(range_bin=e, doppler_index=e, power=np.zeros(0), noise_power=np.zeros(0))
