@@ -60,8 +60,9 @@ from core.processing import (
     refine_bins,
     window,
 )
+from core.processing.angle import azimuth_row, elevation_pairs
 from core.simulation.antenna import AntennaGain
-from core.simulation.baseband import chirp_ranges_m, steering_vectors
+from core.simulation.baseband import steering_vectors
 from core.simulation.frame import FrameOutput, needs_elevation
 from core.simulation.link import noise_power_v2, received_power_w, signal_amplitude_v
 from core.simulation.scatterers import Scatterers
@@ -130,24 +131,29 @@ def range_responses(radar: RadarConfig, range_m: np.ndarray, settings: Processin
 
 def slow_time_sequences(
     radar: RadarConfig, scatterers: Scatterers, settings: ProcessingSettings
-) -> np.ndarray:
-    """Slow-time phase sequence ``y`` of each scatterer per TX slot, ``(N, n_tx, n_loops)``.
+) -> tuple[np.ndarray, np.ndarray]:
+    """Slow-time sequences ``y`` and ``delta y`` per scatterer and TX slot, ``(N, n_tx, n_loops)``.
 
-    After static clutter removal when the settings ask for it (see the module docstring).
+    ``y_c = exp(j (4 pi R(t_c) / lambda + delta_c (Nadc - 1) / 2))`` and ``delta_c y_c`` with
+    ``delta_c = theta' (R(t_c) - R(t_mid))`` the beat tone's drift (rad/sample) at chirp ``c``;
+    both after static clutter removal when the settings ask for it.
     """
-    r_c = chirp_ranges_m(radar, scatterers)  # (N, n_loops * n_tx), chirp c = m Ntx + s
-    n_ch = r_c.shape[1]
-    r_mid = r_c[:, n_ch // 2 : n_ch // 2 + 1]
-    beat = 2 * np.pi * 2 * radar.slope_hz_per_s / (SPEED_OF_LIGHT_MPS * radar.sample_rate_hz)
-    # phi_c = 4 pi R(t_c) / lambda + theta' (R(t_c) - R(t_mid)) (Nadc - 1) / 2
-    phi = (4 * np.pi / radar.wavelength_m) * r_c + beat * (r_c - r_mid) * (
-        (radar.n_samples - 1) / 2
+    return _slow_time_kernel(
+        np.ascontiguousarray(scatterers.position_m, dtype=np.float64),
+        np.ascontiguousarray(scatterers.velocity_mps, dtype=np.float64),
+        radar.n_tx,
+        radar.n_loops,
+        radar.chirp_period_s,
+        4 * np.pi / radar.wavelength_m,
+        _beat_rad_per_sample_per_m(radar),
+        radar.n_samples,
+        settings.static_clutter_removal,
     )
-    y = np.exp(1j * (phi % (2 * np.pi))).reshape(len(scatterers), radar.n_loops, radar.n_tx)
-    y = np.ascontiguousarray(y.transpose(0, 2, 1))  # (N, slot, loop)
-    if settings.static_clutter_removal:
-        y -= y.mean(axis=-1, keepdims=True)
-    return y
+
+
+def _beat_rad_per_sample_per_m(radar: RadarConfig) -> float:
+    """``theta' = 2 pi (2 S / c) / Fs``: beat tone phase per ADC sample per metre of range."""
+    return 2 * np.pi * 2 * radar.slope_hz_per_s / (SPEED_OF_LIGHT_MPS * radar.sample_rate_hz)
 
 
 def doppler_responses(
@@ -158,18 +164,7 @@ def doppler_responses(
     Index ``d`` is zero-velocity centred. Includes the TDM slot delay, static clutter removal
     and the beat tone's phase drift with the range (see the module docstring).
     """
-    r_c = chirp_ranges_m(radar, scatterers)  # (N, n_loops * n_tx), chirp c = m Ntx + s
-    n_ch = r_c.shape[1]
-    r_mid = r_c[:, n_ch // 2 : n_ch // 2 + 1]
-    beat = 2 * np.pi * 2 * radar.slope_hz_per_s / (SPEED_OF_LIGHT_MPS * radar.sample_rate_hz)
-    # phi_c = 4 pi R(t_c) / lambda + theta' (R(t_c) - R(t_mid)) (Nadc - 1) / 2
-    phi = (4 * np.pi / radar.wavelength_m) * r_c + beat * (r_c - r_mid) * (
-        (radar.n_samples - 1) / 2
-    )
-    y = np.exp(1j * (phi % (2 * np.pi))).reshape(len(scatterers), radar.n_loops, radar.n_tx)
-    y = y.transpose(0, 2, 1)  # (N, slot, loop)
-    if settings.static_clutter_removal:
-        y = y - y.mean(axis=-1, keepdims=True)
+    y = slow_time_sequences(radar, scatterers, settings)[0]
     w = _doppler_window_shifted(settings.doppler_window, radar.n_loops)
     out = scipy.fft.fft(y * w, axis=-1)
     if radar.n_loops % 2:
@@ -205,15 +200,60 @@ def _cosine_sum_coefficients(name: str, n: int) -> np.ndarray:
 
 
 @numba.njit(cache=True, nogil=True)
-def _signal_kernel(
-    amp, theta, slow, wd, b, s2, steer, slot, threshold, tw_r, tw_d
+def _slow_time_kernel(
+    pos, vel, n_tx, n_loops, t_chirp, k_phase, k_beat, n_samples, clutter_removal
 ):  # pragma: no cover
-    """Patch cells and their noise-free channel values (see :func:`fast_spectrum`).
+    """Slow-time sequences ``y`` and ``delta y``, each ``(N, n_tx, n_loops)``.
+
+    See :func:`slow_time_sequences`.
+    """
+    n_s = pos.shape[0]
+    n_ch = n_tx * n_loops
+    y = np.empty((n_s, n_tx, n_loops), dtype=np.complex128)
+    y1 = np.empty((n_s, n_tx, n_loops), dtype=np.complex128)
+    centre = (n_samples - 1) / 2
+    for i in range(n_s):
+        t_mid = (n_ch // 2) * t_chirp
+        r_mid = np.sqrt(
+            (pos[i, 0] + vel[i, 0] * t_mid) ** 2
+            + (pos[i, 1] + vel[i, 1] * t_mid) ** 2
+            + (pos[i, 2] + vel[i, 2] * t_mid) ** 2
+        )
+        for c in range(n_ch):
+            t = c * t_chirp
+            # R(t_c) = |p + v t_c|
+            r = np.sqrt(
+                (pos[i, 0] + vel[i, 0] * t) ** 2
+                + (pos[i, 1] + vel[i, 1] * t) ** 2
+                + (pos[i, 2] + vel[i, 2] * t) ** 2
+            )
+            # delta_c = theta' (R(t_c) - R(t_mid));  phi_c = 4 pi R(t_c) / lambda + delta_c (N-1)/2
+            delta = k_beat * (r - r_mid)
+            phi = (k_phase * r) % (2 * np.pi) + delta * centre
+            z = np.cos(phi) + 1j * np.sin(phi)
+            y[i, c % n_tx, c // n_tx] = z
+            y1[i, c % n_tx, c // n_tx] = delta * z
+        if clutter_removal:
+            for s in range(n_tx):
+                mean = y[i, s, :].sum() / n_loops
+                mean1 = y1[i, s, :].sum() / n_loops
+                for m in range(n_loops):
+                    y[i, s, m] -= mean
+                    y1[i, s, m] -= mean1
+    return y, y1
+
+
+@numba.njit(cache=True, nogil=True)
+def _signal_kernel(
+    rng, rd, amp, theta, slow, slow1, wd, b, s2, steer, slot, threshold, tw_r, tw_d, noise
+):  # pragma: no cover
+    """Patch cells, their noise-free channel values and their noisy channel sums.
 
     amp (N,), theta (N,) beat tone rad/sample, slow (N, n_tx, M) slow-time sequences (after
-    clutter removal), wd (M,) Doppler window with the fftshift folded in, b (2J+1,) range
+    clutter removal), wd (M,) Doppler window, b (2J+1,) range
     window coefficients, s2 (M,) cell noise power, steer (N, L), slot (L,) TX slot of each
-    channel, tw_r (N,) = exp(-j 2 pi k / N), tw_d (M, M) = exp(-j 2 pi d m / M).
+    channel, tw_r (N,) = exp(-j 2 pi k / N), tw_d (M, M) = exp(-j 2 pi (d - M/2) m / M). Writes the
+    patch cells' power into ``rd``.
     """
     n_samples = tw_r.shape[0]
     n_s = amp.shape[0]
@@ -222,36 +262,53 @@ def _signal_kernel(
     half = (b.shape[0] - 1) // 2
     nn = n_samples
     # range response R_i[k] = sum_j b_j G(theta - 2 pi (k - j) / N),
-    # G(phi) = (1 - exp(j phi N)) / (1 - exp(j phi)), exp(j phi N) = exp(j theta N)
+    # G(phi) = (1 - exp(j phi N)) / (1 - exp(j phi)), exp(j phi N) = exp(j theta N);
+    # its centred derivative R1_i[k] = dR/dtheta - j (N - 1)/2 R = sum_n w_n j (n - (N-1)/2) ...
     rr = np.empty((n_s, nn), dtype=np.complex128)
+    rr1 = np.empty((n_s, nn), dtype=np.complex128)
+    pr = np.empty((n_s, nn))
+    pr1 = np.empty((n_s, nn))
+    centre = (nn - 1) / 2
     for i in range(n_s):
-        num = 1.0 - np.exp(1j * theta[i] * nn)
+        e_n = np.exp(1j * theta[i] * nn)
+        num = 1.0 - e_n
         e = np.exp(1j * theta[i])
         for k in range(nn):
             acc = 0.0 + 0.0j
+            acc1 = 0.0 + 0.0j
             for jj in range(-half, half + 1):
-                den = 1.0 - e * tw_r[(k - jj) % nn]
-                if abs(den) < 1e-12:
+                q = e * tw_r[(k - jj) % nn]  # exp(j phi)
+                den = 1.0 - q
+                if abs(den) < 1e-9:
                     g = nn + 0.0j
+                    g1 = 1j * nn * (nn - 1) / 2
                 else:
                     g = num / den
+                    # dG/dtheta = (-j N e^{j N theta} (1 - q) + (1 - e^{j N theta}) j q) / (1 - q)^2
+                    g1 = (-1j * nn * e_n * den + num * 1j * q) / (den * den)
                 acc += b[jj + half] * g
+                acc1 += b[jj + half] * g1
             rr[i, k] = amp[i] * acc
-    # Doppler response D_i[s, d] = sum_m wd[m] y[m] exp(-j 2 pi d m / M)
+            rr1[i, k] = amp[i] * (acc1 - 1j * centre * acc)
+            pr[i, k] = rr[i, k].real ** 2 + rr[i, k].imag ** 2
+            pr1[i, k] = rr1[i, k].real ** 2 + rr1[i, k].imag ** 2
+    # Doppler responses D_i[s, d] = sum_m wd[m] y[m] exp(-j 2 pi (d - M/2) m / M), D1 of delta y
     dd = np.empty((n_s, n_tx, m), dtype=np.complex128)
+    dd1 = np.empty((n_s, n_tx, m), dtype=np.complex128)
+    pd = np.zeros((n_s, m))
+    pd1 = np.zeros((n_s, m))
     for i in range(n_s):
         for s in range(n_tx):
             for d in range(m):
                 acc = 0.0 + 0.0j
+                acc1 = 0.0 + 0.0j
                 for t in range(m):
                     acc += wd[t] * slow[i, s, t] * tw_d[d, t]
+                    acc1 += wd[t] * slow1[i, s, t] * tw_d[d, t]
                 dd[i, s, d] = acc
-    pr = np.abs(rr) ** 2
-    pd = np.zeros((n_s, m))
-    for i in range(n_s):
-        for s in range(n_tx):
-            for d in range(m):
-                pd[i, d] = max(pd[i, d], abs(dd[i, s, d]) ** 2)
+                dd1[i, s, d] = acc1
+                pd[i, d] = max(pd[i, d], acc.real**2 + acc.imag**2)
+                pd1[i, d] = max(pd1[i, d], acc1.real**2 + acc1.imag**2)
     cells_k = np.empty(nn * m, dtype=np.int64)
     cells_d = np.empty(nn * m, dtype=np.int64)
     n_c = 0
@@ -259,28 +316,47 @@ def _signal_kernel(
         for d in range(m):
             lim = threshold * s2[d]
             for i in range(n_s):
-                if pr[i, k] * pd[i, d] > lim:
+                if pr[i, k] * pd[i, d] + pr1[i, k] * pd1[i, d] > lim:
                     cells_k[n_c] = k
                     cells_d[n_c] = d
                     n_c += 1
                     break
     x = np.zeros((n_c, n_v), dtype=np.complex128)
+    along = np.zeros(n_c, dtype=np.complex128)
+    ortho = np.zeros(n_c)
+    g = np.empty(n_tx, dtype=np.complex128)
     for c in range(n_c):
         k = cells_k[c]
         d = cells_d[c]
         for i in range(n_s):
+            for s in range(n_tx):
+                # first order in the beat tone's drift: R D + R1 D1
+                g[s] = rr[i, k] * dd[i, s, d] + rr1[i, k] * dd1[i, s, d]
             for v in range(n_v):
                 # X[c, v] = sum_i A_i R_i[k] D_i[slot(v), d] a_i[v]
-                x[c, v] += rr[i, k] * dd[i, slot[v], d] * steer[i, v]
-    return cells_k[:n_c], cells_d[:n_c], x
+                x[c, v] += g[slot[v]] * steer[i, v]
+        norm2 = 0.0
+        for v in range(n_v):
+            norm2 += x[c, v].real ** 2 + x[c, v].imag ** 2
+        if noise:
+            sd = np.sqrt(s2[d] / 2)
+            along[c] = sd * (rng.standard_normal() + 1j * rng.standard_normal())
+            ortho[c] = s2[d] * rng.standard_gamma(n_v - 1.0)
+        # P = |(|s| + n_1)|^2 + |n_perp|^2
+        z = np.sqrt(norm2) + along[c]
+        rd[k, d] = z.real**2 + z.imag**2 + ortho[c]
+    return cells_k[:n_c], cells_d[:n_c], x, along, ortho
 
 
 @functools.lru_cache(maxsize=8)
 def _twiddles(n_r: int, n_d: int) -> tuple[np.ndarray, np.ndarray]:
-    """``exp(-j 2 pi k / Nr)`` ``(Nr,)`` and ``exp(-j 2 pi d m / Nd)`` ``(Nd, Nd)``."""
+    """``exp(-j 2 pi k / Nr)`` ``(Nr,)`` and ``exp(-j 2 pi (d - Nd/2) m / Nd)`` ``(Nd, Nd)``.
+
+    Doppler index ``d`` is zero-velocity centred (bin ``d - Nd // 2``), as in the exact chain.
+    """
     k = np.arange(n_r)
     m = np.arange(n_d)
-    return np.exp(-2j * np.pi * k / n_r), np.exp(-2j * np.pi * np.outer(m, m) / n_d)
+    return np.exp(-2j * np.pi * k / n_r), np.exp(-2j * np.pi * np.outer(m - n_d // 2, m) / n_d)
 
 
 class Spectrum(NamedTuple):
@@ -347,31 +423,22 @@ def fast_spectrum(
         axis=1,
     )
     # theta = 2 pi (2 S R / c) / Fs   (rad per sample)
-    theta = (
-        2 * np.pi * 2 * radar.slope_hz_per_s / (SPEED_OF_LIGHT_MPS * radar.sample_rate_hz)
-    ) * r_mid
-    k_idx, d_idx, x = _signal_kernel(
+    theta = _beat_rad_per_sample_per_m(radar) * r_mid
+    k_idx, d_idx, x, along, ortho = _signal_kernel(
+        rng if noise else np.random.default_rng(0),
+        rd,
         amp,
         theta,
-        slow_time_sequences(radar, scatterers, settings),
-        _doppler_window_shifted(settings.doppler_window, n_d),
+        *slow_time_sequences(radar, scatterers, settings),
+        window(settings.doppler_window, n_d).astype(np.float64),
         _cosine_sum_coefficients(settings.range_window, n_r),
         s2,
         steering_vectors(radar, scatterers),
         np.arange(n_v) // radar.n_rx,
         PATCH_THRESHOLD,
         *_twiddles(n_r, n_d),
+        noise,
     )
-    n_c = len(k_idx)
-    norm = np.sqrt(np.sum(x.real**2 + x.imag**2, axis=1))
-    if noise:
-        sd = np.sqrt(s2[d_idx] / 2)
-        along = sd * (rng.standard_normal(n_c) + 1j * rng.standard_normal(n_c))
-        ortho = s2[d_idx] * rng.standard_gamma(float(n_v - 1), n_c)
-    else:
-        along, ortho = np.zeros(n_c, dtype=complex), np.zeros(n_c)
-    # P = |(|s| + n_1)|^2 + |n_perp|^2
-    rd[k_idx, d_idx] = np.abs(norm + along) ** 2 + ortho
     return Spectrum(rd, np.column_stack((k_idx, d_idx)).astype(np.int64), x, along, ortho)
 
 
@@ -401,7 +468,7 @@ def simulate_frame_fast(
     if len(det):
         ch = detected_channels(radar, spec, det, rng)
         pc = label_points(
-            radar, points_from_channels(radar, settings, rd, det, ch, elevation), scatterers
+            radar, points_compiled(radar, settings, rd, det, ch, elevation), scatterers
         )
     rd_db = None
     if keep_rd_map:
@@ -426,9 +493,14 @@ def detected_channels(
     rd = spec.rd_map
     n_v = radar.n_virtual
     n_det = len(det)
-    index = np.full(rd.shape, -1, dtype=np.int64)
-    index[spec.patch[:, 0], spec.patch[:, 1]] = np.arange(len(spec.patch))
-    j = index[det.range_bin, det.doppler_index]
+    # patch cells are sorted by (range bin, Doppler index): look detections up by linear index
+    n_d = rd.shape[1]
+    lin = spec.patch[:, 0] * n_d + spec.patch[:, 1]
+    want = det.range_bin * n_d + det.doppler_index
+    j = np.full(n_det, -1, dtype=np.int64)
+    if len(lin):
+        pos = np.minimum(np.searchsorted(lin, want), len(lin) - 1)
+        j = np.where(lin[pos] == want, pos, -1)
     z = rng.standard_normal((n_det, n_v)) + 1j * rng.standard_normal((n_det, n_v))
     out = np.empty((n_det, n_v), dtype=np.complex128)
     inside = j >= 0
@@ -673,3 +745,128 @@ def _cfar_arguments(radar: RadarConfig, settings: ProcessingSettings, n_channels
 def _no_detections() -> Detections:
     e = np.zeros(0, dtype=np.int64)
     return Detections(range_bin=e, doppler_index=e, power=np.zeros(0), noise_power=np.zeros(0))
+
+
+# ---- the exact chain's point extraction (steps 6-7), compiled ------------------------------------
+# The same maths as core.processing.refine_bins and core.processing.estimate_angles (log-parabolic
+# peak refinement, TDM-MIMO compensation, zero-padded azimuth DFT, elevation from the elevated
+# row); tests/core/fidelity checks the equality.
+@numba.njit(cache=True, nogil=True)
+def _log_parabola(a, b, c):  # pragma: no cover
+    tiny = 2.2250738585072014e-308
+    la = np.log(max(a, tiny))
+    lb = np.log(max(b, tiny))
+    lc = np.log(max(c, tiny))
+    # delta = (a - c) / (2 (a - 2b + c))
+    den = la - 2.0 * lb + lc
+    if den < 0:
+        delta = 0.5 * (la - lc) / den
+        if not np.isfinite(delta):
+            delta = 0.0
+    else:
+        delta = 0.0
+    return min(0.5, max(-0.5, delta))
+
+
+@numba.njit(cache=True, nogil=True)
+def _points_kernel(
+    rd, r, d, x, n_tx, n_rx, row_ch, row_pos, upper, lower, fft_size, elevation
+):  # pragma: no cover
+    n_r, n_d = rd.shape
+    n_det = r.shape[0]
+    n_v = x.shape[1]
+    r_bin = np.empty(n_det)
+    d_bin = np.empty(n_det)
+    az = np.empty(n_det)
+    el = np.zeros(n_det)
+    spec = np.empty(fft_size)
+    for i in range(n_det):
+        ri, di = r[i], d[i]
+        dr = 0.0
+        if 0 < ri < n_r - 1:
+            dr = _log_parabola(
+                np.float64(rd[ri - 1, di]), np.float64(rd[ri, di]), np.float64(rd[ri + 1, di])
+            )
+        dd = _log_parabola(
+            np.float64(rd[ri, (di - 1) % n_d]),
+            np.float64(rd[ri, di]),
+            np.float64(rd[ri, (di + 1) % n_d]),
+        )
+        r_bin[i] = ri + dr
+        db = di - n_d // 2 + dd
+        d_bin[i] = db
+        # x_v exp(-j 2 pi d k(v) / (Nc Ntx))
+        xc = np.empty(n_v, dtype=np.complex128)
+        for v in range(n_v):
+            xc[v] = x[i, v] * np.exp(-2j * np.pi * db * (v // n_rx) / (n_d * n_tx))
+        # spec[j] = |sum_p x_p exp(-j 2 pi (j - N/2) p / N)|^2  (fftshifted)
+        best = 0
+        for j in range(fft_size):
+            acc = 0.0 + 0.0j
+            for q in range(row_ch.shape[0]):
+                acc += xc[row_ch[q]] * np.exp(
+                    -2j * np.pi * (((j - fft_size // 2) * row_pos[q]) % fft_size) / fft_size
+                )
+            spec[j] = acc.real**2 + acc.imag**2
+            if spec[j] > spec[best]:
+                best = j
+        delta = _log_parabola(spec[(best - 1) % fft_size], spec[best], spec[(best + 1) % fft_size])
+        # u = sin(az) cos(el) = 2 (k - N/2 + delta) / N
+        u = 2.0 * (best - fft_size // 2 + delta) / fft_size
+        e = 0.0
+        if elevation and upper.shape[0] > 0:
+            z = 0.0 + 0.0j
+            for q in range(upper.shape[0]):
+                z += xc[upper[q]] * np.conj(xc[lower[q]])
+            # sin(el) = arg(sum x_upper conj(x_lower)) / pi
+            e = np.arcsin(min(1.0, max(-1.0, np.angle(z) / np.pi)))
+        el[i] = e
+        az[i] = np.arcsin(min(1.0, max(-1.0, u / np.cos(e))))
+    return r_bin, d_bin, az, el
+
+
+@functools.lru_cache(maxsize=16)
+def _array_rows(radar: RadarConfig):
+    row_ch, row_pos = azimuth_row(radar)
+    upper, lower = elevation_pairs(radar)
+    return (
+        row_ch.astype(np.int64),
+        row_pos.astype(np.int64),
+        upper.astype(np.int64),
+        lower.astype(np.int64),
+    )
+
+
+def points_compiled(
+    radar: RadarConfig,
+    settings: ProcessingSettings,
+    rd: np.ndarray,
+    det: Detections,
+    channels: np.ndarray,
+    elevation: bool,
+) -> PointCloud:
+    """:func:`points_from_channels`, compiled: the same point cloud (``source`` = -2)."""
+    r_bin, d_bin, az, el = _points_kernel(
+        rd,
+        det.range_bin,
+        det.doppler_index,
+        np.ascontiguousarray(channels, dtype=np.complex128),
+        radar.n_tx,
+        radar.n_rx,
+        *_array_rows(radar),
+        settings.angle_fft_size,
+        bool(elevation),
+    )
+    rng_m = r_bin * radar.range_resolution_m
+    horiz = rng_m * np.cos(el)
+    return PointCloud(
+        range_m=rng_m,
+        azimuth_rad=az,
+        elevation_rad=el,
+        radial_velocity_mps=d_bin * radar.velocity_resolution_mps,
+        snr_db=det.snr_db,
+        x_m=horiz * np.sin(az),
+        y_m=horiz * np.cos(az),
+        z_m=rng_m * np.sin(el),
+        source=np.full(len(det), SOURCE_OTHER, dtype=np.int32),
+    )
