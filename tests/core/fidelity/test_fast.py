@@ -70,12 +70,14 @@ def test_noise_free_spectrum_equals_exact(settings) -> None:
     rd = range_doppler_map(dc).astype(np.float64)
     assert rd[k, d].sum() / rd.sum() > 0.9999
     # outside the patch the exact map is below the noise by the patch threshold (-30 dB) with
-    # 2 dB margin (several scatterers below the threshold each can add up)
+    # 2 dB margin (several scatterers below the threshold each can add up; more with the
+    # rectangular window's far sidelobes)
+    margin = 10**-2.8 if settings.range_window == "hann" else 10**-2.5
     s2 = cell_noise_power_v2(RADAR, settings)
     outside = np.ones(rd.shape, bool)
     outside[k, d] = False
     assert np.all(
-        rd[outside] < RADAR.n_virtual * 10**-2.8 * s2[None, :].repeat(rd.shape[0], 0)[outside]
+        rd[outside] < RADAR.n_virtual * margin * s2[None, :].repeat(rd.shape[0], 0)[outside]
     )
     # the peak cell and its power
     assert np.unravel_index(rd.argmax(), rd.shape) == np.unravel_index(
