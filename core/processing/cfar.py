@@ -323,7 +323,8 @@ def two_stage_cfar(
     Parameters
     ----------
     rd_map
-        ``[range bin, Doppler bin]`` power, non-coherent sum of ``n_channels`` channels.
+        ``[range bin, Doppler bin]`` power, non-coherent sum of ``n_channels`` channels; the
+        range bins may stop early (bins ``0 .. n-1``, e.g. where the detector stops looking).
     n_channels
         Number of summed channels ``L`` (default: ``radar.n_virtual``).
     """
@@ -339,7 +340,7 @@ def two_stage_cfar(
     ne_r = ne_d = None
     profile = None
     if settings.cfar_noise_model:
-        ne_r = _effective(settings.range_window, n_r, rc.n_train)
+        ne_r = _effective(settings.range_window, radar.n_samples, rc.n_train)
         ne_d = _effective(settings.doppler_window, n_d, dc.n_train)
         if settings.static_clutter_removal:
             profile = clutter_removal_noise_profile(settings.doppler_window, n_d)
