@@ -1,0 +1,423 @@
+"""``measurement`` fidelity level: detections drawn from a statistical model of the chain.
+
+No signal, no spectrum: every reflector of the frame becomes at most one point, drawn from its
+true range, azimuth and radial velocity (at the frame's middle, as the exact chain labels them)
+in four steps.
+
+1. **Peak cell and its SNR.** The per-channel signal power in the reflector's peak cell is
+   ``rho = A^2 |R(delta_r)|^2 |D(nu)|^2 / s2[d]``: the link budget (eqs. 2-5, antenna gain eq. 1)
+   times the windows' responses at the reflector's fractional range bin ``delta_r`` and at its
+   Doppler frequency ``nu`` (in bins, aliased), including static clutter removal, divided by the
+   cell's noise power (:func:`core.simulation.fast.cell_noise_power_v2`). The responses are
+   tabulated once per radar and settings from the ``fast`` level's closed form, together with
+   the index of the peak cell and the chain's own peak refinement (log-parabolic interpolation),
+   so straddle loss, scalloping, the clutter-removal notch around zero Doppler and the
+   refinement's bias are the chain's.
+2. **Detection (CFAR, Swerling 0 within the frame).** The cell under test is drawn as the
+   exact chain would see it: ``X = |sqrt(L rho) + n|^2 + Gamma(L - 1)`` (in units of ``s2``,
+   ``n ~ CN(0, 1)``; the non-coherent sum of ``L = 12`` channels with a fixed amplitude, see
+   ``fast_spectrum``); the training cells' sums are ``Gamma(n_train L)`` per side. The point is
+   detected when ``X > alpha_r mu_r`` and ``X > alpha_d mu_d`` with the two stages' estimators
+   (CA / CASO / CAGO) and thresholds ``alpha`` from :func:`core.processing.make_cfar`; its SNR is
+   ``10 log10(X / mu_r)`` as the chain reports it. The RCS fluctuates from frame to frame through
+   eq. (5) (drawn by the scene), not within a frame.
+3. **Measurement errors (Cramer-Rao).** Around the refined noiseless estimate, Gaussian errors
+   with the Cramer-Rao bound at the cell's SNR (frequency of a tone, ``L`` channels combined)::
+
+       var(range bin)   = 6 / (4 pi^2 L rho)
+       var(Doppler bin) = 6 / (4 pi^2 L rho)
+       var(u)           = 6 / (pi^2 rho M (M^2 - 1)),   u = sin(az), M = 8 azimuth elements
+
+   (the azimuth estimate's own bias, from the 64-point FFT and its interpolation, is tabulated
+   like the range and Doppler refinements).
+4. **False alarms.** The chain's own false alarms (noise and nothing else) are a Poisson number
+   per frame whose rate, and whose joint distribution of Doppler cell, SNR and azimuth, are
+   measured once per radar and settings on noise-only frames of the exact chain; their range
+   is uniform over the detectable range bins (the noise floor does not depend on range).
+   Clutter reflectors (a Poisson number per frame, drawn by the scene) are reflectors like the
+   people and go through steps 1-3.
+
+Not modelled (measured against ``exact`` in ``docs/fidelity.md``): the extra detections next to
+very strong or fast reflectors (window sidelobes, clutter-removal residuals), two reflectors
+sharing a cell, the threshold effect of the estimators at very low SNR.
+"""
+
+from __future__ import annotations
+
+import functools
+from dataclasses import dataclass
+
+import numpy as np
+
+from core.config import DEFAULT_PROCESSING, SPEED_OF_LIGHT_MPS, ProcessingSettings, RadarConfig
+from core.pointcloud import SOURCE_OTHER, PointCloud
+from core.processing import estimate_angles, make_cfar
+from core.processing.angle import log_parabolic_offset
+from core.processing.spectrum import window
+from core.simulation.antenna import AntennaGain
+from core.simulation.fast import cell_noise_power_v2, range_responses
+from core.simulation.frame import FrameOutput, needs_elevation
+from core.simulation.link import receiver_voltage_scale
+from core.simulation.scatterers import Scatterers
+
+#: Tabulation steps: range and Doppler in fractions of a bin, azimuth in u = sin(az).
+RANGE_STEPS_PER_BIN = 64
+DOPPLER_STEPS_PER_BIN = 64
+AZIMUTH_STEPS = 4097
+#: Noise-only exact frames used to measure the chain's own false alarms.
+FALSE_ALARM_FRAMES = 300
+
+
+@dataclass(frozen=True, slots=True, kw_only=True, eq=False)
+class ChainTables:
+    """The chain's noiseless responses, tabulated once per radar and settings.
+
+    Attributes
+    ----------
+    range_frac
+        ``(n_r,)`` fractional range offsets in ``[0, 1]`` (bins).
+    range_gain
+        ``(n_r,)`` peak-cell ``|R|^2`` per unit amplitude.
+    range_est
+        ``(n_r,)`` refined peak position minus the integer bin (bins), what the chain reports.
+    doppler_nu
+        ``(n_d,)`` Doppler frequency in bins, ``[-Nc/2, Nc/2]``.
+    doppler_gain
+        ``(n_d,)`` peak-cell ``|D|^2`` (after clutter removal and window).
+    doppler_index
+        ``(n_d,)`` int: zero-velocity-centred Doppler index of the peak cell.
+    doppler_est
+        ``(n_d,)`` refined Doppler bin (zero velocity = 0) the chain reports.
+    range_leak
+        ``(n_r, 2)`` the reflector's own ``|R|^2`` summed over the range stage's left and right
+        training cells (relative to the peak cell).
+    doppler_leak
+        ``(n_d, 2)`` the same for the Doppler stage's training cells (cyclic).
+    u_grid, u_est
+        ``(n_u,)`` true and estimated ``sin(az)`` (noiseless steering vector).
+    cell_noise
+        ``(Nc,)`` per-channel noise power of a cell, V².
+    """
+
+    range_frac: np.ndarray
+    range_gain: np.ndarray
+    range_est: np.ndarray
+    doppler_nu: np.ndarray
+    doppler_gain: np.ndarray
+    doppler_index: np.ndarray
+    doppler_est: np.ndarray
+    range_leak: np.ndarray
+    doppler_leak: np.ndarray
+    u_grid: np.ndarray
+    u_est: np.ndarray
+    cell_noise: np.ndarray
+
+
+@functools.lru_cache(maxsize=16)
+def chain_tables(radar: RadarConfig, settings: ProcessingSettings) -> ChainTables:
+    """Tabulate the chain's responses and refinements (see the module docstring, step 1)."""
+    n_r, n_d = radar.n_samples, radar.n_loops
+    # range: a tone at bin k0 + f, f in [0, 1]
+    k0 = n_r // 2
+    frac = np.linspace(0.0, 1.0, RANGE_STEPS_PER_BIN + 1)
+    resp = range_responses(radar, (k0 + frac) * radar.range_resolution_m, settings)
+    p = np.abs(resp) ** 2
+    pk = np.argmax(p, axis=1)
+    i = np.arange(len(frac))
+    r_off = log_parabolic_offset(p[i, pk - 1], p[i, pk], p[i, pk + 1])
+    range_est = pk + r_off - k0
+    rc, dcs = settings.range_cfar, settings.doppler_cfar
+    g, nt = rc.n_guard, rc.n_train
+    # the reflector's own energy in the training cells raises the CFAR's noise estimate
+    range_leak = np.column_stack(
+        [
+            np.array([p[a, pk[a] - g - nt : pk[a] - g].sum() for a in i]),
+            np.array([p[a, pk[a] + g + 1 : pk[a] + g + 1 + nt].sum() for a in i]),
+        ]
+    )
+    # Doppler: slow-time tone of nu bins, clutter removal, window, centred DFT
+    nu = np.linspace(-n_d / 2, n_d / 2, n_d * DOPPLER_STEPS_PER_BIN + 1)
+    m = np.arange(n_d)
+    y = np.exp(2j * np.pi * np.outer(nu, m) / n_d)
+    if settings.static_clutter_removal:
+        y = y - y.mean(axis=1, keepdims=True)
+    wd = window(settings.doppler_window, n_d).astype(np.float64)
+    d_idx = np.arange(n_d)
+    # D[d] = sum_m w_m y_m exp(-j 2 pi (d - Nc/2) m / Nc)
+    dft = np.exp(-2j * np.pi * np.outer(m, d_idx - n_d // 2) / n_d)
+    big_d = (y * wd) @ dft
+    s2 = cell_noise_power_v2(radar, settings)
+    pd = np.abs(big_d) ** 2
+    dk = np.argmax(pd, axis=1)
+    j = np.arange(len(nu))
+    d_off = log_parabolic_offset(pd[j, (dk - 1) % n_d], pd[j, dk], pd[j, (dk + 1) % n_d])
+    doppler_est = dk - n_d // 2 + d_off
+    g, nt = dcs.n_guard, dcs.n_train
+    left = (dk[:, None] - g - nt + np.arange(nt)[None, :]) % n_d
+    right = (dk[:, None] + g + 1 + np.arange(nt)[None, :]) % n_d
+    doppler_leak = np.column_stack(
+        [np.take_along_axis(pd, left, 1).sum(1), np.take_along_axis(pd, right, 1).sum(1)]
+    )
+    # azimuth: noiseless steering vector through the chain's estimator
+    u = np.linspace(-1.0, 1.0, AZIMUTH_STEPS)
+    az_pos = np.asarray(radar.azimuth_positions, dtype=np.float64)
+    steer = np.exp(1j * np.pi * np.outer(u, az_pos))
+    az_est, _ = estimate_angles(steer, np.zeros(len(u)), radar, fft_size=settings.angle_fft_size)
+    return ChainTables(
+        range_frac=frac,
+        range_gain=p[i, pk],
+        range_est=range_est,
+        doppler_nu=nu,
+        doppler_gain=pd[j, dk],
+        doppler_index=dk.astype(np.int64),
+        doppler_est=doppler_est,
+        range_leak=range_leak,
+        doppler_leak=doppler_leak,
+        u_grid=u,
+        u_est=np.sin(az_est),
+        cell_noise=np.asarray(s2, dtype=np.float64),
+    )
+
+
+@dataclass(frozen=True, slots=True, kw_only=True, eq=False)
+class FalseAlarms:
+    """The chain's own false alarms, measured on noise-only exact frames.
+
+    Attributes
+    ----------
+    rate_per_frame
+        Mean number of false-alarm points per frame.
+    doppler_index, snr_db, azimuth_rad, range_frac
+        ``(n_pool,)`` the measured points (Doppler index, reported SNR, azimuth, fractional
+        part of the range bin), resampled as a pool.
+    n_frames
+        Frames measured.
+    """
+
+    rate_per_frame: float
+    doppler_index: np.ndarray
+    snr_db: np.ndarray
+    azimuth_rad: np.ndarray
+    range_frac: np.ndarray
+    n_frames: int
+
+
+@functools.lru_cache(maxsize=16)
+def chain_false_alarms(
+    radar: RadarConfig, settings: ProcessingSettings, n_frames: int = FALSE_ALARM_FRAMES
+) -> FalseAlarms:
+    """Run ``n_frames`` noise-only frames through the exact chain (seeded) and pool the points."""
+    from core.simulation.frame import simulate_frame
+
+    rng = np.random.default_rng(20_261_121)
+    ant = AntennaGain.ideal(radar)
+    empty = Scatterers.empty()
+    clouds, dets = [], []
+    for _ in range(n_frames):
+        out = simulate_frame(radar, empty, rng, antenna=ant, settings=settings)
+        clouds.append(out.point_cloud)
+        dets.append(out.detections)
+    pc = PointCloud.concatenate(clouds)
+    det = np.concatenate(dets) if dets else np.zeros((0, 2), dtype=np.int64)
+    r_bin = pc.range_m / radar.range_resolution_m
+    return FalseAlarms(
+        rate_per_frame=len(pc) / n_frames,
+        doppler_index=det[:, 1].astype(np.int64),
+        snr_db=pc.snr_db,
+        azimuth_rad=pc.azimuth_rad,
+        range_frac=r_bin - np.round(r_bin),
+        n_frames=n_frames,
+    )
+
+
+@functools.lru_cache(maxsize=16)
+def _constants(radar: RadarConfig, settings: ProcessingSettings):
+    """Per-radar constants: eq. (4) factor, CFAR thresholds and shapes, range-bin limits."""
+    L = radar.n_virtual
+    rc, dc = make_cfar(settings.range_cfar, L), make_cfar(settings.doppler_cfar, L)
+    pt_w = 10 ** ((radar.tx_power_dbm - 30.0) / 10)
+    # A^2 = Pr R 10^(Ge/20) = C g^2 sigma / R^4,  C = Pt lambda^2 / (4 pi)^3 * R 10^(Ge/20)
+    c_amp2 = pt_w * radar.wavelength_m**2 / (4 * np.pi) ** 3 * receiver_voltage_scale(radar)
+    k = np.arange(radar.n_samples) * radar.range_resolution_m
+    ok = np.flatnonzero((k >= settings.min_range_m) & (k <= settings.max_range_m))
+    row = np.asarray(radar.elevation_positions)
+    n_row = int(np.sum(row == row.min()))
+    # the beat tone's drift moves the slow-time phase by theta' dR (Nadc - 1)/2 besides 4 pi dR /
+    # lambda: the chain's Doppler reads the radial velocity scaled by 1 + theta' (Nadc-1)/2 / (4 pi
+    # / lambda) (the carrier at the middle of the ADC window)
+    beat = 2 * np.pi * 2 * radar.slope_hz_per_s / (SPEED_OF_LIGHT_MPS * radar.sample_rate_hz)
+    doppler_scale = 1.0 + beat * (radar.n_samples - 1) / 2 / (4 * np.pi / radar.wavelength_m)
+    return {
+        "doppler_scale": doppler_scale,
+        "L": L,
+        "c_amp2": c_amp2,
+        "range_stage": (settings.range_cfar.method, settings.range_cfar.n_train, rc.alpha()),
+        "doppler_stage": (settings.doppler_cfar.method, settings.doppler_cfar.n_train, dc.alpha()),
+        "bin_lo": int(ok[0]) if ok.size else 0,
+        "bin_hi": int(ok[-1]) if ok.size else -1,
+        "m_az": min(n_row, len(set(radar.azimuth_positions))),
+    }
+
+
+def _noise_estimate(method: str, n_train: int, L: int, rng: np.random.Generator, leak):
+    """CFAR noise estimates (units of the cell noise), ``(n,)``.
+
+    ``leak`` ``(n, 2)``: the reflector's own power summed over the left and right training
+    cells (units of the cell noise); the noise part of each side's sum is ``Gamma(n_train L)``.
+    """
+    z = rng.standard_gamma(float(n_train * L), (len(leak), 2)) + leak
+    if method == "ca":
+        # mu = (Z_left + Z_right) / 2n
+        return z.sum(axis=1) / (2 * n_train)
+    # CASO: min(Z1, Z2) / n;  CAGO: max(Z1, Z2) / n
+    return (z.min(axis=1) if method == "caso" else z.max(axis=1)) / n_train
+
+
+def simulate_frame_measurement(
+    radar: RadarConfig,
+    scatterers: Scatterers,
+    rng: np.random.Generator,
+    *,
+    antenna: AntennaGain,
+    settings: ProcessingSettings = DEFAULT_PROCESSING,
+    keep_rd_map: bool = False,
+    elevation: bool | None = None,
+    noise: bool = True,
+) -> FrameOutput:
+    """One frame at the ``measurement`` level (see the module docstring).
+
+    Same signature and output as :func:`core.simulation.simulate_frame`. ``rd_map_db``, when
+    asked for, is a model map (mean noise floor plus the detected cells), not a spectrum.
+    ``noise=False`` gives the noiseless estimates of every reflector in the range limits.
+    """
+    tab = chain_tables(radar, settings)
+    const = _constants(radar, settings)
+    L = const["L"]
+    n = len(scatterers)
+    if elevation is None:
+        elevation = needs_elevation(radar, scatterers)
+    if n:
+        t_mid = 0.5 * radar.n_loops * radar.n_tx * radar.chirp_period_s
+        pos = scatterers.position_m + scatterers.velocity_mps * t_mid
+        r = np.sqrt(np.einsum("ij,ij->i", pos, pos))
+        vr = np.einsum("ij,ij->i", pos, scatterers.velocity_mps) / r
+        horiz = np.hypot(pos[:, 0], pos[:, 1])
+        az = np.arctan2(pos[:, 0], pos[:, 1])
+        el = np.arctan2(pos[:, 2], horiz)
+        # A^2 = Pt Gt Gr lambda^2 sigma / ((4 pi)^3 R^4) * R 10^(Ge/20)   (eqs. 2-4)
+        g_db = antenna.gain_db(np.arctan2(scatterers.position_m[:, 0], scatterers.position_m[:, 1]))
+        r0 = scatterers.range_m
+        amp2 = const["c_amp2"] * 10 ** ((2 * g_db + scatterers.rcs_dbsm) / 10) / r0**4
+        # peak cell: range bin, Doppler cell, gains and the chain's refined estimates
+        rb = r / radar.range_resolution_m
+        k_int = np.floor(rb)
+        f = rb - k_int
+        half = radar.n_loops / 2
+        nu = (const["doppler_scale"] * vr / radar.velocity_resolution_mps + half) % (
+            radar.n_loops
+        ) - half
+        gr = np.interp(f, tab.range_frac, tab.range_gain)
+        r_est = k_int + np.interp(f, tab.range_frac, tab.range_est)
+        jd = np.rint((nu + half) * DOPPLER_STEPS_PER_BIN).astype(np.int64)
+        jr = np.rint(f * RANGE_STEPS_PER_BIN).astype(np.int64)
+        d_cell = tab.doppler_index[jd]
+        d_est = np.interp(nu, tab.doppler_nu, tab.doppler_est)
+        # rho = A^2 |R|^2 |D|^2 / s2[d]  (per channel, peak cell)
+        rho = amp2 * gr * tab.doppler_gain[jd] / tab.cell_noise[d_cell]
+        u_true = np.sin(az) * np.cos(el)
+        u_est = np.interp(u_true, tab.u_grid, tab.u_est)
+        if noise:
+            z = rng.standard_normal((5, n))
+            # X = |sqrt(L rho) + n|^2 + Gamma(L - 1),  n ~ CN(0, 1)
+            x = (np.sqrt(L * rho) + z[0] / np.sqrt(2)) ** 2 + z[1] ** 2 / 2
+            x += rng.standard_gamma(L - 1.0, n)
+            # training cells: noise plus the reflector's own leakage (units of s2, L channels)
+            leak = L * amp2 / tab.cell_noise[d_cell]
+            lr = leak[:, None] * tab.doppler_gain[jd][:, None] * tab.range_leak[jr]
+            ld = leak[:, None] * gr[:, None] * tab.doppler_leak[jd]
+            mu_r = _noise_estimate(*const["range_stage"][:2], L, rng, lr)
+            mu_d = _noise_estimate(*const["doppler_stage"][:2], L, rng, ld)
+            det = (x > const["range_stage"][2] * mu_r) & (x > const["doppler_stage"][2] * mu_d)
+            snr_db = 10 * np.log10(x / mu_r)
+            # Cramer-Rao: var(bin) = 6 / (4 pi^2 L rho);  var(u) = 6 / (pi^2 rho M (M^2 - 1))
+            sd_bin = np.sqrt(6.0 / (4 * np.pi**2 * L * rho))
+            m_az = const["m_az"]
+            sd_u = np.sqrt(6.0 / (np.pi**2 * rho * m_az * (m_az**2 - 1)))
+            r_est = r_est + sd_bin * z[2]
+            d_est = d_est + sd_bin * z[3]
+            u_est = np.clip(u_est + sd_u * z[4], -1.0, 1.0)
+        else:
+            det = np.ones(n, dtype=bool)
+            snr_db = 10 * np.log10(L * rho)
+        det &= (r_est >= const["bin_lo"] - 0.5) & (r_est <= const["bin_hi"] + 0.5)
+        d_est = (d_est + half) % radar.n_loops - half
+        cells = np.column_stack((np.rint(r_est[det]), d_cell[det]))
+        az_m = np.arcsin(u_est[det] / np.cos(el[det]) if elevation else u_est[det])
+        pc = _cloud(
+            radar,
+            r_est[det] * radar.range_resolution_m,
+            az_m,
+            el[det] if elevation else np.zeros(int(det.sum())),
+            d_est[det] * radar.velocity_resolution_mps,
+            snr_db[det],
+            scatterers.source[det],
+        )
+    else:
+        pc, cells = PointCloud.empty(), np.zeros((0, 2))
+    if noise:
+        pc, cells = _add_false_alarms(radar, settings, const, pc, cells, rng)
+    rd_db = None
+    if keep_rd_map:
+        rd_db = _model_map(radar, tab, cells, pc)
+    return FrameOutput(point_cloud=pc, rd_map_db=rd_db, detections=cells.astype(np.int64))
+
+
+def _cloud(radar, range_m, az, el, vr, snr_db, source) -> PointCloud:
+    horiz = range_m * np.cos(el)
+    return PointCloud(
+        range_m=range_m,
+        azimuth_rad=az,
+        elevation_rad=el,
+        radial_velocity_mps=vr,
+        snr_db=snr_db,
+        x_m=horiz * np.sin(az),
+        y_m=horiz * np.cos(az),
+        z_m=range_m * np.sin(el),
+        source=np.asarray(source, dtype=np.int32),
+    )
+
+
+def _add_false_alarms(radar, settings, const, pc, cells, rng):
+    """Append a Poisson number of the chain's own false alarms, resampled from the pool."""
+    fa = chain_false_alarms(radar, settings)
+    k = rng.poisson(fa.rate_per_frame) if fa.rate_per_frame > 0 else 0
+    if k == 0 or len(fa.snr_db) == 0:
+        return pc, cells
+    pick = rng.integers(0, len(fa.snr_db), k)
+    r_bin = rng.integers(const["bin_lo"], const["bin_hi"] + 1, k) + fa.range_frac[pick]
+    half = radar.n_loops // 2
+    # the pool's Doppler index with a uniform sub-bin refinement in (-0.5, 0.5)
+    d_bin = fa.doppler_index[pick] - half + rng.uniform(-0.5, 0.5, k)
+    extra = _cloud(
+        radar,
+        r_bin * radar.range_resolution_m,
+        fa.azimuth_rad[pick],
+        np.zeros(k),
+        d_bin * radar.velocity_resolution_mps,
+        fa.snr_db[pick],
+        np.full(k, SOURCE_OTHER),
+    )
+    extra_cells = np.column_stack((np.rint(r_bin), fa.doppler_index[pick]))
+    return PointCloud.concatenate([pc, extra]), np.concatenate([cells, extra_cells])
+
+
+def _model_map(radar: RadarConfig, tab: ChainTables, cells: np.ndarray, pc: PointCloud):
+    """Model range-Doppler map in dB: mean noise floor ``L s2[d]`` plus the detected cells."""
+    floor = radar.n_virtual * tab.cell_noise
+    rd = np.repeat(floor[None, :], radar.n_samples, axis=0)
+    if len(cells):
+        k = np.clip(cells[:, 0].astype(np.int64), 0, radar.n_samples - 1)
+        d = cells[:, 1].astype(np.int64)
+        # reported SNR is power over the per-cell noise estimate (one cell's mean power)
+        rd[k, d] = np.maximum(rd[k, d], 10 ** (pc.snr_db / 10) * floor[d] / radar.n_virtual)
+    return (10 * np.log10(rd)).astype(np.float32)
