@@ -43,14 +43,22 @@ its phase term.
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 from typing import NamedTuple
 
 import numba
 import numpy as np
 import scipy.fft
+from scipy.optimize import brentq
 
-from core.config import DEFAULT_PROCESSING, SPEED_OF_LIGHT_MPS, ProcessingSettings, RadarConfig
+from core.config import (
+    DEFAULT_PROCESSING,
+    SPEED_OF_LIGHT_MPS,
+    CfarSettings,
+    ProcessingSettings,
+    RadarConfig,
+)
 from core.pointcloud import SOURCE_OTHER, PointCloud
 from core.processing import (
     Detections,
@@ -61,6 +69,8 @@ from core.processing import (
     window,
 )
 from core.processing.angle import azimuth_row, elevation_pairs
+from core.processing.cfar import two_stage_pfa
+from core.processing.spectrum import clutter_removal_noise_profile, effective_cells
 from core.simulation.antenna import AntennaGain
 from core.simulation.baseband import steering_vectors
 from core.simulation.frame import FrameOutput, needs_elevation
@@ -461,7 +471,7 @@ def simulate_frame_fast(
     """
     spec = fast_spectrum(radar, scatterers, rng, antenna=antenna, settings=settings, noise=noise)
     rd = spec.rd_map
-    det = two_stage_cfar_compiled(rd, radar, settings)
+    det = two_stage_cfar_compiled(rd, radar, settings, independent_cells=True)
     if elevation is None:
         elevation = needs_elevation(radar, scatterers)
     pc = PointCloud.empty()
@@ -626,6 +636,7 @@ def _cfar_line(p, n, g, cyclic, method, alpha_both, alpha_one, mask, mu, cs):  #
 @numba.njit(cache=True, nogil=True)
 def _two_stage_kernel(
     rd,
+    profile,
     lo,
     hi,
     a,
@@ -646,6 +657,11 @@ def _two_stage_kernel(
 ):  # pragma: no cover
     n_r, n_d = rd.shape
     size = b - a
+    # whitened map: rd / profile[d]; bins the clutter removal empties (profile 0) carry nothing
+    sub = np.empty((size, n_d), dtype=np.float64)
+    for i in range(size):
+        for d in range(n_d):
+            sub[i, d] = 0.0 if profile[d] < 0.01 else rd[a + i, d] / profile[d]
     mask_r = np.zeros((size, n_d), dtype=np.bool_)
     noise_r = np.empty((size, n_d), dtype=np.float64)
     col = np.empty(size, dtype=np.float64)
@@ -654,10 +670,10 @@ def _two_stage_kernel(
     cs = np.empty(2 * (size + n_d) + 2 * (rn + rg + dn + dg) + 2, dtype=np.float64)
     for d in range(n_d):
         for i in range(size):
-            col[i] = rd[a + i, d]
+            col[i] = sub[i, d]
         _cfar_line(col, rn, rg, rcyc, rmeth, ralpha, ralpha1, mcol, ncol, cs)
         for i in range(size):
-            mask_r[i, d] = mcol[i] and (lo <= a + i <= hi)
+            mask_r[i, d] = mcol[i] and (lo <= a + i <= hi) and profile[d] >= 0.01
             noise_r[i, d] = ncol[i]
     out_r = np.empty(size * n_d, dtype=np.int64)
     out_d = np.empty(size * n_d, dtype=np.int64)
@@ -673,7 +689,7 @@ def _two_stage_kernel(
         if not any_r:
             continue
         for d in range(n_d):
-            row[d] = rd[a + i, d]
+            row[d] = sub[i, d]
         _cfar_line(row, dn, dg, dcyc, dmeth, dalpha, dalpha1, mrow, nrow, cs)
         r = a + i
         for d in range(n_d):
@@ -692,7 +708,8 @@ def _two_stage_kernel(
                     continue
             out_r[n_out] = r
             out_d[n_out] = d
-            out_n[n_out] = noise_r[i, d]
+            # back to the map's units at the cell under test
+            out_n[n_out] = noise_r[i, d] * profile[d]
             n_out += 1
     return out_r[:n_out], out_d[:n_out], out_n[:n_out]
 
@@ -703,15 +720,19 @@ def two_stage_cfar_compiled(
     settings: ProcessingSettings = DEFAULT_PROCESSING,
     *,
     n_channels: int | None = None,
+    independent_cells: bool = False,
 ) -> Detections:
     """:func:`core.processing.two_stage_cfar`, compiled: the same detections, in the same order.
 
     Parameters and returns as there (``rd_map`` ``[range bin, Doppler bin]``, Doppler zero
-    velocity centred).
+    velocity centred). ``independent_cells=True`` sets the thresholds for independent cells
+    (what the ``fast`` level's noise map has) instead of the window-correlated cells of the
+    exact chain, with the exact chain's two-stage false-alarm rate
+    (:func:`independent_cell_stages`).
     """
     rd = np.ascontiguousarray(rd_map)
     L = radar.n_virtual if n_channels is None else n_channels
-    args = _cfar_arguments(radar, settings, L, rd.shape[0])
+    args = _cfar_arguments(radar, settings, L, rd.shape[0], rd.shape[1], independent_cells)
     if args is None:
         return _no_detections()
     r, d, noise = _two_stage_kernel(rd, *args)
@@ -721,8 +742,15 @@ def two_stage_cfar_compiled(
 
 
 @functools.lru_cache(maxsize=64)
-def _cfar_arguments(radar: RadarConfig, settings: ProcessingSettings, n_channels: int, n_r: int):
-    """Range limits, training windows and threshold factors of the two stages (cached)."""
+def _cfar_arguments(
+    radar: RadarConfig,
+    settings: ProcessingSettings,
+    n_channels: int,
+    n_r: int,
+    n_d: int,
+    independent_cells: bool,
+):
+    """Whitening profile, range limits, training windows and thresholds (cached)."""
     k = np.arange(n_r) * radar.range_resolution_m
     in_range = (k >= settings.min_range_m) & (k <= settings.max_range_m)
     if not in_range.any():
@@ -731,8 +759,19 @@ def _cfar_arguments(radar: RadarConfig, settings: ProcessingSettings, n_channels
     rc, dc = settings.range_cfar, settings.doppler_cfar
     margin = rc.n_train + rc.n_guard
     a, b = max(0, lo - margin), min(n_r, hi + 1 + margin)
-    rcf, dcf = make_cfar(rc, n_channels), make_cfar(dc, n_channels)
+    ne_r = ne_d = None
+    profile = np.ones(n_d)
+    if settings.cfar_noise_model:
+        ne_r = effective_cells_or_none(settings.range_window, radar.n_samples, rc.n_train)
+        ne_d = effective_cells_or_none(settings.doppler_window, n_d, dc.n_train)
+        if settings.static_clutter_removal:
+            profile = clutter_removal_noise_profile(settings.doppler_window, n_d)
+    if independent_cells and (ne_r is not None or ne_d is not None):
+        rc, dc = independent_cell_stages(settings, n_channels, radar.n_samples, n_d)
+        ne_r = ne_d = None
+    rcf, dcf = make_cfar(rc, n_channels, ne_r), make_cfar(dc, n_channels, ne_d)
     return (
+        np.ascontiguousarray(profile, dtype=np.float64),
         lo, hi, a, b,
         rc.n_train, rc.n_guard, rc.cyclic, _METHOD_CODE[rc.method], rcf.alpha(),
         rcf.alpha_one_side(),
@@ -740,6 +779,48 @@ def _cfar_arguments(radar: RadarConfig, settings: ProcessingSettings, n_channels
         dcf.alpha_one_side(),
         settings.peak_grouping,
     )  # fmt: skip
+
+
+@functools.lru_cache(maxsize=16)
+def independent_cell_stages(
+    settings: ProcessingSettings, n_channels: int, n_range_bins: int, n_doppler_bins: int
+) -> tuple[CfarSettings, CfarSettings]:
+    """CFAR stages for independent cells with the exact chain's two-stage false-alarm rate.
+
+    The exact chain's cells are window-correlated and its thresholds account for it. With
+    independent cells (the ``fast`` level's noise map) the same per-stage ``pfa`` gives a
+    different two-stage rate (periodic Hann: 6.1e-5 per cell instead of 3.6e-5), because the
+    stages share the cell under test. Both stages' ``pfa`` are scaled by one factor ``kappa``
+    so that :func:`core.processing.cfar.two_stage_pfa` for independent cells equals the exact
+    chain's.
+    """
+    target = two_stage_pfa(
+        settings, n_channels, n_range_bins=n_range_bins, n_doppler_bins=n_doppler_bins
+    )
+    rc, dc = settings.range_cfar, settings.doppler_cfar
+
+    def stages(log_kappa: float) -> tuple[CfarSettings, CfarSettings]:
+        k = float(np.exp(log_kappa))
+        return (
+            dataclasses.replace(rc, pfa=min(rc.pfa * k, 0.5)),
+            dataclasses.replace(dc, pfa=min(dc.pfa * k, 0.5)),
+        )
+
+    def err(log_kappa: float) -> float:
+        r, d = stages(log_kappa)
+        indep = dataclasses.replace(settings, range_cfar=r, doppler_cfar=d, cfar_noise_model=False)
+        p = two_stage_pfa(
+            indep, n_channels, n_range_bins=n_range_bins, n_doppler_bins=n_doppler_bins
+        )
+        return float(np.log(p) - np.log(target))
+
+    return stages(brentq(err, -6.0, 3.0, xtol=1e-6))
+
+
+def effective_cells_or_none(window_name: str, n_fft: int, n_train: int) -> float | None:
+    """Effective independent cells of ``n_train`` window-correlated ones (None: independent)."""
+    ne = effective_cells(window_name, n_fft, n_train)
+    return None if abs(ne - n_train) < 1e-9 else ne
 
 
 def _no_detections() -> Detections:

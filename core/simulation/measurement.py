@@ -16,7 +16,9 @@ in four steps.
 2. **Detection (CFAR, Swerling 0 within the frame).** The cell under test is drawn as the
    exact chain would see it: ``X = |sqrt(L rho) + n|^2 + Gamma(L - 1)`` (in units of ``s2``,
    ``n ~ CN(0, 1)``; the non-coherent sum of ``L = 12`` channels with a fixed amplitude, see
-   ``fast_spectrum``); the training cells' sums are ``Gamma(n_train L)`` per side. The point is
+   ``fast_spectrum``); each side's training sum is ``(n / n_eff) Gamma(n_eff L)`` (window-
+   correlated cells, the chain's own moment match) plus the reflector's own leakage into those
+   cells (tabulated). The point is
    detected when ``X > alpha_r mu_r`` and ``X > alpha_d mu_d`` with the two stages' estimators
    (CA / CASO / CAGO) and thresholds ``alpha`` from :func:`core.processing.make_cfar`; its SNR is
    ``10 log10(X / mu_r)`` as the chain reports it. The RCS fluctuates from frame to frame through
@@ -55,7 +57,11 @@ from core.processing import estimate_angles, make_cfar
 from core.processing.angle import log_parabolic_offset
 from core.processing.spectrum import window
 from core.simulation.antenna import AntennaGain
-from core.simulation.fast import cell_noise_power_v2, range_responses
+from core.simulation.fast import (
+    cell_noise_power_v2,
+    effective_cells_or_none,
+    range_responses,
+)
 from core.simulation.frame import FrameOutput, needs_elevation
 from core.simulation.link import receiver_voltage_scale
 from core.simulation.scatterers import Scatterers
@@ -234,7 +240,13 @@ def chain_false_alarms(
 def _constants(radar: RadarConfig, settings: ProcessingSettings):
     """Per-radar constants: eq. (4) factor, CFAR thresholds and shapes, range-bin limits."""
     L = radar.n_virtual
-    rc, dc = make_cfar(settings.range_cfar, L), make_cfar(settings.doppler_cfar, L)
+    rs, ds = settings.range_cfar, settings.doppler_cfar
+    ne_r = ne_d = None
+    if settings.cfar_noise_model:
+        # the exact chain's training cells are window-correlated: n_eff independent ones
+        ne_r = effective_cells_or_none(settings.range_window, radar.n_samples, rs.n_train)
+        ne_d = effective_cells_or_none(settings.doppler_window, radar.n_loops, ds.n_train)
+    rc, dc = make_cfar(rs, L, ne_r), make_cfar(ds, L, ne_d)
     pt_w = 10 ** ((radar.tx_power_dbm - 30.0) / 10)
     # A^2 = Pr R 10^(Ge/20) = C g^2 sigma / R^4,  C = Pt lambda^2 / (4 pi)^3 * R 10^(Ge/20)
     c_amp2 = pt_w * radar.wavelength_m**2 / (4 * np.pi) ** 3 * receiver_voltage_scale(radar)
@@ -251,21 +263,25 @@ def _constants(radar: RadarConfig, settings: ProcessingSettings):
         "doppler_scale": doppler_scale,
         "L": L,
         "c_amp2": c_amp2,
-        "range_stage": (settings.range_cfar.method, settings.range_cfar.n_train, rc.alpha()),
-        "doppler_stage": (settings.doppler_cfar.method, settings.doppler_cfar.n_train, dc.alpha()),
+        "range_stage": (rs.method, rs.n_train, ne_r or rs.n_train, rc.alpha()),
+        "doppler_stage": (ds.method, ds.n_train, ne_d or ds.n_train, dc.alpha()),
         "bin_lo": int(ok[0]) if ok.size else 0,
         "bin_hi": int(ok[-1]) if ok.size else -1,
         "m_az": min(n_row, len(set(radar.azimuth_positions))),
     }
 
 
-def _noise_estimate(method: str, n_train: int, L: int, rng: np.random.Generator, leak):
+def _noise_estimate(
+    method: str, n_train: int, n_eff: float, L: int, rng: np.random.Generator, leak: np.ndarray
+) -> np.ndarray:
     """CFAR noise estimates (units of the cell noise), ``(n,)``.
 
     ``leak`` ``(n, 2)``: the reflector's own power summed over the left and right training
-    cells (units of the cell noise); the noise part of each side's sum is ``Gamma(n_train L)``.
+    cells (units of the cell noise). The noise part of each side's sum is
+    ``(n_train / n_eff) Gamma(n_eff L)``: mean ``n_train L`` and the variance of
+    window-correlated cells (the moment match the CFAR thresholds use).
     """
-    z = rng.standard_gamma(float(n_train * L), (len(leak), 2)) + leak
+    z = rng.standard_gamma(float(n_eff * L), (len(leak), 2)) * (n_train / n_eff) + leak
     if method == "ca":
         # mu = (Z_left + Z_right) / 2n
         return z.sum(axis=1) / (2 * n_train)
@@ -335,9 +351,9 @@ def simulate_frame_measurement(
             leak = L * amp2 / tab.cell_noise[d_cell]
             lr = leak[:, None] * tab.doppler_gain[jd][:, None] * tab.range_leak[jr]
             ld = leak[:, None] * gr[:, None] * tab.doppler_leak[jd]
-            mu_r = _noise_estimate(*const["range_stage"][:2], L, rng, lr)
-            mu_d = _noise_estimate(*const["doppler_stage"][:2], L, rng, ld)
-            det = (x > const["range_stage"][2] * mu_r) & (x > const["doppler_stage"][2] * mu_d)
+            mu_r = _noise_estimate(*const["range_stage"][:3], L, rng, lr)
+            mu_d = _noise_estimate(*const["doppler_stage"][:3], L, rng, ld)
+            det = (x > const["range_stage"][3] * mu_r) & (x > const["doppler_stage"][3] * mu_d)
             snr_db = 10 * np.log10(x / mu_r)
             # Cramer-Rao: var(bin) = 6 / (4 pi^2 L rho);  var(u) = 6 / (pi^2 rho M (M^2 - 1))
             sd_bin = np.sqrt(6.0 / (4 * np.pi**2 * L * rho))

@@ -135,6 +135,8 @@ def test_compiled_cfar_equals_library_cfar() -> None:
             peak_grouping=False,
             min_range_m=2.0,
         ),
+        ProcessingSettings(cfar_noise_model=False),
+        ProcessingSettings(doppler_window="rect"),
     ]
     n_det = 0
     for settings in variants:
