@@ -79,12 +79,16 @@ def threshold_factor(method: str, n_train: int, pfa: float, n_channels: int) -> 
         # T/(1+T) = b  ->  T = b / (1 - b);  alpha = N T
         return n_train * b / (1.0 - b)
     f = {"caso": pfa_caso, "cago": pfa_cago}[method]
-    # Pfa(T) decreases monotonically in T: bracket and solve in log T
-    lo, hi = -20.0, 2.0
+    # Pfa(T) decreases monotonically in T: step up in log T until it falls below pfa (small
+    # steps keep the bracket where Pfa_GO = 2 P1 - Pfa_SO has no cancellation), then solve
+    hi = -8.0
     while f(np.exp(hi), n_train, n_channels) > pfa:
-        hi += 2.0
+        hi += 0.25
     log_t = brentq(
-        lambda u: np.log(f(np.exp(u), n_train, n_channels)) - np.log(pfa), lo, hi, xtol=1e-12
+        lambda u: np.log(f(np.exp(u), n_train, n_channels)) - np.log(pfa),
+        hi - 0.25,
+        hi,
+        xtol=1e-13,
     )
     return n_train * float(np.exp(log_t))
 

@@ -125,7 +125,5 @@ def range_doppler_map(doppler_cube: np.ndarray) -> np.ndarray:
         ``[range bin, Doppler bin]`` float32 power (V²), Doppler zero velocity centred.
     """
     x = np.asarray(doppler_cube)
-    v = x.view(np.float32) if x.dtype == np.complex64 else x.astype(np.complex64).view(np.float32)
-    # |X|^2 = re^2 + im^2, summed over channels
-    sq = v * v
-    return sq.reshape(*x.shape[:-1], x.shape[-1], 2).sum(axis=(0, 3))
+    # P = sum_v (re^2 + im^2)
+    return np.einsum("vkj,vkj->kj", x.real, x.real) + np.einsum("vkj,vkj->kj", x.imag, x.imag)
