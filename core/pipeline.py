@@ -13,6 +13,7 @@ leaves every other stage's numbers bit for bit unchanged, and any frame can be s
 from __future__ import annotations
 
 import dataclasses
+import functools
 import hashlib
 import importlib
 import json
@@ -463,10 +464,40 @@ def default_cache_dir() -> Path:
     return Path(env) if env else Path.home() / ".cache" / "radartune"
 
 
-def dataset_key(scenes: Sequence[Scene], *, fidelity: str, seed: int) -> str:
-    """Hash of the scenes (with their resolved radar), the fidelity level and the seed."""
+#: Sources whose code determines a simulated data set (their text is part of the cache key).
+_SIMULATION_SOURCES = ("config.py", "pipeline.py", "pointcloud.py", "dataset.py")
+_SIMULATION_PACKAGES = ("scene", "simulation", "processing")
+
+
+@functools.cache
+def code_fingerprint() -> str:
+    """Hash of the source of every module that shapes a simulated data set.
+
+    Part of the cache key, so a change to the radar chain, the scenes or this pipeline never
+    serves a stale cached data set.
+    """
+    root = Path(__file__).resolve().parent
+    files = [root / name for name in _SIMULATION_SOURCES]
+    for pkg in _SIMULATION_PACKAGES:
+        files += sorted((root / pkg).rglob("*.py"))
     h = hashlib.sha256()
-    h.update(f"radartune-dataset v{CACHE_VERSION} fidelity={fidelity} seed={seed}\n".encode())
+    for f in files:
+        if f.is_file():
+            h.update(f.relative_to(root).as_posix().encode() + b"\0" + f.read_bytes() + b"\0")
+    return h.hexdigest()[:16]
+
+
+def dataset_key(scenes: Sequence[Scene], *, fidelity: str, seed: int) -> str:
+    """Hash of the scenes (with their resolved radar), the fidelity level, the seed and the code.
+
+    The code part is :func:`code_fingerprint` (the simulation's source), plus
+    :data:`CACHE_VERSION`.
+    """
+    h = hashlib.sha256()
+    h.update(
+        f"radartune-dataset v{CACHE_VERSION} code={code_fingerprint()} "
+        f"fidelity={fidelity} seed={seed}\n".encode()
+    )
     for s in scenes:
         h.update(s.canonical_json().encode())
         h.update(b"\n")
