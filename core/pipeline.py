@@ -487,16 +487,19 @@ def code_fingerprint() -> str:
     return h.hexdigest()[:16]
 
 
-def dataset_key(scenes: Sequence[Scene], *, fidelity: str, seed: int) -> str:
-    """Hash of the scenes (with their resolved radar), the fidelity level, the seed and the code.
+def dataset_key(
+    scenes: Sequence[Scene], *, fidelity: str, seed: int, seeds: Sequence[int] | None = None
+) -> str:
+    """Hash of the scenes (with their resolved radar), the fidelity level, the seed(s), the code.
 
-    The code part is :func:`code_fingerprint` (the simulation's source), plus
+    The code part is :func:`code_fingerprint` (the simulation's source) and
     :data:`CACHE_VERSION`.
     """
+    seeds = list(seeds) if seeds is not None else trajectory_seeds(seed, len(scenes))
     h = hashlib.sha256()
     h.update(
         f"radartune-dataset v{CACHE_VERSION} code={code_fingerprint()} "
-        f"fidelity={fidelity} seed={seed}\n".encode()
+        f"fidelity={fidelity} seed={seed} seeds={seeds}\n".encode()
     )
     for s in scenes:
         h.update(s.canonical_json().encode())
@@ -505,8 +508,12 @@ def dataset_key(scenes: Sequence[Scene], *, fidelity: str, seed: int) -> str:
 
 
 def trajectory_seeds(seed: int, n: int) -> list[int]:
-    """Simulation seed of each scene of a data set: ``SeedSequence(seed).spawn(n)``."""
-    return [int(c.generate_state(1)[0]) for c in np.random.SeedSequence(seed).spawn(n)]
+    """Simulation seed of each of ``n`` scenes: ``SeedSequence([seed, 1]).spawn(n)``.
+
+    (Entropy ``[seed, 1]`` keeps them apart from :func:`core.scene.paper_scenes`, which spawns
+    trajectory seeds from ``SeedSequence(seed)``.)
+    """
+    return [int(c.generate_state(1)[0]) for c in np.random.SeedSequence([seed, 1]).spawn(n)]
 
 
 def _simulate_task(args: tuple[str, int, str]) -> dict[str, Any]:
@@ -543,15 +550,21 @@ def build_dataset(
     cache_dir: str | os.PathLike | None = None,
     progress: ProgressCallback | None = None,
     use_cache: bool = True,
+    seeds: Sequence[int] | None = None,
 ) -> Dataset:
     """Simulate scenes into one data set, cached by hash and written atomically.
 
-    Scene ``k`` is simulated with seed ``trajectory_seeds(seed, K)[k]``, one scene per task in
-    a process pool of ``jobs`` workers (default: all cores; ``1`` runs in this process), so the
-    result does not depend on ``jobs``.
+    Scene ``k`` is simulated with seed ``seeds[k]`` (default ``trajectory_seeds(seed, K)[k]``),
+    one scene per task in a process pool of ``jobs`` workers (default: all cores; ``1`` runs in
+    this process), so the result does not depend on ``jobs``.
 
     Parameters
     ----------
+    seed
+        Seed of the whole set (recorded in the data set).
+    seeds
+        Explicit per-scene simulation seeds (the paper set uses each scene's own seed, so any
+        trajectory re-simulated alone with :func:`simulate_scene` gives the same frames).
     progress
         Called as ``progress(done, total)`` after each scene.
     use_cache
@@ -566,7 +579,8 @@ def build_dataset(
     cache_file = None
     if use_cache:
         root = Path(cache_dir) if cache_dir is not None else default_cache_dir()
-        cache_file = root / "datasets" / f"{dataset_key(scenes, fidelity=fidelity, seed=seed)}.npz"
+        key = dataset_key(scenes, fidelity=fidelity, seed=seed, seeds=seeds)
+        cache_file = root / "datasets" / f"{key}.npz"
         if cache_file.is_file():
             try:
                 ds = Dataset.load(cache_file)
@@ -575,7 +589,10 @@ def build_dataset(
                 return ds
             except InputError:
                 cache_file.unlink(missing_ok=True)  # corrupt cache entry: simulate again
-    seeds = trajectory_seeds(seed, len(scenes))
+    if seeds is None:
+        seeds = trajectory_seeds(seed, len(scenes))
+    elif len(seeds) != len(scenes):
+        raise InputError(f"seeds: {len(seeds)} given for {len(scenes)} scenes")
     tasks = [(s.to_json(), sd, fidelity) for s, sd in zip(scenes, seeds)]
     jobs = (os.cpu_count() or 1) if jobs is None else max(1, int(jobs))
     results: list[dict[str, Any]] = []
@@ -639,15 +656,23 @@ def paper_dataset(
     cache_dir: str | os.PathLike | None = None,
     jobs: int | None = None,
     progress: ProgressCallback | None = None,
+    use_cache: bool = True,
 ) -> Dataset:
-    """The paper's data set: :func:`core.scene.paper_scenes` simulated (cached)."""
+    """The paper's data set: :func:`core.scene.paper_scenes` simulated (cached).
+
+    Each trajectory is simulated with its scene's own seed, so ``simulate_scene(scene)`` of any
+    of the scenes reproduces its frames of the data set bit for bit.
+    """
+    scenes = paper_scenes(seed, n_trajectories)
     return build_dataset(
-        paper_scenes(seed, n_trajectories),
+        scenes,
+        seeds=[s.seed for s in scenes],
         fidelity=fidelity,
         seed=seed,
         jobs=jobs,
         cache_dir=cache_dir,
         progress=progress,
+        use_cache=use_cache,
     )
 
 

@@ -63,3 +63,18 @@ def test_clutter_points_per_frame_match_lambda_area(paper_subset: Dataset) -> No
     # clutter points come from reflectors that move: none inside the zero-Doppler notch
     vr = ds.radial_velocity_mps[ds.source == -1]
     assert np.abs(vr).min() >= 1.0 * 0.4526
+
+
+def test_a_trajectory_of_the_set_re_simulates_alone(paper_subset: Dataset) -> None:
+    from core.pipeline import iter_frames
+    from core.scene import paper_scenes
+
+    ds = paper_subset
+    k = 2
+    scene = paper_scenes(0, N_TRAJECTORIES)[k]
+    first = int(ds.trajectory_offsets[k])
+    for fr in iter_frames(scene, frames=[0, 7]):
+        expected = ds.point_cloud(first + fr.index)
+        for f in ("range_m", "azimuth_rad", "radial_velocity_mps", "snr_db", "source"):
+            np.testing.assert_array_equal(getattr(fr.point_cloud, f), getattr(expected, f))
+        np.testing.assert_array_equal(ds.truth_xy_m[first + fr.index], fr.truth_xy_m)
