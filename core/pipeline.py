@@ -32,6 +32,7 @@ from core.dataset import Dataset
 from core.errors import InputError
 from core.pointcloud import PointCloud
 from core.scene import Scene, draw_clutter, expected_clutter_count, paper_scenes
+from core.scene.body import body_scatterers, walking_headings
 
 #: eq. (5): σ_dBsm ~ N(−8, 16): mean −8 dBsm, variance 16 dB² (standard deviation 4 dB)
 PERSON_RCS_MEAN_DBSM = -8.0
@@ -140,6 +141,7 @@ def plan(
     study = consumer == "study"
     has_clutter = scene.clutter_density_per_m2 > 0
     drawn_rcs = [i for i, p in enumerate(scene.persons) if p.rcs_dbsm is None]
+    extended = [i for i, p in enumerate(scene.persons) if p.model == "extended"]
     needs_el = scene.radar.has_elevation and not scene.is_planar
 
     def stage(name, needs, produces, run, why_run, why_skip):
@@ -168,6 +170,11 @@ def plan(
             "every person has a fixed rcs_dbsm",
         ),
         stage(
+            "body_model", ("truth_xy", "person_rcs"), ("body_scatterers",), extended,
+            f"extended model (torso, arms, legs, micro-Doppler) for person(s) {extended}",
+            "point-scatterer persons (the paper's model)",
+        ),
+        stage(
             "clutter", ("antenna_gain",), ("clutter_reflectors",), has_clutter,
             f"Poisson, mean lambda*area = {expected_clutter_count(scene.aoi, lam):.3f} per frame",
             "clutter_density_per_m2 = 0: no clutter draws",
@@ -179,7 +186,8 @@ def plan(
         ),
         stage(
             "scatterers",
-            ("truth_xy", "person_rcs", "clutter_reflectors", "static_reflectors"),
+            ("truth_xy", "person_rcs", "body_scatterers", "clutter_reflectors",
+             "static_reflectors"),
             ("scatterers",), True, "reflectors of each frame", "",
         ),
         stage(
@@ -348,11 +356,20 @@ def iter_frames(
     static = scene.static_reflectors
     static_pos = np.array([[r.x_m, r.y_m, r.z_m] for r in static]).reshape(-1, 3)
     static_rcs = np.array([r.rcs_dbsm for r in static], dtype=np.float64)
-    run_rcs, run_clutter, run_static = (
+    run_rcs, run_clutter, run_static, run_body = (
         p.runs("person_rcs"),
         p.runs("clutter"),
         p.runs("static_reflectors"),
+        p.runs("body_model"),
     )
+    extended = np.array([q.model == "extended" for q in scene.persons], dtype=bool)
+    if not run_body:
+        extended[:] = False
+    headings = {
+        i: walking_headings(q.trajectory.velocity_mps)
+        for i, q in enumerate(scene.persons)
+        if extended[i]
+    }
     for f in frames if frames is not None else range(scene.n_frames):
         # persons: one point scatterer at the trajectory position, z = 0
         rcs = fixed_rcs.copy()
@@ -363,10 +380,19 @@ def iter_frames(
             )
             rcs = np.where(np.isnan(fixed_rcs), drawn, fixed_rcs)
         active = ~np.isnan(xy[f, :, 0])
-        pos = [np.column_stack((xy[f, active], np.zeros(active.sum())))]
-        vel = [np.column_stack((v[f, active], np.zeros(active.sum())))]
-        rcs_list = [rcs[active]]
-        src = [np.flatnonzero(active).astype(np.int32)]
+        point = active & ~extended
+        pos = [np.column_stack((xy[f, point], np.zeros(point.sum())))]
+        vel = [np.column_stack((v[f, point], np.zeros(point.sum())))]
+        rcs_list = [rcs[point]]
+        src = [np.flatnonzero(point).astype(np.int32)]
+        if run_body:
+            for i in np.flatnonzero(active & extended):
+                bp, bv, frac = body_scatterers(xy[f, i], v[f, i], headings[i][f], t_s[f])
+                pos.append(np.column_stack((bp, np.zeros(len(bp)))))
+                vel.append(np.column_stack((bv, np.zeros(len(bv)))))
+                # σ_part = σ · share (linear power)
+                rcs_list.append(rcs[i] + 10 * np.log10(frac))
+                src.append(np.full(len(bp), i, dtype=np.int32))
         n_clutter = 0
         if run_clutter:
             c = draw_clutter(
