@@ -14,7 +14,6 @@ from core.processing import (
     label_sources,
     range_doppler_map,
     range_fft,
-    remove_static_clutter,
     two_stage_cfar,
 )
 from core.simulation.antenna import AntennaGain
@@ -40,6 +39,14 @@ class FrameOutput:
     point_cloud: PointCloud
     rd_map_db: np.ndarray | None
     detections: np.ndarray
+
+
+def processed_range_bins(radar: RadarConfig, settings: ProcessingSettings) -> int:
+    """Range bins ``0 .. n-1`` that the detector needs: up to ``max_range_m`` plus the range
+    CFAR's guard and training cells (the map beyond is never looked at)."""
+    last = int(np.floor(settings.max_range_m / radar.range_resolution_m))
+    margin = settings.range_cfar.n_train + settings.range_cfar.n_guard
+    return int(min(radar.n_samples, last + 1 + margin))
 
 
 def needs_elevation(radar: RadarConfig, scatterers: Scatterers) -> bool:
@@ -77,9 +84,10 @@ def simulate_frame(
     if noise:
         cube += synthesize_noise(radar, rng)
     rc = range_fft(cube, settings.range_window)
-    if settings.static_clutter_removal:
-        rc = remove_static_clutter(rc)
-    dc = doppler_fft(rc, settings.doppler_window)
+    if not keep_rd_map:
+        # only the range bins the CFAR looks at (limits plus its training window)
+        rc = rc[:, :, : processed_range_bins(radar, settings)]
+    dc = doppler_fft(rc, settings.doppler_window, remove_static=settings.static_clutter_removal)
     rd = range_doppler_map(dc)
     det = two_stage_cfar(rd, radar, settings)
     if elevation is None:
