@@ -249,3 +249,27 @@ def test_static_reflectors_are_removed_by_the_chain() -> None:
     # the only -1 reflectors are static: static clutter removal must take them all out
     assert not np.any(src == -1)
     assert np.mean([np.any(c.source == 0) for c in run.clouds]) > 0.9
+
+
+def test_frame_scatterers_are_persons_clutter_and_static_reflectors() -> None:
+    from core.pipeline import frame_scatterers
+
+    scene = dataclasses.replace(
+        Scene.from_json(ROOT / "resources/scenes/waypoints_static.json"),
+        clutter_density_per_m2=0.2,
+    )
+    t, xy, v = scene.truth()
+    for f in (0, 10):
+        s = frame_scatterers(scene, f)
+        person = s.source == 0
+        assert person.sum() == 1
+        np.testing.assert_array_equal(s.position_m[person, :2], xy[f, :1])
+        np.testing.assert_array_equal(s.velocity_mps[person, :2], v[f, :1])
+        assert s.rcs_dbsm[person][0] == -8.0  # fixed in the scene file
+        static = (s.source == -1) & (np.abs(s.velocity_mps).sum(axis=1) == 0)
+        assert static.sum() == 3
+        moving_clutter = (s.source == -1) & ~static
+        # same stream as in a full run: equals the clutter count iter_frames reports
+        n = next(iter_frames(scene, frames=[f])).n_clutter
+        assert moving_clutter.sum() == n
+        assert np.all(np.abs(s.radial_velocity_mps[moving_clutter]) >= 2 * 0.4526)
