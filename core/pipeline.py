@@ -676,7 +676,10 @@ def build_dataset(
         seeds = trajectory_seeds(seed, len(scenes))
     elif len(seeds) != len(scenes):
         raise InputError(f"seeds: {len(seeds)} given for {len(scenes)} scenes")
-    tasks = [(s.to_json(), sd, fidelity) for s, sd in zip(scenes, seeds)]
+    # self-contained scenes (radar as fields): workers may not see a .cfg relative to a file
+    tasks = [
+        (json.dumps(s.to_dict(resolve_radar=True)), sd, fidelity) for s, sd in zip(scenes, seeds)
+    ]
     jobs = (os.cpu_count() or 1) if jobs is None else max(1, int(jobs))
     results: list[dict[str, Any]] = []
     if jobs == 1 or len(tasks) == 1:

@@ -157,10 +157,18 @@ class Scene:
         return np.arange(f) * self.radar.frame_period_s, xy, v
 
     # ---- JSON --------------------------------------------------------------------------------
-    def to_dict(self) -> dict:
+    def to_dict(self, *, resolve_radar: bool = False) -> dict:
+        """The scene as JSON-ready data; ``resolve_radar`` writes the radar as its fields
+        (self-contained: no ``.cfg`` path relative to a scene file)."""
+        if resolve_radar:
+            radar: Any = self.radar.to_dict()
+        elif isinstance(self.radar_spec, str):
+            radar = self.radar_spec
+        else:
+            radar = dict(self.radar_spec)
         return {
             "schema_version": SCHEMA_VERSION,
-            "radar": self.radar_spec if isinstance(self.radar_spec, str) else dict(self.radar_spec),
+            "radar": radar,
             "seed": self.seed,
             "clutter_density_per_m2": self.clutter_density_per_m2,
             "aoi": self.aoi.to_dict(),
@@ -177,9 +185,7 @@ class Scene:
 
     def canonical_json(self) -> str:
         """Compact, key-sorted JSON including the resolved radar (for hashing)."""
-        d = self.to_dict()
-        d["radar"] = self.radar.to_dict()
-        return json.dumps(d, sort_keys=True, separators=(",", ":"))
+        return json.dumps(self.to_dict(resolve_radar=True), sort_keys=True, separators=(",", ":"))
 
     @classmethod
     def from_json(cls, path: str | os.PathLike) -> Scene:

@@ -273,3 +273,27 @@ def test_frame_scatterers_are_persons_clutter_and_static_reflectors() -> None:
         n = next(iter_frames(scene, frames=[f])).n_clutter
         assert moving_clutter.sum() == n
         assert np.all(np.abs(s.radial_velocity_mps[moving_clutter]) >= 2 * 0.4526)
+
+
+def test_dataset_of_scenes_with_a_ti_cfg_radar_from_another_folder(tmp_path, monkeypatch) -> None:
+    cfg = ROOT / "resources" / "radar" / "paper.cfg"
+    (tmp_path / "radar").mkdir()
+    (tmp_path / "radar" / "r.cfg").write_text(cfg.read_text())
+    (tmp_path / "scenes").mkdir()
+    scenes = []
+    for i, cls in enumerate("ce"):
+        doc = {
+            "schema_version": 1,
+            "radar": "../radar/r.cfg",
+            "seed": i,
+            "clutter_density_per_m2": 0.02,
+            "persons": [{"trajectory": {"class": cls, "seed": i, "duration_s": 0.8}}],
+        }
+        path = tmp_path / "scenes" / f"s{i}.json"
+        path.write_text(__import__("json").dumps(doc))
+        scenes.append(Scene.from_json(path))
+    (tmp_path / "elsewhere" / "deeper").mkdir(parents=True)
+    monkeypatch.chdir(tmp_path / "elsewhere" / "deeper")
+    ds = build_dataset(scenes, seed=0, jobs=2, use_cache=False)  # worker processes
+    assert ds.n_frames == 20 and list(ds.trajectory_class) == ["c", "e"]
+    assert '"../radar/r.cfg"' in ds.scene_json  # the data set keeps the scene as written
