@@ -382,7 +382,8 @@ def _track_kernel(
                     rho = m_hat / (vol_c * L[0, 0] * L[1, 1] * L[2, 2])
                 else:
                     rho = rho_given
-                # log Λᵢ = −½dᵢ² − ½ log det S − (3/2) log 2π − log(P_G ρ); aᵢ = log P_D P_G + log Λᵢ
+                # log Λᵢ = −½dᵢ² − ½ log det S − (3/2) log 2π − log(P_G ρ)
+                # aᵢ = log(P_D P_G) + log Λᵢ
                 c0 = -0.5 * logdet - 1.5 * LOG_2PI - (log_pg + math.log(rho)) + log_pdpg
                 top = a0
                 for j in range(mval):
