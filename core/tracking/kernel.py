@@ -10,6 +10,7 @@ trajectory of a data set. ``tests/core/tracking/test_kernel.py`` checks that bot
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -513,6 +514,28 @@ def _track_kernel(
             o += 1
 
 
+@functools.lru_cache(maxsize=256)
+def _matrices(params: TrackerParams, frame_period_s: float):
+    """F, its sparsity (columns and counts per row), Q, R and P0, cached per parameter set."""
+    d = params.state_dim
+    F = transition_matrix(params.model, frame_period_s)
+    f_nnz = np.count_nonzero(F, axis=1).astype(np.int64)
+    f_cols = np.zeros((d, max(1, int(f_nnz.max()))), dtype=np.int64)
+    for i in range(d):
+        nz = np.flatnonzero(F[i])
+        f_cols[i, : len(nz)] = nz
+    out = (
+        F,
+        f_cols,
+        f_nnz,
+        process_noise(params.model, frame_period_s, params.q_coeff),
+        # R = diag(r11², r22², r33²)
+        np.diag([params.r11**2, params.r22**2, params.r33**2]),
+        initial_covariance(params.p0),
+    )
+    return out  # shared between calls: never written (read-only flags would force a recompile)
+
+
 def track_frames(
     z: np.ndarray,
     frame_offsets: np.ndarray,
@@ -564,12 +587,7 @@ def track_frames(
     n_tr = np.zeros(n_out, dtype=np.int64)
     n_bad = np.zeros(n_out, dtype=np.int64)
     nonparam = params.nonparametric
-    F = transition_matrix(params.model, frame_period_s)
-    f_nnz = np.count_nonzero(F, axis=1).astype(np.int64)
-    f_cols = np.zeros((d, max(1, int(f_nnz.max()))), dtype=np.int64)
-    for i in range(d):
-        nz = np.flatnonzero(F[i])
-        f_cols[i, : len(nz)] = nz
+    F, f_cols, f_nnz, Q, R, P0 = _matrices(params, float(frame_period_s))
     _track_kernel(
         np.ascontiguousarray(z, dtype=np.float64),
         np.ascontiguousarray(frame_offsets, dtype=np.int64),
@@ -579,9 +597,9 @@ def track_frames(
         F,
         f_cols,
         f_nnz,
-        process_noise(params.model, frame_period_s, params.q_coeff),
-        np.diag([params.r11**2, params.r22**2, params.r33**2]),
-        initial_covariance(params.p0),
+        Q,
+        R,
+        P0,
         gate_threshold(params.p_g, 3),
         gate_threshold(params.p_g, 2),
         float(params.p_d),
