@@ -87,8 +87,9 @@ def _prepare(dataset: Dataset) -> tuple[np.ndarray, np.ndarray, np.ndarray, floa
     A study tracks the same (immutable) data set thousands of times, often one trajectory per
     call; this saves re-deriving ~1 ms of arrays on every call.
     """
-    if _PREPARED and _PREPARED[0][0] is dataset:
-        return _PREPARED[0][1:]
+    entry = _PREPARED[0] if _PREPARED else None  # one read: safe if a thread replaces it
+    if entry is not None and entry[0] is dataset:
+        return entry[1:]
     period = dataset_frame_period_s(dataset)
     z = dataset.measurements()
     if not np.all(np.isfinite(z)):
