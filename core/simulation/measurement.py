@@ -49,6 +49,7 @@ from __future__ import annotations
 import functools
 from dataclasses import dataclass
 
+import numba
 import numpy as np
 
 from core.config import DEFAULT_PROCESSING, SPEED_OF_LIGHT_MPS, ProcessingSettings, RadarConfig
@@ -237,6 +238,12 @@ def chain_false_alarms(
 
 
 @functools.lru_cache(maxsize=16)
+def _setup(radar: RadarConfig, settings: ProcessingSettings) -> tuple[ChainTables, dict]:
+    """Tables and constants of a radar and settings (one cache look-up per frame)."""
+    return chain_tables(radar, settings), _constants(radar, settings)
+
+
+@functools.lru_cache(maxsize=16)
 def _constants(radar: RadarConfig, settings: ProcessingSettings):
     """Per-radar constants: eq. (4) factor, CFAR thresholds and shapes, range-bin limits."""
     L = radar.n_virtual
@@ -259,7 +266,18 @@ def _constants(radar: RadarConfig, settings: ProcessingSettings):
     # / lambda) (the carrier at the middle of the ADC window)
     beat = 2 * np.pi * 2 * radar.slope_hz_per_s / (SPEED_OF_LIGHT_MPS * radar.sample_rate_hz)
     doppler_scale = 1.0 + beat * (radar.n_samples - 1) / 2 / (4 * np.pi / radar.wavelength_m)
+    t_mid = 0.5 * radar.n_loops * radar.n_tx * radar.chirp_period_s
+    method = {"ca": 0, "caso": 1, "cago": 2}
+    kernel = (
+        t_mid, radar.range_resolution_m, radar.velocity_resolution_mps, radar.n_loops,
+        doppler_scale, c_amp2, float(L),
+        method[rs.method], rs.n_train, float(ne_r or rs.n_train), rc.alpha(),
+        method[ds.method], ds.n_train, float(ne_d or ds.n_train), dc.alpha(),
+        min(n_row, len(set(radar.azimuth_positions))),
+        int(ok[0]) if ok.size else 0, int(ok[-1]) if ok.size else -1,
+    )  # fmt: skip
     return {
+        "kernel": kernel,
         "doppler_scale": doppler_scale,
         "L": L,
         "c_amp2": c_amp2,
@@ -306,90 +324,206 @@ def simulate_frame_measurement(
     asked for, is a model map (mean noise floor plus the detected cells), not a spectrum.
     ``noise=False`` gives the noiseless estimates of every reflector in the range limits.
     """
-    tab = chain_tables(radar, settings)
-    const = _constants(radar, settings)
-    L = const["L"]
+    tab, const = _setup(radar, settings)
     n = len(scatterers)
     if elevation is None:
         elevation = needs_elevation(radar, scatterers)
+    fields = []
     if n:
-        t_mid = 0.5 * radar.n_loops * radar.n_tx * radar.chirp_period_s
-        pos = scatterers.position_m + scatterers.velocity_mps * t_mid
-        r = np.sqrt(np.einsum("ij,ij->i", pos, pos))
-        vr = np.einsum("ij,ij->i", pos, scatterers.velocity_mps) / r
-        horiz = np.hypot(pos[:, 0], pos[:, 1])
-        az = np.arctan2(pos[:, 0], pos[:, 1])
-        el = np.arctan2(pos[:, 2], horiz)
-        # A^2 = Pt Gt Gr lambda^2 sigma / ((4 pi)^3 R^4) * R 10^(Ge/20)   (eqs. 2-4)
-        g_db = antenna.gain_db(np.arctan2(scatterers.position_m[:, 0], scatterers.position_m[:, 1]))
-        r0 = scatterers.range_m
-        amp2 = const["c_amp2"] * 10 ** ((2 * g_db + scatterers.rcs_dbsm) / 10) / r0**4
-        # peak cell: range bin, Doppler cell, gains and the chain's refined estimates
-        rb = r / radar.range_resolution_m
-        k_int = np.floor(rb)
-        f = rb - k_int
-        half = radar.n_loops / 2
-        nu = (const["doppler_scale"] * vr / radar.velocity_resolution_mps + half) % (
-            radar.n_loops
-        ) - half
-        gr = np.interp(f, tab.range_frac, tab.range_gain)
-        r_est = k_int + np.interp(f, tab.range_frac, tab.range_est)
-        jd = np.rint((nu + half) * DOPPLER_STEPS_PER_BIN).astype(np.int64)
-        jr = np.rint(f * RANGE_STEPS_PER_BIN).astype(np.int64)
-        d_cell = tab.doppler_index[jd]
-        d_est = np.interp(nu, tab.doppler_nu, tab.doppler_est)
-        # rho = A^2 |R|^2 |D|^2 / s2[d]  (per channel, peak cell)
-        rho = amp2 * gr * tab.doppler_gain[jd] / tab.cell_noise[d_cell]
-        u_true = np.sin(az) * np.cos(el)
-        u_est = np.interp(u_true, tab.u_grid, tab.u_est)
-        if noise:
-            z = rng.standard_normal((5, n))
-            # X = |sqrt(L rho) + n|^2 + Gamma(L - 1),  n ~ CN(0, 1)
-            x = (np.sqrt(L * rho) + z[0] / np.sqrt(2)) ** 2 + z[1] ** 2 / 2
-            x += rng.standard_gamma(L - 1.0, n)
-            # training cells: noise plus the reflector's own leakage (units of s2, L channels)
-            leak = L * amp2 / tab.cell_noise[d_cell]
-            lr = leak[:, None] * tab.doppler_gain[jd][:, None] * tab.range_leak[jr]
-            ld = leak[:, None] * gr[:, None] * tab.doppler_leak[jd]
-            mu_r = _noise_estimate(*const["range_stage"][:3], L, rng, lr)
-            mu_d = _noise_estimate(*const["doppler_stage"][:3], L, rng, ld)
-            det = (x > const["range_stage"][3] * mu_r) & (x > const["doppler_stage"][3] * mu_d)
-            snr_db = 10 * np.log10(x / mu_r)
-            # Cramer-Rao: var(bin) = 6 / (4 pi^2 L rho);  var(u) = 6 / (pi^2 rho M (M^2 - 1))
-            sd_bin = np.sqrt(6.0 / (4 * np.pi**2 * L * rho))
-            m_az = const["m_az"]
-            sd_u = np.sqrt(6.0 / (np.pi**2 * rho * m_az * (m_az**2 - 1)))
-            r_est = r_est + sd_bin * z[2]
-            d_est = d_est + sd_bin * z[3]
-            u_est = np.clip(u_est + sd_u * z[4], -1.0, 1.0)
-        else:
-            det = np.ones(n, dtype=bool)
-            snr_db = 10 * np.log10(L * rho)
-        det &= (r_est >= const["bin_lo"] - 0.5) & (r_est <= const["bin_hi"] + 0.5)
-        d_est = (d_est + half) % radar.n_loops - half
-        cells = np.column_stack((np.rint(r_est[det]), d_cell[det]))
-        az_m = np.arcsin(u_est[det] / np.cos(el[det]) if elevation else u_est[det])
-        pc = _cloud(
-            radar,
-            r_est[det] * radar.range_resolution_m,
-            az_m,
-            el[det] if elevation else np.zeros(int(det.sum())),
-            d_est[det] * radar.velocity_resolution_mps,
-            snr_db[det],
-            scatterers.source[det],
+        p0 = scatterers.position_m
+        g_db = antenna.gain_db(np.arctan2(p0[:, 0], p0[:, 1]))
+        det, r_bin, d_bin, u, el, snr_db, d_cell = _measure_kernel(
+            rng if noise else np.random.default_rng(0),
+            np.ascontiguousarray(p0, dtype=np.float64),
+            np.ascontiguousarray(scatterers.velocity_mps, dtype=np.float64),
+            np.asarray(g_db, dtype=np.float64),
+            np.asarray(scatterers.rcs_dbsm, dtype=np.float64),
+            *const["kernel"],
+            tab.range_gain,
+            tab.range_est,
+            tab.range_leak,
+            tab.doppler_gain,
+            tab.doppler_index,
+            tab.doppler_est,
+            tab.doppler_leak,
+            tab.u_est,
+            tab.cell_noise,
+            bool(noise),
         )
-    else:
-        pc, cells = PointCloud.empty(), np.zeros((0, 2))
+        el = el[det] if elevation else np.zeros(int(det.sum()))
+        fields.append(
+            (
+                r_bin[det],
+                np.arcsin(np.clip(u[det] / np.cos(el), -1.0, 1.0)),
+                el,
+                d_bin[det],
+                snr_db[det],
+                scatterers.source[det],
+                d_cell[det],
+            )
+        )
     if noise:
-        pc, cells = _add_false_alarms(radar, settings, const, pc, cells, rng)
+        extra = _false_alarms(radar, settings, const, rng)
+        if extra is not None:
+            fields.append(extra)
+    if len(fields) == 1:
+        r_bin, az, el, d_bin, snr_db, source, d_cell = fields[0]
+    elif fields:
+        r_bin, az, el, d_bin, snr_db, source, d_cell = (np.concatenate(c) for c in zip(*fields))
+    else:
+        r_bin = az = el = d_bin = snr_db = np.zeros(0)
+        source, d_cell = np.zeros(0, dtype=np.int32), np.zeros(0, dtype=np.int64)
+    pc = _cloud(
+        radar,
+        r_bin * radar.range_resolution_m,
+        az,
+        el,
+        d_bin * radar.velocity_resolution_mps,
+        snr_db,
+        source,
+    )
+    cells = np.column_stack((np.rint(r_bin), d_cell)).astype(np.int64)
     rd_db = None
     if keep_rd_map:
         rd_db = _model_map(radar, tab, cells, pc)
-    return FrameOutput(point_cloud=pc, rd_map_db=rd_db, detections=cells.astype(np.int64))
+    return FrameOutput(point_cloud=pc, rd_map_db=rd_db, detections=cells)
+
+
+@numba.njit(cache=True, nogil=True)
+def _lerp(table, x, x0, step):  # pragma: no cover
+    """Linear interpolation in a table on the uniform grid ``x0 + i step`` (clamped)."""
+    t = (x - x0) / step
+    i = int(np.floor(t))
+    i = min(max(i, 0), table.shape[0] - 2)
+    w = min(max(t - i, 0.0), 1.0)
+    return table[i] * (1.0 - w) + table[i + 1] * w
+
+
+@numba.njit(cache=True, nogil=True)
+def _training_sum(rng, method, n_train, n_eff, L, leak_l, leak_r):  # pragma: no cover
+    """CFAR noise estimate: each side ``(n / n_eff) Gamma(n_eff L)`` plus the own leakage."""
+    z1 = rng.standard_gamma(n_eff * L) * (n_train / n_eff) + leak_l
+    z2 = rng.standard_gamma(n_eff * L) * (n_train / n_eff) + leak_r
+    if method == 0:
+        # CA: (Z1 + Z2) / 2n
+        return (z1 + z2) / (2 * n_train)
+    if method == 1:
+        # CASO: min(Z1, Z2) / n
+        return min(z1, z2) / n_train
+    # CAGO: max(Z1, Z2) / n
+    return max(z1, z2) / n_train
+
+
+@numba.njit(cache=True, nogil=True)
+def _measure_kernel(
+    rng,
+    pos,
+    vel,
+    gain_db,
+    rcs,
+    t_mid,
+    range_res,
+    vel_res,
+    n_loops,
+    doppler_scale,
+    c_amp2,
+    L,
+    rmeth,
+    rn,
+    rne,
+    ralpha,
+    dmeth,
+    dn,
+    dne,
+    dalpha,
+    m_az,
+    bin_lo,
+    bin_hi,
+    range_gain,
+    range_est,
+    range_leak,
+    doppler_gain,
+    doppler_index,
+    doppler_est,
+    doppler_leak,
+    u_est_tab,
+    cell_noise,
+    noise,
+):  # pragma: no cover
+    """Steps 1-3 of the module docstring for every reflector; arrays ``(N,)``."""
+    n = pos.shape[0]
+    det = np.zeros(n, dtype=np.bool_)
+    r_out = np.empty(n)
+    d_out = np.empty(n)
+    u_out = np.empty(n)
+    el_out = np.empty(n)
+    snr_out = np.empty(n)
+    cell_out = np.empty(n, dtype=np.int64)
+    f_step = 1.0 / (range_gain.shape[0] - 1)
+    half = n_loops / 2
+    nu_step = n_loops / (doppler_gain.shape[0] - 1)
+    u_step = 2.0 / (u_est_tab.shape[0] - 1)
+    for i in range(n):
+        px = pos[i, 0] + vel[i, 0] * t_mid
+        py = pos[i, 1] + vel[i, 1] * t_mid
+        pz = pos[i, 2] + vel[i, 2] * t_mid
+        r = np.sqrt(px * px + py * py + pz * pz)
+        vr = (px * vel[i, 0] + py * vel[i, 1] + pz * vel[i, 2]) / r
+        el_out[i] = np.arctan2(pz, np.hypot(px, py))
+        r0 = np.sqrt(pos[i, 0] ** 2 + pos[i, 1] ** 2 + pos[i, 2] ** 2)
+        # A^2 = Pt Gt Gr lambda^2 sigma / ((4 pi)^3 R^4) * R 10^(Ge/20)   (eqs. 2-4)
+        amp2 = c_amp2 * 10.0 ** ((2.0 * gain_db[i] + rcs[i]) / 10.0) / r0**4
+        rb = r / range_res
+        k_int = np.floor(rb)
+        f = rb - k_int
+        nu = (doppler_scale * vr / vel_res + half) % n_loops - half
+        gr = _lerp(range_gain, f, 0.0, f_step)
+        r_est = k_int + _lerp(range_est, f, 0.0, f_step)
+        jd = int(np.rint((nu + half) / nu_step))
+        jr = int(np.rint(f / f_step))
+        dc = doppler_index[jd]
+        d_est = _lerp(doppler_est, nu, -half, nu_step)
+        # rho = A^2 |R|^2 |D|^2 / s2[d]  (per channel, peak cell)
+        rho = max(amp2 * gr * doppler_gain[jd] / cell_noise[dc], 1e-30)
+        # the array phase of the exact chain is that of the first chirp's direction
+        u_est = _lerp(u_est_tab, pos[i, 0] / r0, -1.0, u_step)
+        if noise:
+            # X = |sqrt(L rho) + n|^2 + Gamma(L - 1),  n ~ CN(0, 1)
+            a = np.sqrt(L * rho) + rng.standard_normal() / np.sqrt(2.0)
+            b = rng.standard_normal() / np.sqrt(2.0)
+            x = a * a + b * b + rng.standard_gamma(L - 1.0)
+            # training cells: noise plus the reflector's own leakage (units of s2)
+            leak = L * amp2 / cell_noise[dc]
+            lr = leak * doppler_gain[jd]
+            ld = leak * gr
+            mu_r = _training_sum(
+                rng, rmeth, rn, rne, L, lr * range_leak[jr, 0], lr * range_leak[jr, 1]
+            )
+            mu_d = _training_sum(
+                rng, dmeth, dn, dne, L, ld * doppler_leak[jd, 0], ld * doppler_leak[jd, 1]
+            )
+            det[i] = x > ralpha * mu_r and x > dalpha * mu_d
+            snr_out[i] = 10.0 * np.log10(x / mu_r)
+            # Cramer-Rao: var(bin) = 6 / (4 pi^2 L rho);  var(u) = 6 / (pi^2 rho M (M^2 - 1))
+            sd_bin = np.sqrt(6.0 / (4.0 * np.pi**2 * L * rho))
+            sd_u = np.sqrt(6.0 / (np.pi**2 * rho * m_az * (m_az**2 - 1)))
+            r_est += sd_bin * rng.standard_normal()
+            d_est += sd_bin * rng.standard_normal()
+            u_est = min(1.0, max(-1.0, u_est + sd_u * rng.standard_normal()))
+        else:
+            det[i] = True
+            snr_out[i] = 10.0 * np.log10(L * rho)
+        det[i] = det[i] and bin_lo - 0.5 <= r_est <= bin_hi + 0.5
+        r_out[i] = r_est
+        d_out[i] = (d_est + half) % n_loops - half
+        u_out[i] = u_est
+        cell_out[i] = dc
+    return det, r_out, d_out, u_out, el_out, snr_out, cell_out
 
 
 def _cloud(radar, range_m, az, el, vr, snr_db, source) -> PointCloud:
     horiz = range_m * np.cos(el)
+    range_m = np.asarray(range_m, dtype=np.float64)
     return PointCloud(
         range_m=range_m,
         azimuth_rad=az,
@@ -403,28 +537,29 @@ def _cloud(radar, range_m, az, el, vr, snr_db, source) -> PointCloud:
     )
 
 
-def _add_false_alarms(radar, settings, const, pc, cells, rng):
-    """Append a Poisson number of the chain's own false alarms, resampled from the pool."""
+def _false_alarms(radar, settings, const, rng):
+    """A Poisson number of the chain's own false alarms, resampled from the measured pool.
+
+    Returns the point fields ``(range bin, azimuth, elevation, Doppler bin, SNR, source,
+    Doppler cell)``, or None when there is none this frame.
+    """
     fa = chain_false_alarms(radar, settings)
-    k = rng.poisson(fa.rate_per_frame) if fa.rate_per_frame > 0 else 0
-    if k == 0 or len(fa.snr_db) == 0:
-        return pc, cells
-    pick = rng.integers(0, len(fa.snr_db), k)
+    k = rng.poisson(fa.rate_per_frame) if fa.rate_per_frame > 0 and len(fa.snr_db) else 0
+    if k == 0:
+        return None
+    pick = rng.integers(0, max(len(fa.snr_db), 1), k)
     r_bin = rng.integers(const["bin_lo"], const["bin_hi"] + 1, k) + fa.range_frac[pick]
-    half = radar.n_loops // 2
-    # the pool's Doppler index with a uniform sub-bin refinement in (-0.5, 0.5)
-    d_bin = fa.doppler_index[pick] - half + rng.uniform(-0.5, 0.5, k)
-    extra = _cloud(
-        radar,
-        r_bin * radar.range_resolution_m,
+    # the pool's Doppler cell with a uniform sub-bin refinement in (-0.5, 0.5)
+    d_bin = fa.doppler_index[pick] - radar.n_loops // 2 + rng.uniform(-0.5, 0.5, k)
+    return (
+        r_bin,
         fa.azimuth_rad[pick],
         np.zeros(k),
-        d_bin * radar.velocity_resolution_mps,
+        d_bin,
         fa.snr_db[pick],
-        np.full(k, SOURCE_OTHER),
+        np.full(k, SOURCE_OTHER, dtype=np.int32),
+        fa.doppler_index[pick],
     )
-    extra_cells = np.column_stack((np.rint(r_bin), fa.doppler_index[pick]))
-    return PointCloud.concatenate([pc, extra]), np.concatenate([cells, extra_cells])
 
 
 def _model_map(radar: RadarConfig, tab: ChainTables, cells: np.ndarray, pc: PointCloud):

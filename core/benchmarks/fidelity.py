@@ -1,0 +1,310 @@
+"""``radartune bench fidelity``: error against run time of the simulation's fidelity levels.
+
+The same scenes (a subset of the paper's data set: ``n`` trajectories per class) and the same
+per-frame reflectors and noise seeds go through every level of
+:data:`core.simulation.FIDELITY_LEVELS`. Only the simulator call is timed (process CPU time,
+so that the other processes on a shared machine count less), frame by frame, and the levels run
+interleaved trajectory by trajectory so that a load change hits all of them alike. A second
+``exact`` run with other noise seeds (``exact*``) shows how far two statistically identical
+simulations differ: the yardstick for every distance below.
+
+Figures per level: frames per second and speed-up over ``exact``; detection probability of the
+person; range, azimuth and radial-velocity errors of the person's points (mean, spread) and
+their Kolmogorov-Smirnov distance to ``exact``; the same for the reported SNR; clutter and
+false detections per frame; the tracking loss (eq. 14) of the same tracker parameters on each
+level's data set for the CV and CA models, with the run time of one trial.
+
+Writes ``docs/fidelity/results.md`` and ``docs/fidelity/error_vs_runtime.png`` (``--quick``:
+``bench/results/fidelity-quick.*``).
+"""
+
+from __future__ import annotations
+
+import json
+import time
+from pathlib import Path
+
+import numpy as np
+
+#: trajectories per class (a-e) in the full and the quick run
+PER_CLASS = 3
+PER_CLASS_QUICK = 1
+QUICK_FRAMES = 60
+#: noise seed offset of the second exact run
+OTHER_SEED = 1_000_003
+
+
+def _ks(a: np.ndarray, b: np.ndarray) -> float | None:
+    from scipy.stats import ks_2samp
+
+    if len(a) < 5 or len(b) < 5:
+        return None
+    return float(ks_2samp(a, b).statistic)
+
+
+def _frames(scene, seed):
+    """Reflectors of every frame as the pipeline builds them (same streams as a data set)."""
+    from core import pipeline
+    from core import simulation as sim
+
+    p = pipeline.plan(scene)
+    antenna = sim.AntennaGain.draw(scene.radar, pipeline.stage_rng(seed, "antenna"))
+    settings = pipeline.processing_settings(scene)
+    # the pipeline's reflector builder (private: the bench needs the frames without simulating)
+    refl = pipeline._Reflectors.build(scene, p, seed, antenna, settings)
+    frames = [refl.frame(f)[0] for f in range(scene.n_frames)]
+    return frames, antenna, settings, p.elevation, refl
+
+
+def run(quick: bool = False) -> dict:
+    """Run every level on the same scenes; returns JSON-ready figures (see module docstring)."""
+    from core import pipeline
+    from core.dataset import Dataset
+    from core.evaluation import evaluate
+    from core.scene import paper_scenes
+    from core.simulation import FIDELITY_LEVELS
+    from core.tracking import TrackerParams, track_dataset
+
+    per_class = PER_CLASS_QUICK if quick else PER_CLASS
+    scenes = paper_scenes(0, 5 * per_class)
+    levels = list(FIDELITY_LEVELS)
+    runs = [*levels, "exact*"]
+    acc = {
+        name: {"cpu_s": 0.0, "frames": 0, "clouds": [], "err": [], "snr": [], "hit": []}
+        for name in runs
+    }
+    truth = {"xy": [], "v": [], "t": [], "traj": [], "cls": []}
+    for k, scene in enumerate(scenes):
+        seed = scene.seed
+        frames, antenna, settings, elevation, refl = _frames(scene, seed)
+        n_f = QUICK_FRAMES if quick else len(frames)
+        radar = scene.radar
+        t_mid = 0.5 * radar.n_loops * radar.n_tx * radar.chirp_period_s
+        for name in runs:
+            simulate = FIDELITY_LEVELS[name.rstrip("*")]
+            a = acc[name]
+            noise_seed = seed + OTHER_SEED if name.endswith("*") else seed
+            for f in range(n_f):
+                sc = frames[f]
+                rng = pipeline.stage_rng(noise_seed, "noise", f)
+                t0 = time.process_time()
+                out = simulate(
+                    radar, sc, rng, antenna=antenna, settings=settings, elevation=elevation
+                )
+                a["cpu_s"] += time.process_time() - t0
+                a["frames"] += 1
+                pc = out.point_cloud
+                a["clouds"].append(pc)
+                person = np.flatnonzero(sc.source == 0)
+                a["hit"].append(bool(np.any(pc.source == 0)))
+                if person.size:
+                    i = person[0]
+                    pos = sc.position_m[i] + sc.velocity_mps[i] * t_mid
+                    r = np.linalg.norm(pos)
+                    az = np.arctan2(pos[0], pos[1])
+                    vr = pos @ sc.velocity_mps[i] / r
+                    m = pc.source == 0
+                    for j in np.flatnonzero(m):
+                        a["err"].append(
+                            (
+                                pc.range_m[j] - r,
+                                pc.azimuth_rad[j] - az,
+                                pc.radial_velocity_mps[j] - vr,
+                            )
+                        )
+                        a["snr"].append(pc.snr_db[j])
+        truth["xy"].append(refl.truth_xy_m[:n_f])
+        truth["v"].append(refl.truth_v_mps[:n_f])
+        truth["t"].append(refl.truth_t_s[:n_f])
+        truth["traj"].append(np.full(n_f, k, dtype=np.int32))
+        truth["cls"].append(scene.trajectory_class)
+
+    # data sets and tracking: the same parameters on every level's point clouds
+    params = {m: TrackerParams.default(m) for m in ("cv", "ca")}
+    exact = acc["exact"]
+    result_levels = {}
+    exact_fps = exact["frames"] / exact["cpu_s"]
+    for name in runs:
+        a = acc[name]
+        ds = Dataset.from_frames(
+            clouds=a["clouds"],
+            trajectory=np.concatenate(truth["traj"]),
+            truth_t_s=np.concatenate(truth["t"]),
+            truth_xy_m=np.concatenate(truth["xy"]),
+            truth_v_mps=np.concatenate(truth["v"]),
+            trajectory_class=truth["cls"],
+            scene_json=json.dumps([s.to_dict() for s in scenes]),
+            radar_json=json.dumps(scenes[0].radar.to_dict()),
+            fidelity=name.rstrip("*"),
+            seed=0,
+        )
+        tracking = {}
+        for model, prm in params.items():
+            t0 = time.process_time()
+            est = track_dataset(ds, prm)
+            ev = evaluate(ds, est)
+            dt = time.process_time() - t0
+            tracking[model] = {
+                "loss_x1e3": 1e3 * ev.loss_total,
+                "mse_m2": float(np.nanmean(ev.mse)) if len(ev.mse) else None,
+                "n_c_mean": float(np.mean(ev.n_c)),
+                "rmse_m": ev.rmse_m,
+                "confirmed_fraction": ev.confirmed_fraction,
+                "track_cpu_s": dt,
+                "trial_cpu_s": dt + a["cpu_s"],
+            }
+        err = np.asarray(a["err"]).reshape(-1, 3)
+        ex = np.asarray(exact["err"]).reshape(-1, 3)
+        n_frames = a["frames"]
+        src = np.concatenate([c.source for c in a["clouds"]])
+        fps = n_frames / a["cpu_s"]
+
+        def dist(x: np.ndarray) -> dict:
+            if not len(x):
+                return {"mean": None, "sd": None, "p05": None, "p95": None}
+            return {
+                "mean": float(np.mean(x)),
+                "sd": float(np.std(x)),
+                "p05": float(np.percentile(x, 5)),
+                "p95": float(np.percentile(x, 95)),
+            }
+
+        result_levels[name] = {
+            "frames": n_frames,
+            "cpu_s": a["cpu_s"],
+            "fps": fps,
+            "speedup": fps / exact_fps,
+            "person_pd": float(np.mean(a["hit"])),
+            "range_error_m": {**dist(err[:, 0]), "ks": _ks(err[:, 0], ex[:, 0])},
+            "azimuth_error_deg": {
+                **dist(np.degrees(err[:, 1])),
+                "ks": _ks(err[:, 1], ex[:, 1]),
+            },
+            "radial_velocity_error_mps": {**dist(err[:, 2]), "ks": _ks(err[:, 2], ex[:, 2])},
+            "snr_db": {
+                **dist(np.asarray(a["snr"])),
+                "ks": _ks(np.asarray(a["snr"]), np.asarray(exact["snr"])),
+            },
+            "clutter_points_per_frame": float(np.sum(src == -1) / n_frames),
+            "false_points_per_frame": float(np.sum(src == -2) / n_frames),
+            "person_points_per_frame": float(np.sum(src >= 0) / n_frames),
+            "tracking": tracking,
+        }
+    out = {
+        "scenes": f"paper_scenes(seed=0): first {len(scenes)} trajectories "
+        f"({per_class} per class a-e){f', first {QUICK_FRAMES} frames each' if quick else ''}",
+        "frames_per_level": exact["frames"],
+        "tracker_parameters": "TrackerParams.default('cv') / ('ca') (no tuned parameters "
+        "committed on branch tune when this ran)",
+        "timing": "process CPU time of the simulator call only, levels interleaved per "
+        "trajectory; exact* = exact with other noise seeds",
+        "levels": result_levels,
+    }
+    target = Path("bench/results") if quick else Path("docs/fidelity")
+    stem = "fidelity-quick" if quick else "results"
+    target.mkdir(parents=True, exist_ok=True)
+    _write_table(out, target / f"{stem}.md")
+    _plot(out, target / ("fidelity-quick.png" if quick else "error_vs_runtime.png"))
+    return out
+
+
+def _fmt(v, spec: str = ".3g") -> str:
+    return "–" if v is None else format(v, spec)
+
+
+def _table(result: dict) -> str:
+    lv = result["levels"]
+    head = (
+        "| level | frames/s | speed-up | Pd person | range err mean/sd (mm) | KS | "
+        "az err mean/sd (°) | KS | vr err mean/sd (m/s) | KS | SNR median-ish mean (dB) | KS | "
+        "clutter pts/frame | false pts/frame | loss CV ×1e-3 | loss CA ×1e-3 | trial CPU CV (s) |"
+    )
+    rows = [head, "|" + "---|" * 18]
+    for name, r in lv.items():
+        re, ae, ve, sn = (
+            r["range_error_m"],
+            r["azimuth_error_deg"],
+            r["radial_velocity_error_mps"],
+            r["snr_db"],
+        )
+        mean_mm = None if re["mean"] is None else 1e3 * re["mean"]
+        sd_mm = None if re["sd"] is None else 1e3 * re["sd"]
+        mm = f"{_fmt(mean_mm, '.2f')}/{_fmt(sd_mm, '.2f')}"
+        rows.append(
+            f"| {name} | {r['fps']:.0f} | {r['speedup']:.1f} | {r['person_pd']:.3f} | {mm} | "
+            f"{_fmt(re['ks'], '.3f')} | {_fmt(ae['mean'], '.3f')}/{_fmt(ae['sd'], '.3f')} | "
+            f"{_fmt(ae['ks'], '.3f')} | {_fmt(ve['mean'], '.4f')}/{_fmt(ve['sd'], '.4f')} | "
+            f"{_fmt(ve['ks'], '.3f')} | {_fmt(sn['mean'], '.2f')} | {_fmt(sn['ks'], '.3f')} | "
+            f"{r['clutter_points_per_frame']:.3f} | {r['false_points_per_frame']:.3f} | "
+            f"{r['tracking']['cv']['loss_x1e3']:.4f} | {r['tracking']['ca']['loss_x1e3']:.4f} | "
+            f"{r['tracking']['cv']['trial_cpu_s']:.2f} |"
+        )
+    return "\n".join(rows)
+
+
+def _write_table(result: dict, path: Path) -> None:
+    text = (
+        "# Fidelity levels: error against run time\n\n"
+        f"Command: `radartune bench fidelity` (writes this file, the plot and "
+        f"`bench/results/fidelity.json`).\n\n"
+        f"- Scenes: {result['scenes']}; {result['frames_per_level']} frames per level.\n"
+        f"- Tracker: {result['tracker_parameters']}.\n"
+        f"- Timing: {result['timing']}.\n"
+        "- KS: two-sample Kolmogorov-Smirnov distance of the person's point errors to `exact`; "
+        "`exact*` is the yardstick (same scenes, other noise).\n"
+        "- Loss: eq. (14) on the level's own data set (×1e-3); trial CPU = simulation of the "
+        "data set + one tracking run.\n\n" + _table(result) + "\n"
+    )
+    tmp = path.with_suffix(path.suffix + ".tmp")
+    tmp.write_text(text)
+    tmp.replace(path)
+
+
+def _plot(result: dict, path: Path) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    lv = result["levels"]
+    names = list(lv)
+    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(11, 4.2))
+    for key, label, mk in (
+        ("range_error_m", "range error", "o"),
+        ("azimuth_error_deg", "azimuth error", "s"),
+        ("radial_velocity_error_mps", "radial-velocity error", "^"),
+        ("snr_db", "SNR", "D"),
+    ):
+        xs = [lv[n]["fps"] for n in names if lv[n][key]["ks"] is not None]
+        ys = [lv[n][key]["ks"] for n in names if lv[n][key]["ks"] is not None]
+        ax1.plot(xs, ys, mk, label=label, alpha=0.8)
+    for n in names:
+        ax1.annotate(n, (lv[n]["fps"], 0.0), textcoords="offset points", xytext=(0, -14),
+                     ha="center", fontsize=8)  # fmt: skip
+    ax1.set_xscale("log")
+    ax1.set_xlabel("frames per second (simulator CPU time)")
+    ax1.set_ylabel("KS distance to exact")
+    ax1.set_ylim(bottom=-0.05)
+    ax1.set_title("point errors against run time")
+    ax1.legend(fontsize=8)
+    for model, mk in (("cv", "o-"), ("ca", "s--")):
+        xs = [lv[n]["tracking"][model]["trial_cpu_s"] for n in names]
+        ys = [lv[n]["tracking"][model]["loss_x1e3"] for n in names]
+        ax2.plot(xs, ys, mk, label=model.upper(), alpha=0.8)
+        for n, x, y in zip(names, xs, ys):
+            ax2.annotate(n, (x, y), textcoords="offset points", xytext=(4, 4), fontsize=8)
+    ax2.set_xscale("log")
+    ax2.set_xlabel("CPU time per trial: simulate the data set + track it (s)")
+    ax2.set_ylabel("tracking loss L_t (×1e-3)")
+    ax2.set_title("tracking loss against run time")
+    ax2.legend(fontsize=8)
+    fig.tight_layout()
+    tmp = path.with_name(path.stem + ".tmp.png")
+    fig.savefig(tmp, dpi=110)
+    plt.close(fig)
+    tmp.replace(path)
+
+
+def summary(result: dict) -> str:
+    """Terminal summary: the Markdown table."""
+    return f"{result['scenes']}\n" + _table(result)
