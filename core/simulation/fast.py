@@ -850,12 +850,50 @@ def _log_parabola(a, b, c):  # pragma: no cover
 
 
 @numba.njit(cache=True, nogil=True)
+def angles_of(
+    x, db, n_tx, n_rx, n_loops, row_ch, row_pos, upper, lower, fft_size, elevation, spec
+):  # pragma: no cover
+    """Azimuth and elevation of one cell's channel values ``x`` (L,), the chain's step 6.
+
+    TDM-MIMO compensation with the (refined) Doppler bin ``db``, zero-padded DFT of the azimuth
+    row, log-parabolic peak refinement, elevation from the elevated pairs. ``spec`` is a work
+    array of ``fft_size``.
+    """
+    n_v = x.shape[0]
+    # x_v exp(-j 2 pi d k(v) / (Nc Ntx))
+    xc = np.empty(n_v, dtype=np.complex128)
+    for v in range(n_v):
+        xc[v] = x[v] * np.exp(-2j * np.pi * db * (v // n_rx) / (n_loops * n_tx))
+    # spec[j] = |sum_p x_p exp(-j 2 pi (j - N/2) p / N)|^2  (fftshifted)
+    best = 0
+    for j in range(fft_size):
+        acc = 0.0 + 0.0j
+        for q in range(row_ch.shape[0]):
+            acc += xc[row_ch[q]] * np.exp(
+                -2j * np.pi * (((j - fft_size // 2) * row_pos[q]) % fft_size) / fft_size
+            )
+        spec[j] = acc.real**2 + acc.imag**2
+        if spec[j] > spec[best]:
+            best = j
+    delta = _log_parabola(spec[(best - 1) % fft_size], spec[best], spec[(best + 1) % fft_size])
+    # u = sin(az) cos(el) = 2 (k - N/2 + delta) / N
+    u = 2.0 * (best - fft_size // 2 + delta) / fft_size
+    e = 0.0
+    if elevation and upper.shape[0] > 0:
+        z = 0.0 + 0.0j
+        for q in range(upper.shape[0]):
+            z += xc[upper[q]] * np.conj(xc[lower[q]])
+        # sin(el) = arg(sum x_upper conj(x_lower)) / pi
+        e = np.arcsin(min(1.0, max(-1.0, np.angle(z) / np.pi)))
+    return np.arcsin(min(1.0, max(-1.0, u / np.cos(e)))), e
+
+
+@numba.njit(cache=True, nogil=True)
 def _points_kernel(
     rd, r, d, x, n_tx, n_rx, row_ch, row_pos, upper, lower, fft_size, elevation
 ):  # pragma: no cover
     n_r, n_d = rd.shape
     n_det = r.shape[0]
-    n_v = x.shape[1]
     r_bin = np.empty(n_det)
     d_bin = np.empty(n_det)
     az = np.empty(n_det)
@@ -876,38 +914,14 @@ def _points_kernel(
         r_bin[i] = ri + dr
         db = di - n_d // 2 + dd
         d_bin[i] = db
-        # x_v exp(-j 2 pi d k(v) / (Nc Ntx))
-        xc = np.empty(n_v, dtype=np.complex128)
-        for v in range(n_v):
-            xc[v] = x[i, v] * np.exp(-2j * np.pi * db * (v // n_rx) / (n_d * n_tx))
-        # spec[j] = |sum_p x_p exp(-j 2 pi (j - N/2) p / N)|^2  (fftshifted)
-        best = 0
-        for j in range(fft_size):
-            acc = 0.0 + 0.0j
-            for q in range(row_ch.shape[0]):
-                acc += xc[row_ch[q]] * np.exp(
-                    -2j * np.pi * (((j - fft_size // 2) * row_pos[q]) % fft_size) / fft_size
-                )
-            spec[j] = acc.real**2 + acc.imag**2
-            if spec[j] > spec[best]:
-                best = j
-        delta = _log_parabola(spec[(best - 1) % fft_size], spec[best], spec[(best + 1) % fft_size])
-        # u = sin(az) cos(el) = 2 (k - N/2 + delta) / N
-        u = 2.0 * (best - fft_size // 2 + delta) / fft_size
-        e = 0.0
-        if elevation and upper.shape[0] > 0:
-            z = 0.0 + 0.0j
-            for q in range(upper.shape[0]):
-                z += xc[upper[q]] * np.conj(xc[lower[q]])
-            # sin(el) = arg(sum x_upper conj(x_lower)) / pi
-            e = np.arcsin(min(1.0, max(-1.0, np.angle(z) / np.pi)))
-        el[i] = e
-        az[i] = np.arcsin(min(1.0, max(-1.0, u / np.cos(e))))
+        az[i], el[i] = angles_of(
+            x[i], db, n_tx, n_rx, n_d, row_ch, row_pos, upper, lower, fft_size, elevation, spec
+        )
     return r_bin, d_bin, az, el
 
 
 @functools.lru_cache(maxsize=16)
-def _array_rows(radar: RadarConfig):
+def array_rows(radar: RadarConfig):
     row_ch, row_pos = azimuth_row(radar)
     upper, lower = elevation_pairs(radar)
     return (
@@ -934,7 +948,7 @@ def points_compiled(
         np.ascontiguousarray(channels, dtype=np.complex128),
         radar.n_tx,
         radar.n_rx,
-        *_array_rows(radar),
+        *array_rows(radar),
         settings.angle_fft_size,
         bool(elevation),
     )
