@@ -255,7 +255,7 @@ def _slow_time_kernel(
 
 @numba.njit(cache=True, nogil=True)
 def _signal_kernel(
-    rng, rd, amp, theta, slow, slow1, wd, b, s2, steer, slot, threshold, tw_r, tw_d, noise
+    rng, rd, amp, theta, slow, slow1, wd, b, s2, steer, slot, threshold, tw_r, tw_d, noise, k_max
 ):  # pragma: no cover
     """Patch cells, their noise-free channel values and their noisy channel sums.
 
@@ -263,7 +263,7 @@ def _signal_kernel(
     clutter removal), wd (M,) Doppler window, b (2J+1,) range
     window coefficients, s2 (M,) cell noise power, steer (N, L), slot (L,) TX slot of each
     channel, tw_r (N,) = exp(-j 2 pi k / N), tw_d (M, M) = exp(-j 2 pi (d - M/2) m / M). Writes the
-    patch cells' power into ``rd``.
+    patch cells' power into ``rd``; only range bins below ``k_max`` are looked at.
     """
     n_samples = tw_r.shape[0]
     n_s = amp.shape[0]
@@ -283,7 +283,7 @@ def _signal_kernel(
         e_n = np.exp(1j * theta[i] * nn)
         num = 1.0 - e_n
         e = np.exp(1j * theta[i])
-        for k in range(nn):
+        for k in range(k_max):
             acc = 0.0 + 0.0j
             acc1 = 0.0 + 0.0j
             for jj in range(-half, half + 1):
@@ -322,7 +322,7 @@ def _signal_kernel(
     cells_k = np.empty(nn * m, dtype=np.int64)
     cells_d = np.empty(nn * m, dtype=np.int64)
     n_c = 0
-    for k in range(nn):
+    for k in range(k_max):
         for d in range(m):
             lim = threshold * s2[d]
             for i in range(n_s):
@@ -339,6 +339,8 @@ def _signal_kernel(
         k = cells_k[c]
         d = cells_d[c]
         for i in range(n_s):
+            if pr[i, k] * pd[i, d] + pr1[i, k] * pd1[i, d] < 1e-6 * s2[d]:
+                continue  # below -60 dB of the noise: nothing to add
             for s in range(n_tx):
                 # first order in the beat tone's drift: R D + R1 D1
                 g[s] = rr[i, k] * dd[i, s, d] + rr1[i, k] * dd1[i, s, d]
@@ -403,8 +405,13 @@ def fast_spectrum(
     antenna: AntennaGain,
     settings: ProcessingSettings = DEFAULT_PROCESSING,
     noise: bool = True,
+    n_range_bins: int | None = None,
 ) -> Spectrum:
     """Range-Doppler map in closed form (see the module docstring).
+
+    ``n_range_bins``: only the first range bins are drawn (the CFAR never looks beyond its
+    range limit plus its training window, :func:`cfar_range_bins`); the rest of the map holds
+    the mean noise power. None: the whole map (for display).
 
     Circular complex Gaussian noise is invariant under rotations of ``C^L``: in a patch cell
     with signal vector ``s`` the channel sum ``sum_v |s_v + n_v|^2`` has the law of
@@ -414,10 +421,13 @@ def fast_spectrum(
     """
     n_r, n_d, n_v = radar.n_samples, radar.n_loops, radar.n_virtual
     s2 = cell_noise_power_v2(radar, settings)  # (n_d,)
+    n_use = n_r if n_range_bins is None else max(0, min(n_r, int(n_range_bins)))
     if noise:
         # noise-only cell: sum of L exponentials of mean s2[d] ~ s2[d] Gamma(L)
-        rd = rng.standard_gamma(float(n_v), (n_r, n_d), dtype=np.float32)
-        rd *= s2.astype(np.float32)[None, :]
+        rd = np.empty((n_r, n_d), dtype=np.float32)
+        rd[:n_use] = rng.standard_gamma(float(n_v), (n_use, n_d), dtype=np.float32)
+        rd[:n_use] *= s2.astype(np.float32)[None, :]
+        rd[n_use:] = (n_v * s2).astype(np.float32)[None, :]
     else:
         rd = np.zeros((n_r, n_d), dtype=np.float32)
     if len(scatterers) == 0:
@@ -448,6 +458,7 @@ def fast_spectrum(
         PATCH_THRESHOLD,
         *_twiddles(n_r, n_d),
         noise,
+        n_use,
     )
     return Spectrum(rd, np.column_stack((k_idx, d_idx)).astype(np.int64), x, along, ortho)
 
@@ -469,7 +480,15 @@ def simulate_frame_fast(
     docstring for the model. ``rng`` draws the noise (a different stream from the exact level's,
     so the same seed gives statistically equivalent, not identical, frames).
     """
-    spec = fast_spectrum(radar, scatterers, rng, antenna=antenna, settings=settings, noise=noise)
+    spec = fast_spectrum(
+        radar,
+        scatterers,
+        rng,
+        antenna=antenna,
+        settings=settings,
+        noise=noise,
+        n_range_bins=None if keep_rd_map else cfar_range_bins(radar, settings),
+    )
     rd = spec.rd_map
     det = two_stage_cfar_compiled(rd, radar, settings, independent_cells=True)
     if elevation is None:
@@ -782,6 +801,17 @@ def _cfar_arguments(
 
 
 @functools.lru_cache(maxsize=16)
+def cfar_range_bins(radar: RadarConfig, settings: ProcessingSettings) -> int:
+    """Range bins the two-stage CFAR reads: up to its range limit plus guard and training."""
+    k = np.arange(radar.n_samples) * radar.range_resolution_m
+    inside = np.flatnonzero((k >= settings.min_range_m) & (k <= settings.max_range_m))
+    if inside.size == 0:
+        return 0
+    margin = settings.range_cfar.n_train + settings.range_cfar.n_guard
+    return int(min(radar.n_samples, inside[-1] + 1 + margin))
+
+
+@functools.lru_cache(maxsize=16)
 def independent_cell_stages(
     settings: ProcessingSettings, n_channels: int, n_range_bins: int, n_doppler_bins: int
 ) -> tuple[CfarSettings, CfarSettings]:
@@ -851,14 +881,16 @@ def _log_parabola(a, b, c):  # pragma: no cover
 
 @numba.njit(cache=True, nogil=True)
 def angles_of(
-    x, db, n_tx, n_rx, n_loops, row_ch, row_pos, upper, lower, fft_size, elevation, spec
+    x, db, n_tx, n_rx, n_loops, row_ch, row_pos, upper, lower, tw_a, elevation, spec
 ):  # pragma: no cover
     """Azimuth and elevation of one cell's channel values ``x`` (L,), the chain's step 6.
 
     TDM-MIMO compensation with the (refined) Doppler bin ``db``, zero-padded DFT of the azimuth
     row, log-parabolic peak refinement, elevation from the elevated pairs. ``spec`` is a work
-    array of ``fft_size``.
+    array of ``fft_size``; ``tw_a`` ``(fft_size, n_row)`` the DFT's twiddles
+    ``exp(-j 2 pi (j - N/2) p / N)`` (:func:`angle_twiddles`).
     """
+    fft_size = tw_a.shape[0]
     n_v = x.shape[0]
     # x_v exp(-j 2 pi d k(v) / (Nc Ntx))
     xc = np.empty(n_v, dtype=np.complex128)
@@ -869,9 +901,7 @@ def angles_of(
     for j in range(fft_size):
         acc = 0.0 + 0.0j
         for q in range(row_ch.shape[0]):
-            acc += xc[row_ch[q]] * np.exp(
-                -2j * np.pi * (((j - fft_size // 2) * row_pos[q]) % fft_size) / fft_size
-            )
+            acc += xc[row_ch[q]] * tw_a[j, q]
         spec[j] = acc.real**2 + acc.imag**2
         if spec[j] > spec[best]:
             best = j
@@ -890,7 +920,7 @@ def angles_of(
 
 @numba.njit(cache=True, nogil=True)
 def _points_kernel(
-    rd, r, d, x, n_tx, n_rx, row_ch, row_pos, upper, lower, fft_size, elevation
+    rd, r, d, x, n_tx, n_rx, row_ch, row_pos, upper, lower, tw_a, elevation
 ):  # pragma: no cover
     n_r, n_d = rd.shape
     n_det = r.shape[0]
@@ -898,7 +928,7 @@ def _points_kernel(
     d_bin = np.empty(n_det)
     az = np.empty(n_det)
     el = np.zeros(n_det)
-    spec = np.empty(fft_size)
+    spec = np.empty(tw_a.shape[0])
     for i in range(n_det):
         ri, di = r[i], d[i]
         dr = 0.0
@@ -915,9 +945,19 @@ def _points_kernel(
         db = di - n_d // 2 + dd
         d_bin[i] = db
         az[i], el[i] = angles_of(
-            x[i], db, n_tx, n_rx, n_d, row_ch, row_pos, upper, lower, fft_size, elevation, spec
+            x[i], db, n_tx, n_rx, n_d, row_ch, row_pos, upper, lower, tw_a, elevation, spec
         )
     return r_bin, d_bin, az, el
+
+
+@functools.lru_cache(maxsize=16)
+def angle_twiddles(radar: RadarConfig, fft_size: int) -> np.ndarray:
+    """``exp(-j 2 pi (j - N/2) p / N)`` for the azimuth row, ``(fft_size, n_row)`` complex128."""
+    _, row_pos, _, _ = array_rows(radar)
+    j = np.arange(fft_size)[:, None] - fft_size // 2
+    out = np.exp(-2j * np.pi * ((j * row_pos[None, :]) % fft_size) / fft_size)
+    out.flags.writeable = False
+    return out
 
 
 @functools.lru_cache(maxsize=16)
@@ -949,7 +989,7 @@ def points_compiled(
         radar.n_tx,
         radar.n_rx,
         *array_rows(radar),
-        settings.angle_fft_size,
+        angle_twiddles(radar, settings.angle_fft_size),
         bool(elevation),
     )
     rng_m = r_bin * radar.range_resolution_m

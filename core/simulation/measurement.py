@@ -63,6 +63,7 @@ from core.processing.angle import log_parabolic_offset
 from core.processing.spectrum import window
 from core.simulation.antenna import AntennaGain
 from core.simulation.fast import (
+    angle_twiddles,
     angles_of,
     array_rows,
     cell_noise_power_v2,
@@ -364,7 +365,7 @@ def simulate_frame_measurement(
             tab.cell_noise,
             bool(noise),
             *const["array"],
-            settings.angle_fft_size,
+            angle_twiddles(radar, settings.angle_fft_size),
             bool(elevation),
         )
         el = el[det]
@@ -474,7 +475,7 @@ def _measure_kernel(
     row_pos,
     upper,
     lower,
-    fft_size,
+    tw_a,
     elevation,
 ):  # pragma: no cover
     """Steps 1-3 of the module docstring for every reflector; arrays ``(N,)``."""
@@ -491,7 +492,7 @@ def _measure_kernel(
     nu_step = n_loops / (doppler_gain.shape[0] - 1)
     n_v = az_pos.shape[0]
     xv = np.empty(n_v, dtype=np.complex128)
-    spec = np.empty(fft_size)
+    spec = np.empty(tw_a.shape[0])
     for i in range(n):
         px = pos[i, 0] + vel[i, 0] * t_mid
         py = pos[i, 1] + vel[i, 1] * t_mid
@@ -552,7 +553,7 @@ def _measure_kernel(
             if noise:
                 xv[v] += (rng.standard_normal() + 1j * rng.standard_normal()) / np.sqrt(2.0)
         a_i, e_i = angles_of(
-            xv, d_est, n_tx, n_rx, n_loops, row_ch, row_pos, upper, lower, fft_size, elevation, spec
+            xv, d_est, n_tx, n_rx, n_loops, row_ch, row_pos, upper, lower, tw_a, elevation, spec
         )
         u_est = np.sin(a_i) * np.cos(e_i)
         el_out[i] = e_i
