@@ -293,9 +293,10 @@ def _signal_kernel(
                     g = nn + 0.0j
                     g1 = 1j * nn * (nn - 1) / 2
                 else:
-                    g = num / den
+                    inv = 1.0 / den
+                    g = num * inv
                     # dG/dtheta = (-j N e^{j N theta} (1 - q) + (1 - e^{j N theta}) j q) / (1 - q)^2
-                    g1 = (-1j * nn * e_n * den + num * 1j * q) / (den * den)
+                    g1 = (-1j * nn * e_n * den + num * 1j * q) * (inv * inv)
                 acc += b[jj + half] * g
                 acc1 += b[jj + half] * g1
             rr[i, k] = amp[i] * acc
@@ -307,14 +308,19 @@ def _signal_kernel(
     dd1 = np.empty((n_s, n_tx, m), dtype=np.complex128)
     pd = np.zeros((n_s, m))
     pd1 = np.zeros((n_s, m))
+    ws = np.empty(m, dtype=np.complex128)
+    ws1 = np.empty(m, dtype=np.complex128)
     for i in range(n_s):
         for s in range(n_tx):
+            for t in range(m):
+                ws[t] = wd[t] * slow[i, s, t]
+                ws1[t] = wd[t] * slow1[i, s, t]
             for d in range(m):
                 acc = 0.0 + 0.0j
                 acc1 = 0.0 + 0.0j
                 for t in range(m):
-                    acc += wd[t] * slow[i, s, t] * tw_d[d, t]
-                    acc1 += wd[t] * slow1[i, s, t] * tw_d[d, t]
+                    acc += ws[t] * tw_d[d, t]
+                    acc1 += ws1[t] * tw_d[d, t]
                 dd[i, s, d] = acc
                 dd1[i, s, d] = acc1
                 pd[i, d] = max(pd[i, d], acc.real**2 + acc.imag**2)
