@@ -17,6 +17,7 @@ import functools
 import hashlib
 import importlib
 import json
+import multiprocessing
 import os
 import time
 from collections.abc import Callable, Iterator, Sequence
@@ -688,7 +689,11 @@ def build_dataset(
             if progress is not None:
                 progress(i + 1, len(tasks))
     else:
-        with ProcessPoolExecutor(max_workers=min(jobs, len(tasks))) as pool:
+        # workers fork from a single-threaded server that has imported the chain once: safe when
+        # the caller has threads (GUI, FFT pools: forking a threaded process can deadlock) and
+        # cheaper than "spawn", which imports the chain in every worker
+        ctx = _worker_context()
+        with ProcessPoolExecutor(max_workers=min(jobs, len(tasks)), mp_context=ctx) as pool:
             for i, r in enumerate(pool.map(_simulate_task, tasks)):
                 results.append(r)
                 if progress is not None:
@@ -697,6 +702,14 @@ def build_dataset(
     if cache_file is not None:
         ds.save(cache_file)
     return ds
+
+
+def _worker_context() -> multiprocessing.context.BaseContext:
+    if "forkserver" in multiprocessing.get_all_start_methods():
+        ctx = multiprocessing.get_context("forkserver")
+        ctx.set_forkserver_preload(["core.pipeline", "core.simulation"])
+        return ctx
+    return multiprocessing.get_context("spawn")
 
 
 def _assemble(
