@@ -237,6 +237,9 @@ def plan(
             "point clouds are simulated here",
         ),
     )  # fmt: skip
+    unknown = sorted(set(force) - {s.name for s in stages})
+    if unknown:
+        raise InputError(f"force: unknown stage(s) {unknown}")
     return Plan(stages=stages, fidelity=fidelity, consumer=consumer)
 
 

@@ -105,9 +105,13 @@ def test_stages_declare_consistent_needs_and_products() -> None:
         produced |= set(s.produces)
 
 
-def test_unknown_fidelity_is_an_input_error() -> None:
+def test_unknown_fidelity_consumer_or_stage_is_an_input_error() -> None:
     with pytest.raises(InputError, match="fidelity"):
         plan(short_scene(), fidelity="approximate")
+    with pytest.raises(InputError, match="consumer"):
+        plan(short_scene(), consumer="printer")
+    with pytest.raises(InputError, match="clutterr"):
+        plan(short_scene(), force=("clutterr",))
 
 
 # ---- skipped stages are not executed and change nothing --------------------------------------
