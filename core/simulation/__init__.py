@@ -8,13 +8,7 @@ from core.simulation.baseband import (
     synthesize_noise,
     synthesize_signal,
 )
-from core.simulation.frame import (
-    FrameOutput,
-    frame_from_spectrum,
-    needs_elevation,
-    processed_range_bins,
-    simulate_frame,
-)
+from core.simulation.frame import FrameOutput, needs_elevation, simulate_frame
 from core.simulation.link import (
     draw_person_rcs_dbsm,
     noise_power_v2,
@@ -33,11 +27,9 @@ __all__ = [
     "Scatterers",
     "chirp_ranges_m",
     "draw_person_rcs_dbsm",
-    "frame_from_spectrum",
     "needs_elevation",
     "noise_power_v2",
     "post_processing_snr_db",
-    "processed_range_bins",
     "processing_gain_db",
     "rcs_for_snr_db",
     "received_power_w",
