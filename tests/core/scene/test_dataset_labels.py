@@ -65,6 +65,23 @@ def test_clutter_points_per_frame_match_lambda_area(paper_subset: Dataset) -> No
     assert np.abs(vr).min() >= 1.0 * 0.4526
 
 
+def test_false_points_per_frame_match_the_tracker_clutter_density(paper_subset: Dataset) -> None:
+    """ρ·V (clutter reflectors + the chain's noise detections) against the points that are not
+    the person in the simulated set."""
+    from core.pipeline import scene_clutter_density
+    from core.scene import paper_scenes
+
+    scene = paper_scenes(0, 1)[0]
+    aoi = scene.aoi
+    volume = (
+        (aoi.max_range_m - aoi.min_range_m) * 2 * aoi.max_azimuth_rad * 2
+        * scene.radar.max_velocity_mps
+    )  # fmt: skip
+    expected = scene_clutter_density(scene) * volume  # ≈ 2.29 per frame
+    measured = np.sum(paper_subset.source != 0) / paper_subset.n_frames
+    assert measured == pytest.approx(expected, rel=0.10)
+
+
 def test_a_trajectory_of_the_set_re_simulates_alone(paper_subset: Dataset) -> None:
     from core.pipeline import iter_frames
     from core.scene import paper_scenes
