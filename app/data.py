@@ -1,0 +1,143 @@
+"""Frozen, Qt-free snapshots that workers hand to the GUI thread.
+
+Views only draw these; they never compute physics or tracking. All arrays are numpy, SI units,
+and the x-y plane is the radar's (x to the right, y along boresight).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from core.pointcloud import PointCloud
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class FrameData:
+    """One simulated radar frame as the GUI needs it.
+
+    Attributes
+    ----------
+    index
+        Frame index within the scene (0-based).
+    t_s
+        Frame time in s.
+    cloud
+        The frame's point cloud (with the ground-truth ``source`` label).
+    truth_xy_m
+        Person positions, shape ``(n_persons, 2)`` in m (NaN where a person has no position).
+    rd_map_db
+        Range-Doppler map in dB, shape ``(n_range_bins, n_doppler_bins)``, zero velocity
+        centred, or ``None`` when maps were not kept.
+    detections
+        CFAR detections, shape ``(n_det, 2)`` int: range bin, Doppler bin index into the map.
+    """
+
+    index: int
+    t_s: float
+    cloud: PointCloud
+    truth_xy_m: np.ndarray
+    rd_map_db: np.ndarray | None = None
+    detections: np.ndarray = field(default_factory=lambda: np.zeros((0, 2), dtype=np.int64))
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class TrackFrame:
+    """Every live track at one frame (n tracks).
+
+    Attributes
+    ----------
+    track_id
+        ``(n,)`` int, unique over the run.
+    xy_m
+        ``(n, 2)`` estimated position in m.
+    cov_xy_m2
+        ``(n, 2, 2)`` position covariance in m² (for the gate ellipse).
+    psi
+        ``(n,)`` existence probability ψ in [0, 1].
+    confirmed
+        ``(n,)`` bool, True once the track is confirmed.
+    """
+
+    track_id: np.ndarray
+    xy_m: np.ndarray
+    cov_xy_m2: np.ndarray
+    psi: np.ndarray
+    confirmed: np.ndarray
+
+    @classmethod
+    def empty(cls) -> TrackFrame:
+        return cls(
+            track_id=np.zeros(0, dtype=np.int64),
+            xy_m=np.zeros((0, 2)),
+            cov_xy_m2=np.zeros((0, 2, 2)),
+            psi=np.zeros(0),
+            confirmed=np.zeros(0, dtype=bool),
+        )
+
+    def __len__(self) -> int:
+        return len(self.track_id)
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class TrackingResult:
+    """A tracker run over the cached frames, prepared for drawing.
+
+    Attributes
+    ----------
+    frames
+        One :class:`TrackFrame` per tracked frame (length F).
+    estimate_xy_m
+        ``(F, 2)`` the scene estimate (confirmed track with the highest ψ), NaN when none.
+    truth_xy_m
+        ``(F, 2)`` position of person 0 in m (the paper's single-person loss).
+    running_loss
+        ``(F,)`` eq. (13) over frames ``0..k``: L = MSE / N_c (1.0 m² while N_c = 0).
+    running_rmse_m
+        ``(F,)`` position RMSE over the frames with an estimate so far (NaN while none).
+    ospa_m
+        ``(F,)`` OSPA distance (c = 1 m, p = 2) between confirmed tracks and persons per frame.
+    psi_curves
+        ``(t_s, psi, confirmed)``: per track, NaN-separated, for the ψ time plot; arrays of
+        equal length.
+    params_key
+        Identifies the parameter vector the run used (drop stale results).
+    elapsed_s
+        Wall-clock time of the tracker run plus preparation, in s.
+    """
+
+    frames: tuple[TrackFrame, ...]
+    estimate_xy_m: np.ndarray
+    truth_xy_m: np.ndarray
+    running_loss: np.ndarray
+    running_rmse_m: np.ndarray
+    ospa_m: np.ndarray
+    psi_t_s: np.ndarray
+    psi_value: np.ndarray
+    psi_confirmed_t_s: np.ndarray
+    psi_confirmed_value: np.ndarray
+    trail_t_index: np.ndarray
+    trail_xy_m: np.ndarray
+    trail_id: np.ndarray
+    params_key: str = ""
+    elapsed_s: float = 0.0
+
+    @property
+    def n_frames(self) -> int:
+        return len(self.frames)
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class ParamSpec:
+    """One slider: a tracker parameter with its search-space range.
+
+    ``name`` uses the search-space naming (``q_coeff``, ``p0_00`` …); ``log`` selects a
+    logarithmic slider.
+    """
+
+    name: str
+    low: float
+    high: float
+    log: bool
+    label: str = ""
