@@ -52,8 +52,10 @@ class TrackFrame:
         ``(n,)`` int, unique over the run.
     xy_m
         ``(n, 2)`` estimated position in m.
-    cov_xy_m2
-        ``(n, 2, 2)`` position covariance in m² (for the gate ellipse).
+    gate_center_xy_m
+        ``(n, 2)`` centre of the gate in x-y (the predicted position), m.
+    gate_shape_xy_m2
+        ``(n, 2, 2)`` gate ellipse G in x-y: the points d with dᵀ G⁻¹ d ≤ 1 (γ included), m².
     psi
         ``(n,)`` existence probability ψ in [0, 1].
     confirmed
@@ -62,7 +64,8 @@ class TrackFrame:
 
     track_id: np.ndarray
     xy_m: np.ndarray
-    cov_xy_m2: np.ndarray
+    gate_center_xy_m: np.ndarray
+    gate_shape_xy_m2: np.ndarray
     psi: np.ndarray
     confirmed: np.ndarray
 
@@ -71,7 +74,8 @@ class TrackFrame:
         return cls(
             track_id=np.zeros(0, dtype=np.int64),
             xy_m=np.zeros((0, 2)),
-            cov_xy_m2=np.zeros((0, 2, 2)),
+            gate_center_xy_m=np.zeros((0, 2)),
+            gate_shape_xy_m2=np.zeros((0, 2, 2)),
             psi=np.zeros(0),
             confirmed=np.zeros(0, dtype=bool),
         )
@@ -98,9 +102,12 @@ class TrackingResult:
         ``(F,)`` position RMSE over the frames with an estimate so far (NaN while none).
     ospa_m
         ``(F,)`` OSPA distance (c = 1 m, p = 2) between confirmed tracks and persons per frame.
-    psi_curves
-        ``(t_s, psi, confirmed)``: per track, NaN-separated, for the ψ time plot; arrays of
-        equal length.
+    psi_t_s, psi_value
+        ψ of every track against time, one NaN-separated curve (tracks in id order).
+    psi_confirmed_t_s, psi_confirmed_value
+        The same restricted to frames where the track is confirmed.
+    trail_id, trail_t_index, trail_xy_m
+        Position of every track at every frame it lived, sorted by (id, frame).
     params_key
         Identifies the parameter vector the run used (drop stale results).
     elapsed_s

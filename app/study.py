@@ -24,10 +24,11 @@ class StudyForm:
     model: str = "cv"
     n_trials: int = 50
     n_jobs: int = 1
-    storage: str = "radartune-study.sqlite3"
+    storage: str = "radartune-studies.db"
     study_name: str = ""
-    n_trajectories: int = 35
     seed: int = 0
+    #: "scene": the current scene's cached point clouds; "paper": the paper's 35 trajectories
+    dataset: str = "scene"
 
     def __post_init__(self) -> None:
         if self.model not in ("cv", "ca"):
@@ -38,8 +39,8 @@ class StudyForm:
             raise InputError(f"jobs must be >= 1, got {self.n_jobs}", "jobs")
         if not self.storage.strip():
             raise InputError("storage must not be empty", "storage")
-        if self.n_trajectories < 1:
-            raise InputError(f"trajectories must be >= 1, got {self.n_trajectories}", "trajectories")
+        if self.dataset not in ("scene", "paper"):
+            raise InputError(f"data set must be 'scene' or 'paper', got {self.dataset!r}", "dataset")
 
     @property
     def effective_name(self) -> str:
@@ -97,6 +98,22 @@ class StudyModel(QtCore.QObject):
 class _PollSignals(QtCore.QObject):
     done = QtCore.Signal(int, object)
     failed = QtCore.Signal(int, str)
+    started = QtCore.Signal(object)
+    start_failed = QtCore.Signal(str)
+
+
+class _StartJob(QtCore.QRunnable):
+    def __init__(self, engine, form, dataset_path, signals) -> None:
+        super().__init__()
+        self._engine, self._form, self._path, self._signals = engine, form, dataset_path, signals
+
+    def run(self) -> None:
+        try:
+            handle = self._engine.start_study(self._form, self._path)
+            self._signals.started.emit(handle)
+        except Exception as exc:
+            traceback.print_exc()
+            self._signals.start_failed.emit(describe_error(exc))
 
 
 class _PollJob(QtCore.QRunnable):
@@ -117,6 +134,7 @@ class StudyController(QtCore.QObject):
     """Starts and stops study processes and polls their progress (never blocking the GUI)."""
 
     finished = QtCore.Signal()
+    start_failed = QtCore.Signal(str)
 
     def __init__(self, engine, model: StudyModel, poll_ms: int = 500, parent=None) -> None:
         super().__init__(parent)
@@ -128,6 +146,9 @@ class StudyController(QtCore.QObject):
         self._signals = _PollSignals()
         self._signals.done.connect(self._on_progress)
         self._signals.failed.connect(self._on_poll_failed)
+        self._signals.started.connect(self._on_started)
+        self._signals.start_failed.connect(self._on_start_failed)
+        self._starting = False
         self._timer = QtCore.QTimer(self)
         self._timer.setInterval(poll_ms)
         self._timer.timeout.connect(self._poll)
@@ -137,26 +158,47 @@ class StudyController(QtCore.QObject):
         self.dashboard_url: str | None = None
         self._dashboard = None
         self.t_started = 0.0
+        self._stop_requested = False
 
     @property
     def running(self) -> bool:
-        return self._handle is not None
+        return self._handle is not None or self._starting
 
-    def start(self) -> None:
-        if self._handle is not None:
+    def start(self, dataset_path: str | None = None) -> None:
+        """Create the study and start its processes from a pool thread (Optuna's import and
+        the study creation take seconds; the window keeps running)."""
+        if self.running:
             raise InputError("a study is already running", "study")
         form = self._model.form
-        Path(form.storage).expanduser().parent.mkdir(parents=True, exist_ok=True)
-        self._handle = self._engine.start_study(form)
-        self.t_started = time.perf_counter()
+        Path(form.storage).expanduser().resolve().parent.mkdir(parents=True, exist_ok=True)
+        self._starting = True
+        self._stop_requested = False
         self._model.set_running(True)
+        self._model.message.emit(f"starting study {form.effective_name} …")
+        self._pool.start(_StartJob(self._engine, form, dataset_path, self._signals))
+
+    def _on_started(self, handle) -> None:
+        self._starting = False
+        self._handle = handle
+        self.t_started = time.perf_counter()
+        form = self._model.form
         self._model.message.emit(f"study {form.effective_name} started ({form.n_jobs} process(es))")
+        if self._stop_requested:
+            self._handle.stop()
         self._timer.start()
+
+    def _on_start_failed(self, message: str) -> None:
+        self._starting = False
+        self._model.set_running(False)
+        self._model.message.emit(f"cannot start study: {message}")
+        self.start_failed.emit(message)
 
     def stop(self) -> None:
         if self._handle is not None:
             self._handle.stop()
             self._model.message.emit("stopping study …")
+        elif self._starting:
+            self._stop_requested = True
 
     def _poll(self) -> None:
         if self._handle is not None and not self._handle.alive():
@@ -205,6 +247,8 @@ class StudyController(QtCore.QObject):
 
     def shutdown(self, timeout_ms: int = 10000) -> None:
         self._timer.stop()
+        self._pool.waitForDone(timeout_ms)  # a start in flight delivers its handle first
+        QtCore.QCoreApplication.sendPostedEvents(self)
         if self._handle is not None:
             self._handle.stop()
             self._handle.join(timeout_ms / 1000)

@@ -271,9 +271,16 @@ class ScenePanel(QtWidgets.QWidget):
             "class": self.class_combo.currentData(),
             "seed": int(self.person_seed.value() if seed is None else seed),
         }
-        for name, spin in self.class_params.items():
-            if spin.value() > spin.minimum():
-                traj[name] = round(spin.value(), spin.decimals())
+        allowed = self.engine.class_param_names(traj["class"])
+        values = {
+            name: round(spin.value(), spin.decimals())
+            for name, spin in self.class_params.items()
+            if spin.value() > spin.minimum() and name in allowed
+        }
+        sx, sy = values.pop("start_x_m", None), values.pop("start_y_m", None)
+        if sx is not None and sy is not None:
+            values["start_m"] = [sx, sy]
+        traj.update(values)
         return traj
 
     def _on_class_edit(self, *_args) -> None:
@@ -399,8 +406,13 @@ class ScenePanel(QtWidgets.QWidget):
                 self.stack.setCurrentIndex(0)
                 self.class_combo.setCurrentIndex(max(0, list(CLASS_NAMES).index(t["class"])))
                 self.person_seed.setValue(int(t.get("seed", 0)))
+                allowed = self.engine.class_param_names(t["class"])
+                values = dict(t)
+                if "start_m" in t:
+                    values["start_x_m"], values["start_y_m"] = t["start_m"]
                 for name, spin in self.class_params.items():
-                    spin.setValue(float(t[name]) if name in t else spin.minimum())
+                    spin.setValue(float(values[name]) if name in values else spin.minimum())
+                    spin.setEnabled(name in allowed)
             elif "waypoints" in t:
                 self.stack.setCurrentIndex(1)
                 self.waypoints.set_rows(t["waypoints"])

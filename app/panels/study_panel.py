@@ -39,10 +39,10 @@ class StudyPanel(QtWidgets.QWidget):
         self.jobs = QtWidgets.QSpinBox()
         self.jobs.setObjectName("studyJobs")
         self.jobs.setRange(1, 64)
-        self.trajectories = QtWidgets.QSpinBox()
-        self.trajectories.setObjectName("studyTrajectories")
-        self.trajectories.setRange(1, 1000)
-        self.trajectories.setToolTip("paper data set: 35 trajectories, 7 per class")
+        self.dataset = QtWidgets.QComboBox()
+        self.dataset.setObjectName("studyDataset")
+        self.dataset.addItem("current scene (cached point clouds)", "scene")
+        self.dataset.addItem("paper data set (35 trajectories)", "paper")
         storage_row = QtWidgets.QHBoxLayout()
         self.storage = QtWidgets.QLineEdit()
         self.storage.setObjectName("studyStorage")
@@ -51,12 +51,12 @@ class StudyPanel(QtWidgets.QWidget):
         self.browse.setText("…")
         storage_row.addWidget(self.storage, 1)
         storage_row.addWidget(self.browse)
-        for w in (self.trials, self.jobs, self.trajectories):
+        for w in (self.trials, self.jobs):
             w.setKeyboardTracking(False)
         form.addRow("motion model", self.model_combo)
         form.addRow("trials", self.trials)
         form.addRow("processes", self.jobs)
-        form.addRow("trajectories", self.trajectories)
+        form.addRow("data set", self.dataset)
         form.addRow("storage", storage_row)
         outer.addWidget(form_box)
 
@@ -111,7 +111,9 @@ class StudyPanel(QtWidgets.QWidget):
         )
         self.trials.valueChanged.connect(lambda v: self._set(n_trials=int(v)))
         self.jobs.valueChanged.connect(lambda v: self._set(n_jobs=int(v)))
-        self.trajectories.valueChanged.connect(lambda v: self._set(n_trajectories=int(v)))
+        self.dataset.currentIndexChanged.connect(
+            lambda i: self._set(dataset=self.dataset.itemData(i))
+        )
         self.storage.editingFinished.connect(lambda: self._set(storage=self.storage.text().strip()))
         self.browse.clicked.connect(self.browse_requested)
         self.start_button.clicked.connect(self.start_requested)
@@ -134,19 +136,19 @@ class StudyPanel(QtWidgets.QWidget):
 
     def sync(self) -> None:
         f = self.model.form
-        widgets = (self.model_combo, self.trials, self.jobs, self.trajectories, self.storage)
+        widgets = (self.model_combo, self.trials, self.jobs, self.dataset, self.storage)
         for w in widgets:
             w.blockSignals(True)
         self.model_combo.setCurrentIndex(0 if f.model == "cv" else 1)
         self.trials.setValue(f.n_trials)
         self.jobs.setValue(f.n_jobs)
-        self.trajectories.setValue(f.n_trajectories)
+        self.dataset.setCurrentIndex(self.dataset.findData(f.dataset))
         if self.storage.text() != f.storage:
             self.storage.setText(f.storage)
         for w in widgets:
             w.blockSignals(False)
         running = self.model.running
-        for w in (self.model_combo, self.trials, self.jobs, self.trajectories, self.storage):
+        for w in (self.model_combo, self.trials, self.jobs, self.dataset, self.storage):
             w.setEnabled(not running)
         self.start_button.setEnabled(not running)
         self.stop_button.setEnabled(running)

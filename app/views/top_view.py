@@ -13,7 +13,7 @@ import pyqtgraph as pg
 from PySide6 import QtCore, QtGui
 
 from app.data import FrameData, TrackFrame, TrackingResult
-from app.geometry import aoi_polyline, chi2_2dof_quantile, ellipse_polyline, trails_polyline
+from app.geometry import aoi_polyline, ellipse_polyline, trails_polyline
 
 SNR_MIN_DB = 10.0
 SNR_MAX_DB = 50.0
@@ -35,7 +35,14 @@ def _psi_palette(rgb: tuple[int, int, int]) -> list[QtGui.QBrush]:
 
 
 class TopView(pg.PlotWidget):
-    """x-y plot of one frame; call :meth:`show_frame`."""
+    """x-y plot of one frame; call :meth:`show_frame`.
+
+    Also the waypoint editor: in draw mode a click appends a waypoint (``waypoint_added``);
+    waypoints are draggable (``waypoints_moved`` with all rows ``[x_m, y_m, speed_mps]``).
+    """
+
+    waypoint_added = QtCore.Signal(float, float)
+    waypoints_moved = QtCore.Signal(list)
 
     def __init__(self, parent=None) -> None:
         super().__init__(parent)
@@ -81,11 +88,17 @@ class TopView(pg.PlotWidget):
         )
         self.addItem(self.estimate)
         self._labels: list[pg.TextItem] = []
+        self.waypoint_line = self.plot(
+            pen=pg.mkPen((255, 0, 255), width=1, style=QtCore.Qt.DashLine), symbol=None
+        )
+        self._waypoint_items: list[pg.TargetItem] = []
+        self._waypoint_rows: list[list[float]] = []
+        self.draw_mode = False
+        self.scene().sigMouseClicked.connect(self._on_click)
 
         self.colour_by = "snr"  # or "label"
         self.persistence = 5
         self.trail_length = 25
-        self.p_g = 0.99
         self.n_draws = 0
         self.last_n_points = 0
         self.last_n_tracks = 0
@@ -111,6 +124,44 @@ class TopView(pg.PlotWidget):
             parts.append(np.full((1, 2), np.nan))
         line = np.vstack(parts) if parts else np.zeros((0, 2))
         self.truth_path.setData(line[:, 0], line[:, 1], connect="finite")
+
+    # ---- waypoint editor ---------------------------------------------------------------------
+    def set_draw_mode(self, on: bool) -> None:
+        self.draw_mode = bool(on)
+        self.setCursor(QtCore.Qt.CrossCursor if on else QtCore.Qt.ArrowCursor)
+
+    def set_waypoints(self, rows) -> None:
+        """Show the selected person's waypoints (``None``: not a drawn trajectory)."""
+        rows = [list(map(float, r)) for r in (rows or [])]
+        self._waypoint_rows = rows
+        while len(self._waypoint_items) > len(rows):
+            self.removeItem(self._waypoint_items.pop())
+        while len(self._waypoint_items) < len(rows):
+            item = pg.TargetItem(
+                pos=(0.0, 0.0), size=12, movable=True, pen=pg.mkPen((255, 0, 255), width=2)
+            )
+            item.sigPositionChangeFinished.connect(self._on_waypoint_dragged)
+            self.addItem(item)
+            self._waypoint_items.append(item)
+        for item, (x, y, _v) in zip(self._waypoint_items, rows):
+            item.blockSignals(True)
+            item.setPos(x, y)
+            item.blockSignals(False)
+        xy = np.array([r[:2] for r in rows]).reshape(-1, 2)
+        self.waypoint_line.setData(xy[:, 0], xy[:, 1])
+
+    def _on_waypoint_dragged(self, *_args) -> None:
+        rows = []
+        for item, row in zip(self._waypoint_items, self._waypoint_rows):
+            p = item.pos()
+            rows.append([round(p.x(), 3), round(p.y(), 3), row[2]])
+        self.waypoints_moved.emit(rows)
+
+    def _on_click(self, event) -> None:
+        if not self.draw_mode or event.button() != QtCore.Qt.LeftButton:
+            return
+        p = self.getPlotItem().vb.mapSceneToView(event.scenePos())
+        self.waypoint_added.emit(float(p.x()), float(p.y()))
 
     # ---- per frame ----------------------------------------------------------------------------
     def _point_brushes(self, frames: Sequence[FrameData]) -> tuple[np.ndarray, np.ndarray, list]:
@@ -185,11 +236,11 @@ class TopView(pg.PlotWidget):
         ]
         symbols = ["o" if c else "t" for c in tf.confirmed]
         self.tracks.setData(x=tf.xy_m[:, 0], y=tf.xy_m[:, 1], brush=brushes, symbol=symbols)
-        gamma = chi2_2dof_quantile(self.p_g)
         conf = tf.confirmed
-        e = ellipse_polyline(tf.xy_m[conf], tf.cov_xy_m2[conf], gamma)
+        c, g = tf.gate_center_xy_m, tf.gate_shape_xy_m2
+        e = ellipse_polyline(c[conf], g[conf], 1.0)
         self.gates_confirmed.setData(e[:, 0], e[:, 1], connect="finite")
-        e = ellipse_polyline(tf.xy_m[~conf], tf.cov_xy_m2[~conf], gamma)
+        e = ellipse_polyline(c[~conf], g[~conf], 1.0)
         self.gates_tentative.setData(e[:, 0], e[:, 1], connect="finite")
         if tracking is not None:
             t = trails_polyline(
