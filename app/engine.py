@@ -134,7 +134,13 @@ def class_param_specs() -> list[ClassParamSpec]:
             continue
         out.append(
             ClassParamSpec(
-                name=name, label=label, unit=unit, low=lo, high=hi, step=step, decimals=dec,
+                name=name,
+                label=label,
+                unit=unit,
+                low=lo,
+                high=hi,
+                step=step,
+                decimals=dec,
                 help=help_,
             )
         )
@@ -212,61 +218,137 @@ def make_params(model: str, values: dict[str, float], extra: dict | None = None)
 
 
 # ---- simulation -------------------------------------------------------------------------------
-def simulate(scene, *, keep_rd_maps: bool = True) -> Iterator[FrameData]:
-    """Simulate the scene frame by frame (radar chain of :mod:`core`), yielding snapshots."""
+def simulate(scene, *, fidelity: str = "exact") -> Iterator[FrameData]:
+    """Simulate the scene frame by frame through the radar chain (GUI plan: range-Doppler
+    maps kept), yielding snapshots as they are ready."""
     from core import pipeline
 
-    _, truth_xy, _ = scene.truth()
-    for k, out in pipeline.iter_frames(scene, keep_rd_maps=keep_rd_maps):
+    the_plan = pipeline.plan(scene, fidelity=fidelity, consumer="gui")
+    for fr in pipeline.iter_frames(scene, the_plan=the_plan):
         yield FrameData(
-            index=k,
-            t_s=k * scene.radar.frame_period_s,
-            cloud=out.point_cloud,
-            truth_xy_m=truth_xy[k],
-            rd_map_db=out.rd_map_db,
-            detections=np.asarray(out.detections).reshape(-1, 2),
+            index=fr.index,
+            t_s=fr.t_s,
+            cloud=fr.point_cloud,
+            truth_xy_m=np.asarray(fr.truth_xy_m, dtype=float).reshape(-1, 2),
+            rd_map_db=fr.rd_map_db,
+            detections=np.asarray(fr.detections).reshape(-1, 2),
         )
 
 
 # ---- tracking ---------------------------------------------------------------------------------
+def _truth0(frames: Sequence[FrameData]) -> np.ndarray:
+    return np.array(
+        [f.truth_xy_m[0] if len(f.truth_xy_m) else (np.nan, np.nan) for f in frames], dtype=float
+    ).reshape(-1, 2)
+
+
+def _ospa_per_frame(frames: Sequence[FrameData], confirmed_xy: Sequence[np.ndarray]) -> np.ndarray:
+    """OSPA (c = 1 m, p = 2) between confirmed tracks and the persons present, per frame."""
+    from core.evaluation import ospa
+
+    out = np.zeros(len(frames))
+    for k, (f, xy) in enumerate(zip(frames, confirmed_xy)):
+        truth = f.truth_xy_m[np.isfinite(f.truth_xy_m).all(axis=1)]
+        out[k] = ospa(xy, truth)
+    return out
+
+
+def track_fast(
+    frames: Sequence[FrameData], params, frame_period_s: float, *, key: str = ""
+) -> TrackingResult:
+    """First stage of a re-track: the compiled kernel (the same algorithm as the study's).
+
+    Gives the estimate, the confirmed track positions and all metrics in milliseconds; track
+    ids, ψ of every track and gates follow from :func:`track` (``detail=True``).
+    """
+    from core.tracking.kernel import track_frames
+
+    t0 = time.perf_counter()
+    counts = np.array([len(f.cloud) for f in frames], dtype=np.int64)
+    z = (
+        np.concatenate([f.cloud.measurements() for f in frames])
+        if len(frames)
+        else np.zeros((0, 3))
+    )
+    f_off = np.concatenate(([0], np.cumsum(counts))).astype(np.int64)
+    t_off = np.array([0, len(frames)], dtype=np.int64)
+    out = track_frames(z, f_off, t_off, np.array([0]), params, frame_period_s)
+    est_xy, has, est_psi, conf_xy, n_conf = out[0], out[1], out[2], out[3], out[4]
+    tfs, conf_list = [], []
+    for k in range(len(frames)):
+        xy = np.asarray(conf_xy[k, : n_conf[k]], dtype=float).reshape(-1, 2)
+        conf_list.append(xy)
+        n = len(xy)
+        tfs.append(
+            TrackFrame(
+                track_id=np.full(n, -1, dtype=np.int64),
+                xy_m=xy,
+                gate_center_xy_m=xy,
+                gate_shape_xy_m2=np.zeros((n, 2, 2)),
+                psi=np.full(n, np.nan),
+                confirmed=np.ones(n, dtype=bool),
+            )
+        )
+    has = np.asarray(has, dtype=bool)
+    est = np.where(has[:, None], est_xy, np.nan)
+    truth0 = _truth0(frames)
+    loss, rmse = running_loss(est, has, truth0)
+    t_idx = np.flatnonzero(has)
+    t_s = np.arange(len(frames)) * frame_period_s
+    return TrackingResult(
+        frames=tuple(tfs),
+        estimate_xy_m=est,
+        truth_xy_m=truth0,
+        running_loss=loss,
+        running_rmse_m=rmse,
+        ospa_m=_ospa_per_frame(frames, conf_list),
+        psi_t_s=np.zeros(0),
+        psi_value=np.zeros(0),
+        psi_confirmed_t_s=t_s,
+        psi_confirmed_value=np.where(has, est_psi, np.nan),
+        trail_t_index=t_idx,
+        trail_xy_m=est[t_idx],
+        trail_id=np.full(len(t_idx), -1, dtype=np.int64),
+        params_key=key,
+        elapsed_s=time.perf_counter() - t0,
+        detail=False,
+    )
+
+
 def track(
     frames: Sequence[FrameData], params, frame_period_s: float, *, key: str = ""
 ) -> TrackingResult:
-    """Run the tracker on the cached point clouds and prepare everything the overlay draws.
+    """Run the readable tracker on the cached point clouds, keeping every track of every
+    frame, and prepare everything the overlay draws.
 
     The loss follows eqs. (12)–(13) against person 0 (the paper's single-person scenes).
     """
-    from core.evaluation import ospa
     from core.tracking import run_tracker
 
     t0 = time.perf_counter()
     z = [f.cloud.measurements() for f in frames]
     res = run_tracker(z, params, frame_period_s, keep_tracks=True)
-    n_f = len(frames)
-    tfs = []
+    tfs, conf_list = [], []
     ids_l, t_l, xy_l, psi_l, conf_l = [], [], [], [], []
-    ospa_m = np.zeros(n_f)
     for k, ft in enumerate(res.frames):
-        xy = np.asarray(ft.state)[:, :2]
+        xy = np.asarray(ft.state, dtype=float)[:, :2].reshape(-1, 2)
+        confirmed = np.asarray(ft.confirmed, dtype=bool)
         tfs.append(
             TrackFrame(
-                track_id=np.asarray(ft.ids),
+                track_id=np.asarray(ft.ids, dtype=np.int64),
                 xy_m=xy,
-                gate_center_xy_m=np.asarray(ft.gate_center_xy),
-                gate_shape_xy_m2=np.asarray(ft.gate_shape_xy),
-                psi=np.asarray(ft.psi),
-                confirmed=np.asarray(ft.confirmed, dtype=bool),
+                gate_center_xy_m=np.asarray(ft.gate_center_xy, dtype=float).reshape(-1, 2),
+                gate_shape_xy_m2=np.asarray(ft.gate_shape_xy, dtype=float).reshape(-1, 2, 2),
+                psi=np.asarray(ft.psi, dtype=float),
+                confirmed=confirmed,
             )
         )
-        n = len(ft.ids)
-        ids_l.append(np.asarray(ft.ids))
-        t_l.append(np.full(n, k))
+        conf_list.append(xy[confirmed])
+        ids_l.append(np.asarray(ft.ids, dtype=np.int64))
+        t_l.append(np.full(len(ft.ids), k, dtype=np.int64))
         xy_l.append(xy)
-        psi_l.append(np.asarray(ft.psi))
-        conf_l.append(np.asarray(ft.confirmed, dtype=bool))
-        truth = frames[k].truth_xy_m
-        truth = truth[np.isfinite(truth).all(axis=1)]
-        ospa_m[k] = ospa(xy[np.asarray(ft.confirmed, dtype=bool)], truth)
+        psi_l.append(np.asarray(ft.psi, dtype=float))
+        conf_l.append(confirmed)
     ids = np.concatenate(ids_l) if ids_l else np.zeros(0, dtype=np.int64)
     t_idx = np.concatenate(t_l) if t_l else np.zeros(0, dtype=np.int64)
     xy_all = np.concatenate(xy_l) if xy_l else np.zeros((0, 2))
@@ -275,20 +357,20 @@ def track(
     order = np.lexsort((t_idx, ids))
     ids, t_idx, xy_all, psi, conf = ids[order], t_idx[order], xy_all[order], psi[order], conf[order]
     breaks = np.flatnonzero(np.diff(ids)) + 1
-    t_s = t_idx * frame_period_s
-    psi_t = np.insert(t_s.astype(float), breaks, np.nan)
+    psi_t = np.insert(t_idx * frame_period_s, breaks, np.nan)
     psi_v = np.insert(psi, breaks, np.nan)
     psi_c = np.insert(np.where(conf, psi, np.nan), breaks, np.nan)
-
-    truth0 = np.array([f.truth_xy_m[0] if len(f.truth_xy_m) else (np.nan, np.nan) for f in frames])
-    loss, rmse = running_loss(np.asarray(res.estimate_xy), np.asarray(res.has_estimate), truth0)
+    has = np.asarray(res.has_estimate, dtype=bool)
+    est = np.where(has[:, None], np.asarray(res.estimate_xy, dtype=float), np.nan)
+    truth0 = _truth0(frames)
+    loss, rmse = running_loss(est, has, truth0)
     return TrackingResult(
         frames=tuple(tfs),
-        estimate_xy_m=np.where(np.asarray(res.has_estimate)[:, None], res.estimate_xy, np.nan),
+        estimate_xy_m=est,
         truth_xy_m=truth0,
         running_loss=loss,
         running_rmse_m=rmse,
-        ospa_m=ospa_m,
+        ospa_m=_ospa_per_frame(frames, conf_list),
         psi_t_s=psi_t,
         psi_value=psi_v,
         psi_confirmed_t_s=psi_t,
@@ -298,6 +380,7 @@ def track(
         trail_id=ids,
         params_key=key,
         elapsed_s=time.perf_counter() - t0,
+        detail=True,
     )
 
 
@@ -442,7 +525,9 @@ def study_progress(form):
 def enqueue_trial(form, values: dict[str, float], model: str) -> None:
     from core.optimization import enqueue_params, tracker_params_dict
 
-    enqueue_params(storage_url(form.storage), form.effective_name, tracker_params_dict(values, model))
+    enqueue_params(
+        storage_url(form.storage), form.effective_name, tracker_params_dict(values, model)
+    )
 
 
 class Dashboard:
@@ -496,6 +581,7 @@ class Engine:
     make_params = staticmethod(make_params)
     simulate = staticmethod(simulate)
     track = staticmethod(track)
+    track_fast = staticmethod(track_fast)
     read_ti_cfg = staticmethod(read_ti_cfg)
     scene_dataset = staticmethod(scene_dataset)
     start_study = staticmethod(start_study)

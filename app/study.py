@@ -40,7 +40,9 @@ class StudyForm:
         if not self.storage.strip():
             raise InputError("storage must not be empty", "storage")
         if self.dataset not in ("scene", "paper"):
-            raise InputError(f"data set must be 'scene' or 'paper', got {self.dataset!r}", "dataset")
+            raise InputError(
+                f"data set must be 'scene' or 'paper', got {self.dataset!r}", "dataset"
+            )
 
     @property
     def effective_name(self) -> str:

@@ -164,7 +164,7 @@ class MainWindow(QtWidgets.QMainWindow):
         if load_scene:
             self.load_initial_scene(scene_path)
 
-    # ---- construction helpers -----------------------------------------------------------------
+    # ---- construction helpers ----
     def _dock(self, title: str, widget: QtWidgets.QWidget, area) -> None:
         scroll = QtWidgets.QScrollArea()
         scroll.setWidget(widget)
@@ -271,7 +271,7 @@ class MainWindow(QtWidgets.QMainWindow):
         self.statusBar().addPermanentWidget(self.metrics_label)
         self.statusBar().addPermanentWidget(self.retrack_label)
 
-    # ---- errors -------------------------------------------------------------------------------
+    # ---- errors ----
     def show_error(self, message: str) -> None:
         """One message naming the problem; never blocks, never crashes."""
         self.errors.append(message)
@@ -285,7 +285,7 @@ class MainWindow(QtWidgets.QMainWindow):
         self._error_box.setText(message)
         self._error_box.show()
 
-    # ---- scene --------------------------------------------------------------------------------
+    # ---- scene ----
     def load_initial_scene(self, path: str | None) -> None:
         if path:
             try:
@@ -395,7 +395,7 @@ class MainWindow(QtWidgets.QMainWindow):
             self.settings.setValue("radar/last_dir", str(Path(path).parent))
             self.load_cfg(path)
 
-    # ---- tracker parameters -----------------------------------------------------------------------
+    # ---- tracker parameters ----
     def load_params_dialog(self) -> None:
         path, _ = QtWidgets.QFileDialog.getOpenFileName(
             self, "Load tracker parameters", str(Path.cwd()), "JSON (*.json)"
@@ -447,7 +447,7 @@ class MainWindow(QtWidgets.QMainWindow):
         except InputError as exc:
             self.show_error(str(exc))
 
-    # ---- cache, tracking ---------------------------------------------------------------------------
+    # ---- cache, tracking ----
     def _on_cache_reset(self) -> None:
         self.playback.set_available(0)
         self.playback.set_frame(0)
@@ -468,16 +468,18 @@ class MainWindow(QtWidgets.QMainWindow):
     def _on_cache_finished(self) -> None:
         self.tracker.request()
 
-    def _on_tracked(self, elapsed_s: float) -> None:
+    def _on_tracked(self, fast_s: float, detail_s: float) -> None:
         n = self.tracking_model.result.n_frames if self.tracking_model.result else len(self.cache)
-        self.retrack_label.setText(f"re-track {elapsed_s * 1e3:.0f} ms / {n} frames")
-        self.tracker_panel.show_timing(elapsed_s, n)
+        self.retrack_label.setText(
+            f"re-track {n} frames: {fast_s * 1e3:.0f} ms (+ tracks {detail_s * 1e3:.0f} ms)"
+        )
+        self.tracker_panel.show_timing(fast_s, detail_s, n)
 
     def _on_tracking_changed(self, result) -> None:
         self.psi_view.set_result(result, self._frame_period_s)
         self._dirty = True
 
-    # ---- playback -----------------------------------------------------------------------------
+    # ---- playback ----
     def _step(self, delta: int) -> None:
         self.playback.set_playing(False)
         self.playback.step(delta)
@@ -531,7 +533,7 @@ class MainWindow(QtWidgets.QMainWindow):
             f" (of {total}) · {t:5.2f} s"
         )
 
-    # ---- drawing ------------------------------------------------------------------------------
+    # ---- drawing ----
     def _on_view_options(self, *_args) -> None:
         self.top_view.colour_by = self.colour_combo.currentData()
         self.top_view.persistence = self.persistence_spin.value()
@@ -589,7 +591,7 @@ class MainWindow(QtWidgets.QMainWindow):
             + (" (done)" if self.cache.complete else "")
         )
 
-    # ---- study --------------------------------------------------------------------------------
+    # ---- study ----
     def start_study(self) -> None:
         """Start a study on the current scene's point clouds (written as a data set first)."""
         if self.study.running:
@@ -643,7 +645,7 @@ class MainWindow(QtWidgets.QMainWindow):
             except InputError as exc:
                 self.show_error(str(exc))
 
-    # ---- persistence --------------------------------------------------------------------------
+    # ---- persistence ----
     def save_settings(self) -> None:
         s = self.settings
         s.setValue("window/geometry", self.saveGeometry())

@@ -126,24 +126,34 @@ class SimulationController(QtCore.QObject):
 class _Signals(QtCore.QObject):
     result = QtCore.Signal(int, object)
     failed = QtCore.Signal(int, str)
+    done = QtCore.Signal(int)
 
 
 class _TrackJob(QtCore.QRunnable):
-    def __init__(self, engine, frames, params, frame_period_s, key, ticket, signals) -> None:
+    """Two stages: the compiled kernel (estimate, confirmed tracks, metrics; milliseconds),
+    then the readable tracker with every track (ids, ψ, gates), skipped when superseded."""
+
+    def __init__(self, engine, frames, params, frame_period_s, key, ticket, signals, latest):
         super().__init__()
         self.setAutoDelete(True)
         self._args = (engine, frames, params, frame_period_s, key)
         self._ticket = ticket
         self._signals = signals
+        self._latest = latest  # callable: the newest ticket (read across threads, an int)
 
     def run(self) -> None:  # pool thread
         engine, frames, params, frame_period_s, key = self._args
         try:
-            result = engine.track(frames, params, frame_period_s, key=key)
-            self._signals.result.emit(self._ticket, result)
+            fast = engine.track_fast(frames, params, frame_period_s, key=key)
+            self._signals.result.emit(self._ticket, fast)
+            if self._latest() == self._ticket:
+                full = engine.track(frames, params, frame_period_s, key=key)
+                self._signals.result.emit(self._ticket, full)
         except Exception as exc:
             traceback.print_exc()
             self._signals.failed.emit(self._ticket, describe_error(exc))
+        finally:
+            self._signals.done.emit(self._ticket)
 
 
 class TrackingController(QtCore.QObject):
@@ -154,7 +164,7 @@ class TrackingController(QtCore.QObject):
     """
 
     failed = QtCore.Signal(str)
-    finished = QtCore.Signal(float)  # elapsed seconds of the run
+    finished = QtCore.Signal(float, float)  # elapsed s of the fast stage, of the detailed stage
 
     def __init__(
         self,
@@ -177,6 +187,7 @@ class TrackingController(QtCore.QObject):
         self._signals = _Signals()
         self._signals.result.connect(self._on_result)
         self._signals.failed.connect(self._on_failed)
+        self._signals.done.connect(self._on_done)
         self._timer = QtCore.QTimer(self)
         self._timer.setSingleShot(True)
         self._timer.setInterval(debounce_ms)
@@ -184,7 +195,8 @@ class TrackingController(QtCore.QObject):
         self._ticket = 0
         self._busy = False
         self._pending = False
-        self.last_elapsed_s = float("nan")
+        self.last_fast_s = float("nan")
+        self.last_detail_s = float("nan")
         self.n_runs = 0
         params.changed.connect(self.request)
 
@@ -214,26 +226,30 @@ class TrackingController(QtCore.QObject):
             self._params.key(),
             self._ticket,
             self._signals,
+            lambda: self._ticket,
         )
         self._pool.start(job)
 
-    def _finish(self) -> None:
+    def _on_result(self, ticket: int, result: TrackingResult) -> None:
+        if result.detail:
+            self.last_detail_s = result.elapsed_s
+        else:
+            self.last_fast_s = result.elapsed_s
+        if ticket == self._ticket:
+            self._tracking.set_result(result)
+            if result.detail:
+                self.n_runs += 1
+                self.finished.emit(self.last_fast_s, self.last_detail_s)
+
+    def _on_failed(self, ticket: int, message: str) -> None:
+        if ticket == self._ticket:
+            self.failed.emit(message)
+
+    def _on_done(self, ticket: int) -> None:
         self._busy = False
         if self._pending:
             self._pending = False
             self._launch()
-
-    def _on_result(self, ticket: int, result: TrackingResult) -> None:
-        self.n_runs += 1
-        self.last_elapsed_s = result.elapsed_s
-        if ticket == self._ticket and not self._pending:
-            self._tracking.set_result(result)
-        self.finished.emit(result.elapsed_s)
-        self._finish()
-
-    def _on_failed(self, ticket: int, message: str) -> None:
-        self.failed.emit(message)
-        self._finish()
 
     def invalidate(self) -> None:
         """Drop any run in flight (the cache was reset) and clear the overlay."""

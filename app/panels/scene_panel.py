@@ -146,7 +146,9 @@ class ScenePanel(QtWidgets.QWidget):
         cf.addRow("seed", seed_row)
         self.class_params: dict[str, QtWidgets.QDoubleSpinBox] = {}
         for spec in engine.class_param_specs():
-            spin = _dspin(spec.low - spec.step, spec.high, spec.decimals, spec.unit, f"cp_{spec.name}")
+            spin = _dspin(
+                spec.low - spec.step, spec.high, spec.decimals, spec.unit, f"cp_{spec.name}"
+            )
             spin.setSingleStep(spec.step)
             spin.setSpecialValueText("random")
             spin.setToolTip(f"{spec.help} ('random' lets the generator draw it)")
@@ -422,7 +424,10 @@ class ScenePanel(QtWidgets.QWidget):
             self.rcs.setValue(float(person.get("rcs_dbsm", -8.0)))
             self.rcs.setEnabled("rcs_dbsm" in person)
             self.reflectors.set_rows(
-                [[r["x_m"], r["y_m"], r.get("rcs_dbsm", 10.0)] for r in doc.get("static_reflectors", [])]
+                [
+                    [r["x_m"], r["y_m"], r.get("rcs_dbsm", 10.0)]
+                    for r in doc.get("static_reflectors", [])
+                ]
             )
             self.remove_button.setEnabled(len(persons) > 1)
         finally:

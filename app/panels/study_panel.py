@@ -46,7 +46,9 @@ class StudyPanel(QtWidgets.QWidget):
         storage_row = QtWidgets.QHBoxLayout()
         self.storage = QtWidgets.QLineEdit()
         self.storage.setObjectName("studyStorage")
-        self.storage.setToolTip("SQLite file (default), a .log journal file, or a postgresql:// URL")
+        self.storage.setToolTip(
+            "SQLite file (default), a .log journal file, or a postgresql:// URL"
+        )
         self.browse = QtWidgets.QToolButton()
         self.browse.setText("…")
         storage_row.addWidget(self.storage, 1)

@@ -60,7 +60,9 @@ class ParamRow(QtCore.QObject):
         self.spec = spec
         self._model = model
         self._on_error = on_error
-        self.label = QtWidgets.QLabel(LABELS.get(spec.name, spec.name) + (" (log)" if spec.log else ""))
+        self.label = QtWidgets.QLabel(
+            LABELS.get(spec.name, spec.name) + (" (log)" if spec.log else "")
+        )
         self.slider = QtWidgets.QSlider(QtCore.Qt.Horizontal)
         self.slider.setObjectName(f"slider_{spec.name}")
         self.slider.setRange(0, SLIDER_STEPS)
@@ -240,5 +242,9 @@ class TrackerPanel(QtWidgets.QWidget):
         for w in widgets:
             w.blockSignals(False)
 
-    def show_timing(self, elapsed_s: float, n_frames: int) -> None:
-        self.timing.setText(f"re-track: {elapsed_s * 1e3:.0f} ms for {n_frames} frames")
+    def show_timing(self, fast_s: float, detail_s: float, n_frames: int) -> None:
+        self.timing.setText(
+            f"re-track of {n_frames} frames: estimate and metrics {fast_s * 1e3:.0f} ms, "
+            f"every track with ψ and gates {detail_s * 1e3:.0f} ms"
+        )
+        self.timing.setWordWrap(True)

@@ -25,12 +25,16 @@ class PsiView(pg.GraphicsLayoutWidget):
         self.psi_all = self.psi_plot.plot(pen=pg.mkPen((240, 220, 40, 120), width=1))
         self.psi_confirmed = self.psi_plot.plot(pen=pg.mkPen((0, 220, 90), width=2))
         self.confirm_line = pg.InfiniteLine(
-            angle=0, pen=pg.mkPen((0, 220, 90), style=QtCore.Qt.DashLine), label="confirm {value:.2f}",
-            labelOpts={"position": 0.05, "color": (0, 220, 90)},
+            angle=0,
+            pen=pg.mkPen((0, 220, 90), style=QtCore.Qt.DashLine),
+            label="confirm {value:.2f}",
+            labelOpts={"position": 0.9, "color": (0, 220, 90), "anchors": [(1, 1), (1, 1)]},
         )
         self.delete_line = pg.InfiniteLine(
-            angle=0, pen=pg.mkPen((255, 80, 80), style=QtCore.Qt.DashLine), label="delete {value:.2f}",
-            labelOpts={"position": 0.05, "color": (255, 80, 80)},
+            angle=0,
+            pen=pg.mkPen((255, 80, 80), style=QtCore.Qt.DashLine),
+            label="delete {value:.2f}",
+            labelOpts={"position": 0.9, "color": (255, 80, 80), "anchors": [(1, 0), (1, 0)]},
         )
         self.psi_plot.addItem(self.confirm_line)
         self.psi_plot.addItem(self.delete_line)

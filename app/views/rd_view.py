@@ -48,9 +48,7 @@ class RangeDopplerView(pg.GraphicsLayoutWidget):
         dv = radar.velocity_resolution_mps
         n_d = radar.n_loops
         # bin centres: range k*dr, velocity (j - n_d/2)*dv; the image spans the bin edges
-        self._rect = QtCore.QRectF(
-            (-n_d / 2 - 0.5) * dv, -0.5 * dr, n_d * dv, radar.n_samples * dr
-        )
+        self._rect = QtCore.QRectF((-n_d / 2 - 0.5) * dv, -0.5 * dr, n_d * dv, radar.n_samples * dr)
         self.image.setRect(self._rect)
         self.plot.setXRange(self._rect.left(), self._rect.right(), padding=0)
         self.plot.setYRange(0.0, radar.n_samples * dr, padding=0)

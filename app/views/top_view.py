@@ -55,6 +55,10 @@ class TopView(pg.PlotWidget):
         self.addLegend(offset=(5, 5))
         self._snr_brushes = _snr_palette()
         self._label_brushes = {k: pg.mkBrush(*c, 220) for k, c in LABEL_COLOURS.items()}
+        self._snr_array = np.empty(N_SNR_COLOURS, dtype=object)
+        self._snr_array[:] = self._snr_brushes
+        self._label_array = np.empty(3, dtype=object)
+        self._label_array[:] = [self._label_brushes[k] for k in ("person", "clutter", "noise")]
         self._confirmed_brushes = _psi_palette((0, 220, 90))
         self._tentative_brushes = _psi_palette((240, 220, 40))
 
@@ -164,7 +168,9 @@ class TopView(pg.PlotWidget):
         self.waypoint_added.emit(float(p.x()), float(p.y()))
 
     # ---- per frame ----------------------------------------------------------------------------
-    def _point_brushes(self, frames: Sequence[FrameData]) -> tuple[np.ndarray, np.ndarray, list]:
+    def _point_brushes(
+        self, frames: Sequence[FrameData]
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         xs, ys, keys = [], [], []
         for f in frames:
             c = f.cloud
@@ -176,16 +182,13 @@ class TopView(pg.PlotWidget):
             else:
                 keys.append(np.asarray(c.source))
         if not xs:
-            return np.zeros(0), np.zeros(0), []
+            return np.zeros(0), np.zeros(0), np.zeros(0, dtype=object)
         x, y, key = np.concatenate(xs), np.concatenate(ys), np.concatenate(keys)
         if self.colour_by == "snr":
-            palette = self._snr_brushes
-            brushes = [palette[k] for k in key]
+            brushes = self._snr_array[key]
         else:
-            lb = self._label_brushes
-            brushes = [
-                lb["person"] if k >= 0 else lb["clutter"] if k == -1 else lb["noise"] for k in key
-            ]
+            # source >= 0 person, -1 clutter, -2 noise  ->  palette index 0, 1, 2
+            brushes = self._label_array[np.clip(-key, 0, 2)]
         return x, y, brushes
 
     def show_frame(
@@ -229,7 +232,8 @@ class TopView(pg.PlotWidget):
             for label in self._labels:
                 label.hide()
             return
-        level = np.clip(np.round(tf.psi * (N_PSI_LEVELS - 1)), 0, N_PSI_LEVELS - 1).astype(int)
+        psi = np.nan_to_num(tf.psi, nan=1.0)  # fast stage: ψ not known yet, drawn opaque
+        level = np.clip(np.round(psi * (N_PSI_LEVELS - 1)), 0, N_PSI_LEVELS - 1).astype(int)
         brushes = [
             (self._confirmed_brushes if c else self._tentative_brushes)[k]
             for k, c in zip(level, tf.confirmed)
@@ -262,7 +266,7 @@ class TopView(pg.PlotWidget):
             self.addItem(label)
             self._labels.append(label)
         for k, label in enumerate(self._labels):
-            if k < n:
+            if k < n and tf.track_id[k] >= 0:
                 label.setText(f"{tf.track_id[k]} ψ={tf.psi[k]:.2f}")
                 label.setPos(float(tf.xy_m[k, 0]) + 0.1, float(tf.xy_m[k, 1]) + 0.1)
                 label.show()
