@@ -77,11 +77,12 @@ def paper_document() -> dict:
     return json.loads(json.dumps(PAPER_SCENE_DOCUMENT))
 
 
-def scene_from_document(doc: dict, base_dir: Path):
-    """Validate a scene document with :mod:`core.scene`; raises :class:`InputError`."""
+def scene_from_document(doc: dict, base_dir: Path, source: str | None = None):
+    """Validate a scene document with :mod:`core.scene`; raises :class:`InputError` naming
+    ``source`` (the file) and the field."""
     from core.scene import Scene
 
-    return Scene.from_dict(doc, source="scene", base_dir=base_dir)
+    return Scene.from_dict(doc, source=source, base_dir=base_dir)
 
 
 def scene_info(scene) -> SceneInfo:

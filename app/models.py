@@ -90,10 +90,12 @@ class SceneModel(QtCore.QObject):
         return copy.deepcopy(self._doc["persons"][index])
 
     # ---- edits -------------------------------------------------------------------------------
-    def set_document(self, doc: dict, *, base_dir: Path | None = None) -> None:
+    def set_document(
+        self, doc: dict, *, base_dir: Path | None = None, source: str | None = None
+    ) -> None:
         """Validate and adopt a document; on error raise :class:`InputError`, keep the old one."""
         base = base_dir if base_dir is not None else self._base_dir
-        scene = self._engine.scene_from_document(doc, base)
+        scene = self._engine.scene_from_document(doc, base, source)
         self._doc = copy.deepcopy(doc)
         self._scene = scene
         self._base_dir = base
@@ -144,10 +146,7 @@ class SceneModel(QtCore.QObject):
             raise InputError(f"invalid JSON at line {exc.lineno}: {exc.msg}", str(path)) from None
         if not isinstance(doc, dict):
             raise InputError("a scene file must hold a JSON object", str(path))
-        try:
-            self.set_document(doc, base_dir=path.parent)
-        except InputError as exc:
-            raise InputError(exc.message, exc.source or str(path)) from None
+        self.set_document(doc, base_dir=path.parent, source=str(path))
         self._path = path
 
     def save(self, path: str | Path) -> None:
