@@ -27,22 +27,31 @@ from dataclasses import dataclass
 from typing import Protocol
 
 import numpy as np
+from scipy.integrate import quad
 from scipy.optimize import brentq
-from scipy.special import betaincc, betainccinv, gammaln, logsumexp
+from scipy.special import betaincc, betainccinv, gammaincc, gammaln, logsumexp
 
 from core.config import DEFAULT_PROCESSING, CfarSettings, ProcessingSettings, RadarConfig
+from core.processing.spectrum import clutter_removal_noise_profile, effective_cells
 
 
 # ---- exact false-alarm probabilities ------------------------------------------------------------
-def pfa_ca(t: float, n_cells: int, n_channels: int) -> float:
-    """Pfa of ``X > T * Z`` with ``X ~ Gamma(L)``, ``Z`` the sum of ``n_cells`` such cells."""
+def pfa_ca(t: float, n_cells: float, n_channels: int) -> float:
+    """Pfa of ``X > T * Z`` with ``X ~ Gamma(L)``, ``Z ~ Gamma(n_cells L)`` (sum of the cells)."""
     # Pfa = 1 - I_{T/(1+T)}(L, N L)
     return float(betaincc(n_channels, n_cells * n_channels, t / (1.0 + t)))
 
 
-def pfa_caso(t: float, n_side: int, n_channels: int) -> float:
-    """Pfa of ``X > T * min(Z1, Z2)``, each side the sum of ``n_side`` cells (exact sum)."""
+def pfa_caso(t: float, n_side: float, n_channels: int) -> float:
+    """Pfa of ``X > T * min(Z1, Z2)``, each side ``Z ~ Gamma(n_side L)``.
+
+    Exact finite double sum for integer ``M = n_side L``; for a non-integer (effective) shape
+    the same integral ``int 2 f_M(z) Q(M, z) Q(L, T z) dz`` is evaluated numerically.
+    """
     m, l = n_side * n_channels, n_channels
+    if abs(m - round(m)) > 1e-9:
+        return _pfa_so_numeric(t, m, l)
+    m = round(m)
     j = np.arange(m)[:, None]
     k = np.arange(l)[None, :]
     # log of T^k Gamma(M+j+k) / (j! k! Gamma(M) (2+T)^(M+j+k))
@@ -57,13 +66,26 @@ def pfa_caso(t: float, n_side: int, n_channels: int) -> float:
     return float(2.0 * np.exp(logsumexp(log_terms)))
 
 
-def pfa_cago(t: float, n_side: int, n_channels: int) -> float:
+def _pfa_so_numeric(t: float, m: float, l: int) -> float:
+    def integrand(z: float) -> float:
+        # 2 f_M(z) (1 - F_M(z)) P(X > T z)
+        log_f = (m - 1) * np.log(z) - z - gammaln(m)
+        return 2.0 * np.exp(log_f) * gammaincc(m, z) * gammaincc(l, t * z)
+
+    hi = m + 60.0 * np.sqrt(m) + 60.0
+    val, _ = quad(integrand, 0.0, hi, points=[m], limit=400, epsabs=0.0, epsrel=1e-11)
+    return float(val)
+
+
+def pfa_cago(t: float, n_side: float, n_channels: int) -> float:
     """Pfa of ``X > T * max(Z1, Z2)``: ``2 P(X > T Z1) - Pfa_SO``."""
     return 2.0 * pfa_ca(t, n_side, n_channels) - pfa_caso(t, n_side, n_channels)
 
 
 @functools.lru_cache(maxsize=256)
-def threshold_factor(method: str, n_train: int, pfa: float, n_channels: int) -> float:
+def threshold_factor(
+    method: str, n_train: int, pfa: float, n_channels: int, n_effective: float | None = None
+) -> float:
     """``alpha`` such that ``X > alpha * mu_hat`` has false-alarm probability ``pfa``.
 
     Parameters
@@ -73,20 +95,27 @@ def threshold_factor(method: str, n_train: int, pfa: float, n_channels: int) -> 
         (``n_train`` cells on each side).
     n_channels
         ``L``, the number of exponential looks summed per cell (12 virtual channels).
+    n_effective
+        Effective number of independent cells among the ``n_train`` (window-correlated cells,
+        see :func:`core.processing.spectrum.effective_cells`); None: all independent (exact).
+        The training sum is then moment-matched by ``Gamma(n_eff L)`` with the same mean.
     """
+    ne = float(n_train if n_effective is None else n_effective)
     if method == "ca":
-        b = float(betainccinv(n_channels, n_train * n_channels, pfa))
-        # T/(1+T) = b  ->  T = b / (1 - b);  alpha = N T
-        return n_train * b / (1.0 - b)
+        b = float(betainccinv(n_channels, ne * n_channels, pfa))
+        # T/(1+T) = b  ->  T = b / (1 - b);  alpha = N_eff T
+        return ne * b / (1.0 - b)
     f = {"caso": pfa_caso, "cago": pfa_cago}[method]
-    # Pfa(T) decreases monotonically in T: bracket and solve in log T
-    lo, hi = -20.0, 2.0
-    while f(np.exp(hi), n_train, n_channels) > pfa:
-        hi += 2.0
+    # Pfa(T) decreases monotonically in T: step up in log T until it falls below pfa (small
+    # steps keep the bracket where Pfa_GO = 2 P1 - Pfa_SO has no cancellation), then solve
+    hi = -8.0
+    while f(np.exp(hi), ne, n_channels) > pfa:
+        hi += 0.25
     log_t = brentq(
-        lambda u: np.log(f(np.exp(u), n_train, n_channels)) - np.log(pfa), lo, hi, xtol=1e-12
+        lambda u: np.log(f(np.exp(u), ne, n_channels)) - np.log(pfa), hi - 0.25, hi, xtol=1e-13
     )
-    return n_train * float(np.exp(log_t))
+    # with Z' = Z n_eff / n ~ Gamma(n_eff L): X > T Z'  <=>  X > (T n_eff) * (Z / n)
+    return ne * float(np.exp(log_t))
 
 
 # ---- detectors ----------------------------------------------------------------------------------
@@ -130,18 +159,23 @@ class _SidedCfar:
     pfa: float = 1e-4
     cyclic: bool = False
     n_channels: int = 12
+    #: effective independent cells among the ``n_train`` of one side (None: n_train)
+    n_effective: float | None = None
 
     method = "ca"
 
     def alpha(self) -> float:
         """Threshold factor on the per-cell noise estimate when both sides are available."""
+        ne = self.n_effective
         if self.method == "ca":
-            return threshold_factor("ca", 2 * self.n_train, self.pfa, self.n_channels)
-        return threshold_factor(self.method, self.n_train, self.pfa, self.n_channels)
+            # the two sides are independent of each other (guard cells in between)
+            ne2 = None if ne is None else 2 * ne
+            return threshold_factor("ca", 2 * self.n_train, self.pfa, self.n_channels, ne2)
+        return threshold_factor(self.method, self.n_train, self.pfa, self.n_channels, ne)
 
     def alpha_one_side(self) -> float:
         """Threshold factor at a non-cyclic edge (CA over the one complete side)."""
-        return threshold_factor("ca", self.n_train, self.pfa, self.n_channels)
+        return threshold_factor("ca", self.n_train, self.pfa, self.n_channels, self.n_effective)
 
     def _combine(self, left: np.ndarray, right: np.ndarray) -> np.ndarray:
         raise NotImplementedError
@@ -209,14 +243,21 @@ class CagoCfar(_SidedCfar):
 CFAR_CLASSES = {"ca": CaCfar, "caso": CasoCfar, "cago": CagoCfar}
 
 
-def make_cfar(settings: CfarSettings, n_channels: int) -> _SidedCfar:
-    """The detector strategy named by ``settings.method`` for ``n_channels`` summed looks."""
+def make_cfar(
+    settings: CfarSettings, n_channels: int, n_effective: float | None = None
+) -> _SidedCfar:
+    """The detector strategy named by ``settings.method`` for ``n_channels`` summed looks.
+
+    ``n_effective``: effective independent cells among the ``n_train`` of one side (window
+    correlation, :func:`core.processing.spectrum.effective_cells`); None: independent cells.
+    """
     return CFAR_CLASSES[settings.method](
         n_train=settings.n_train,
         n_guard=settings.n_guard,
         pfa=settings.pfa,
         cyclic=settings.cyclic,
         n_channels=n_channels,
+        n_effective=n_effective,
     )
 
 
@@ -273,6 +314,12 @@ def two_stage_cfar(
     CFAR (along axis 1), lies within ``[min_range_m, max_range_m]`` and, with peak grouping, is
     a local maximum of the map.
 
+    With ``settings.cfar_noise_model`` (default) the thresholds account for what the chain does
+    to the noise: window-correlated neighbouring cells (effective cell counts, see
+    :func:`~core.processing.spectrum.effective_cells`) and, after static clutter removal, the
+    lower noise around zero Doppler (the map is divided by
+    :func:`~core.processing.spectrum.clutter_removal_noise_profile` before the CFAR).
+
     Parameters
     ----------
     rd_map
@@ -282,36 +329,62 @@ def two_stage_cfar(
     """
     rd = np.asarray(rd_map)
     L = radar.n_virtual if n_channels is None else n_channels
-    n_r = rd.shape[0]
+    n_r, n_d = rd.shape
     k = np.arange(n_r) * radar.range_resolution_m
     in_range = (k >= settings.min_range_m) & (k <= settings.max_range_m)
     lo, hi = np.flatnonzero(in_range)[[0, -1]] if in_range.any() else (0, -1)
     if hi < lo:
         return _empty_detections()
+    rc, dc = settings.range_cfar, settings.doppler_cfar
+    ne_r = ne_d = None
+    profile = None
+    if settings.cfar_noise_model:
+        ne_r = _effective(settings.range_window, n_r, rc.n_train)
+        ne_d = _effective(settings.doppler_window, n_d, dc.n_train)
+        if settings.static_clutter_removal:
+            profile = clutter_removal_noise_profile(settings.doppler_window, n_d)
     # the range stage needs training cells beyond the limits: run it on a margin around them
-    margin = settings.range_cfar.n_train + settings.range_cfar.n_guard
+    margin = rc.n_train + rc.n_guard
     a, b = max(0, lo - margin), min(n_r, hi + 1 + margin)
-    sub = rd[a:b]
-    mask_r, noise_r = make_cfar(settings.range_cfar, L).detect(sub, axis=0)
+    if profile is None:
+        sub = rd[a:b]
+    else:
+        # whiten: equal noise in every Doppler bin; bins the removal empties (rectangular
+        # window: zero Doppler) carry nothing and are never detected
+        dead = profile < 0.01
+        profile = np.where(dead, 1.0, profile)
+        sub = np.where(dead, 0.0, rd[a:b] / profile)
+    mask_r, noise_r = make_cfar(rc, L, ne_r).detect(sub, axis=0)
+    if profile is not None:
+        mask_r[:, dead] = False
     mask_r[: lo - a] = False
     mask_r[hi + 1 - a :] = False
     rows = np.flatnonzero(mask_r.any(axis=1))
     if rows.size == 0:
         return _empty_detections()
     # Doppler stage only on the rows the range stage passed
-    mask_d, _ = make_cfar(settings.doppler_cfar, L).detect(sub[rows], axis=1)
+    mask_d, _ = make_cfar(dc, L, ne_d).detect(sub[rows], axis=1)
     mask = mask_r[rows] & mask_d
     ri, d = np.nonzero(mask)
     r = rows[ri] + a
     if settings.peak_grouping and r.size:
         keep = _local_maxima(rd, r, d)
         r, d, ri = r[keep], d[keep], ri[keep]
+    noise = noise_r[rows[ri], d]
+    if profile is not None:
+        noise = noise * profile[d]  # back to the map's units at the cell under test
     return Detections(
         range_bin=r.astype(np.int64),
         doppler_index=d.astype(np.int64),
         power=rd[r, d].astype(np.float64),
-        noise_power=noise_r[rows[ri], d],
+        noise_power=noise,
     )
+
+
+@functools.lru_cache(maxsize=64)
+def _effective(window_name: str, n_fft: int, n_train: int) -> float | None:
+    ne = effective_cells(window_name, n_fft, n_train)
+    return None if abs(ne - n_train) < 1e-9 else ne
 
 
 def _empty_detections() -> Detections:
