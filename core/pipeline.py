@@ -12,6 +12,8 @@ leaves every other stage's numbers bit for bit unchanged, and any frame can be s
 
 from __future__ import annotations
 
+import dataclasses
+import functools
 import hashlib
 import importlib
 import json
@@ -25,11 +27,12 @@ from typing import Any
 
 import numpy as np
 
-from core.config import RadarConfig
+from core.config import DEFAULT_PROCESSING, ProcessingSettings, RadarConfig
 from core.dataset import Dataset
 from core.errors import InputError
 from core.pointcloud import PointCloud
 from core.scene import Scene, draw_clutter, expected_clutter_count, paper_scenes
+from core.scene.body import body_scatterers, walking_headings
 
 #: eq. (5): σ_dBsm ~ N(−8, 16): mean −8 dBsm, variance 16 dB² (standard deviation 4 dB)
 PERSON_RCS_MEAN_DBSM = -8.0
@@ -138,6 +141,7 @@ def plan(
     study = consumer == "study"
     has_clutter = scene.clutter_density_per_m2 > 0
     drawn_rcs = [i for i, p in enumerate(scene.persons) if p.rcs_dbsm is None]
+    extended = [i for i, p in enumerate(scene.persons) if p.model == "extended"]
     needs_el = scene.radar.has_elevation and not scene.is_planar
 
     def stage(name, needs, produces, run, why_run, why_skip):
@@ -166,6 +170,11 @@ def plan(
             "every person has a fixed rcs_dbsm",
         ),
         stage(
+            "body_model", ("truth_xy", "person_rcs"), ("body_scatterers",), extended,
+            f"extended model (torso, arms, legs, micro-Doppler) for person(s) {extended}",
+            "point-scatterer persons (the paper's model)",
+        ),
+        stage(
             "clutter", ("antenna_gain",), ("clutter_reflectors",), has_clutter,
             f"Poisson, mean lambda*area = {expected_clutter_count(scene.aoi, lam):.3f} per frame",
             "clutter_density_per_m2 = 0: no clutter draws",
@@ -177,7 +186,8 @@ def plan(
         ),
         stage(
             "scatterers",
-            ("truth_xy", "person_rcs", "clutter_reflectors", "static_reflectors"),
+            ("truth_xy", "person_rcs", "body_scatterers", "clutter_reflectors",
+             "static_reflectors"),
             ("scatterers",), True, "reflectors of each frame", "",
         ),
         stage(
@@ -300,10 +310,9 @@ class SceneRun:
         )
 
 
-def _processing_settings():
-    from core.config import ProcessingSettings  # added by the radar chain (branch sim)
-
-    return ProcessingSettings()
+def processing_settings(scene: Scene) -> ProcessingSettings:
+    """The chain's default processing, with detections limited to the scene's AOI range."""
+    return dataclasses.replace(DEFAULT_PROCESSING, max_range_m=scene.aoi.max_range_m)
 
 
 def iter_frames(
@@ -338,7 +347,7 @@ def iter_frames(
         raise InputError("a study trial never simulates: load the cached data set instead")
     seed = scene.seed if seed is None else int(seed)
     radar = scene.radar
-    settings = _processing_settings()
+    settings = processing_settings(scene)
     simulate = simulator(p.fidelity)
     antenna = sim.AntennaGain.draw(radar, stage_rng(seed, "antenna"))
     t_s, xy, v = scene.truth()
@@ -347,11 +356,20 @@ def iter_frames(
     static = scene.static_reflectors
     static_pos = np.array([[r.x_m, r.y_m, r.z_m] for r in static]).reshape(-1, 3)
     static_rcs = np.array([r.rcs_dbsm for r in static], dtype=np.float64)
-    run_rcs, run_clutter, run_static = (
+    run_rcs, run_clutter, run_static, run_body = (
         p.runs("person_rcs"),
         p.runs("clutter"),
         p.runs("static_reflectors"),
+        p.runs("body_model"),
     )
+    extended = np.array([q.model == "extended" for q in scene.persons], dtype=bool)
+    if not run_body:
+        extended[:] = False
+    headings = {
+        i: walking_headings(q.trajectory.velocity_mps)
+        for i, q in enumerate(scene.persons)
+        if extended[i]
+    }
     for f in frames if frames is not None else range(scene.n_frames):
         # persons: one point scatterer at the trajectory position, z = 0
         rcs = fixed_rcs.copy()
@@ -362,10 +380,19 @@ def iter_frames(
             )
             rcs = np.where(np.isnan(fixed_rcs), drawn, fixed_rcs)
         active = ~np.isnan(xy[f, :, 0])
-        pos = [np.column_stack((xy[f, active], np.zeros(active.sum())))]
-        vel = [np.column_stack((v[f, active], np.zeros(active.sum())))]
-        rcs_list = [rcs[active]]
-        src = [np.flatnonzero(active).astype(np.int32)]
+        point = active & ~extended
+        pos = [np.column_stack((xy[f, point], np.zeros(point.sum())))]
+        vel = [np.column_stack((v[f, point], np.zeros(point.sum())))]
+        rcs_list = [rcs[point]]
+        src = [np.flatnonzero(point).astype(np.int32)]
+        if run_body:
+            for i in np.flatnonzero(active & extended):
+                bp, bv, frac = body_scatterers(xy[f, i], v[f, i], headings[i][f], t_s[f])
+                pos.append(np.column_stack((bp, np.zeros(len(bp)))))
+                vel.append(np.column_stack((bv, np.zeros(len(bv)))))
+                # σ_part = σ · share (linear power)
+                rcs_list.append(rcs[i] + 10 * np.log10(frac))
+                src.append(np.full(len(bp), i, dtype=np.int32))
         n_clutter = 0
         if run_clutter:
             c = draw_clutter(
@@ -463,10 +490,43 @@ def default_cache_dir() -> Path:
     return Path(env) if env else Path.home() / ".cache" / "radartune"
 
 
-def dataset_key(scenes: Sequence[Scene], *, fidelity: str, seed: int) -> str:
-    """Hash of the scenes (with their resolved radar), the fidelity level and the seed."""
+#: Sources whose code determines a simulated data set (their text is part of the cache key).
+_SIMULATION_SOURCES = ("config.py", "pipeline.py", "pointcloud.py", "dataset.py")
+_SIMULATION_PACKAGES = ("scene", "simulation", "processing")
+
+
+@functools.cache
+def code_fingerprint() -> str:
+    """Hash of the source of every module that shapes a simulated data set.
+
+    Part of the cache key, so a change to the radar chain, the scenes or this pipeline never
+    serves a stale cached data set.
+    """
+    root = Path(__file__).resolve().parent
+    files = [root / name for name in _SIMULATION_SOURCES]
+    for pkg in _SIMULATION_PACKAGES:
+        files += sorted((root / pkg).rglob("*.py"))
     h = hashlib.sha256()
-    h.update(f"radartune-dataset v{CACHE_VERSION} fidelity={fidelity} seed={seed}\n".encode())
+    for f in files:
+        if f.is_file():
+            h.update(f.relative_to(root).as_posix().encode() + b"\0" + f.read_bytes() + b"\0")
+    return h.hexdigest()[:16]
+
+
+def dataset_key(
+    scenes: Sequence[Scene], *, fidelity: str, seed: int, seeds: Sequence[int] | None = None
+) -> str:
+    """Hash of the scenes (with their resolved radar), the fidelity level, the seed(s), the code.
+
+    The code part is :func:`code_fingerprint` (the simulation's source) and
+    :data:`CACHE_VERSION`.
+    """
+    seeds = list(seeds) if seeds is not None else trajectory_seeds(seed, len(scenes))
+    h = hashlib.sha256()
+    h.update(
+        f"radartune-dataset v{CACHE_VERSION} code={code_fingerprint()} "
+        f"fidelity={fidelity} seed={seed} seeds={seeds}\n".encode()
+    )
     for s in scenes:
         h.update(s.canonical_json().encode())
         h.update(b"\n")
@@ -474,8 +534,12 @@ def dataset_key(scenes: Sequence[Scene], *, fidelity: str, seed: int) -> str:
 
 
 def trajectory_seeds(seed: int, n: int) -> list[int]:
-    """Simulation seed of each scene of a data set: ``SeedSequence(seed).spawn(n)``."""
-    return [int(c.generate_state(1)[0]) for c in np.random.SeedSequence(seed).spawn(n)]
+    """Simulation seed of each of ``n`` scenes: ``SeedSequence([seed, 1]).spawn(n)``.
+
+    (Entropy ``[seed, 1]`` keeps them apart from :func:`core.scene.paper_scenes`, which spawns
+    trajectory seeds from ``SeedSequence(seed)``.)
+    """
+    return [int(c.generate_state(1)[0]) for c in np.random.SeedSequence([seed, 1]).spawn(n)]
 
 
 def _simulate_task(args: tuple[str, int, str]) -> dict[str, Any]:
@@ -512,15 +576,21 @@ def build_dataset(
     cache_dir: str | os.PathLike | None = None,
     progress: ProgressCallback | None = None,
     use_cache: bool = True,
+    seeds: Sequence[int] | None = None,
 ) -> Dataset:
     """Simulate scenes into one data set, cached by hash and written atomically.
 
-    Scene ``k`` is simulated with seed ``trajectory_seeds(seed, K)[k]``, one scene per task in
-    a process pool of ``jobs`` workers (default: all cores; ``1`` runs in this process), so the
-    result does not depend on ``jobs``.
+    Scene ``k`` is simulated with seed ``seeds[k]`` (default ``trajectory_seeds(seed, K)[k]``),
+    one scene per task in a process pool of ``jobs`` workers (default: all cores; ``1`` runs in
+    this process), so the result does not depend on ``jobs``.
 
     Parameters
     ----------
+    seed
+        Seed of the whole set (recorded in the data set).
+    seeds
+        Explicit per-scene simulation seeds (the paper set uses each scene's own seed, so any
+        trajectory re-simulated alone with :func:`simulate_scene` gives the same frames).
     progress
         Called as ``progress(done, total)`` after each scene.
     use_cache
@@ -535,7 +605,8 @@ def build_dataset(
     cache_file = None
     if use_cache:
         root = Path(cache_dir) if cache_dir is not None else default_cache_dir()
-        cache_file = root / "datasets" / f"{dataset_key(scenes, fidelity=fidelity, seed=seed)}.npz"
+        key = dataset_key(scenes, fidelity=fidelity, seed=seed, seeds=seeds)
+        cache_file = root / "datasets" / f"{key}.npz"
         if cache_file.is_file():
             try:
                 ds = Dataset.load(cache_file)
@@ -544,7 +615,10 @@ def build_dataset(
                 return ds
             except InputError:
                 cache_file.unlink(missing_ok=True)  # corrupt cache entry: simulate again
-    seeds = trajectory_seeds(seed, len(scenes))
+    if seeds is None:
+        seeds = trajectory_seeds(seed, len(scenes))
+    elif len(seeds) != len(scenes):
+        raise InputError(f"seeds: {len(seeds)} given for {len(scenes)} scenes")
     tasks = [(s.to_json(), sd, fidelity) for s, sd in zip(scenes, seeds)]
     jobs = (os.cpu_count() or 1) if jobs is None else max(1, int(jobs))
     results: list[dict[str, Any]] = []
@@ -608,39 +682,46 @@ def paper_dataset(
     cache_dir: str | os.PathLike | None = None,
     jobs: int | None = None,
     progress: ProgressCallback | None = None,
+    use_cache: bool = True,
 ) -> Dataset:
-    """The paper's data set: :func:`core.scene.paper_scenes` simulated (cached)."""
+    """The paper's data set: :func:`core.scene.paper_scenes` simulated (cached).
+
+    Each trajectory is simulated with its scene's own seed, so ``simulate_scene(scene)`` of any
+    of the scenes reproduces its frames of the data set bit for bit.
+    """
+    scenes = paper_scenes(seed, n_trajectories)
     return build_dataset(
-        paper_scenes(seed, n_trajectories),
+        scenes,
+        seeds=[s.seed for s in scenes],
         fidelity=fidelity,
         seed=seed,
         jobs=jobs,
         cache_dir=cache_dir,
         progress=progress,
+        use_cache=use_cache,
     )
 
 
 # ---- clutter density for the tracker ----------------------------------------------------------
 
 
-def expected_false_alarms_per_frame(radar: RadarConfig, max_range_m: float, settings=None) -> float:
+def expected_false_alarms_per_frame(radar: RadarConfig, settings: ProcessingSettings) -> float:
     """Expected CFAR false alarms per frame from receiver noise alone.
 
     A noise cell is declared only when it passes both CFAR stages, so per cell
-    ``P_fa ≈ P_fa,range · P_fa,Doppler``; cells are the range bins inside the processing
-    range limits (minimum range … ``max_range_m``) times all Doppler bins. Peak grouping can
-    only lower this, so it is an upper estimate (about 5e-4 per frame for the paper radar).
+    ``P_fa ≈ P_fa,range · P_fa,Doppler``; the cells are the range bins inside the processing
+    range limits times all Doppler bins. Peak grouping can only lower this, so it is an upper
+    estimate (about 5.5e-4 per frame for the paper radar: negligible next to clutter).
     """
-    settings = settings or _processing_settings()
-    cfar = settings.cfar
-    r_min = float(getattr(settings, "min_range_m", 0.3))
     dr = radar.range_resolution_m
-    n_range = max(0, int(np.floor(max_range_m / dr)) - int(np.ceil(r_min / dr)) + 1)
+    n_range = int(np.floor(settings.max_range_m / dr)) - int(np.ceil(settings.min_range_m / dr))
+    n_range = max(0, n_range + 1)
     # P_fa per cell = P_fa,range * P_fa,Doppler
-    return n_range * radar.n_loops * cfar.pfa_range * cfar.pfa_doppler
+    pfa = settings.range_cfar.pfa * settings.doppler_cfar.pfa
+    return n_range * radar.n_loops * pfa
 
 
-def scene_clutter_density(scene: Scene, settings=None) -> float:
+def scene_clutter_density(scene: Scene, settings: ProcessingSettings | None = None) -> float:
     """Clutter density ρ for the tracker, per m · rad · m/s.
 
     ``ρ = (λ·area(AOI) + false alarms per frame) / (Δr · Δaz · 2 v_max)``: the expected false
@@ -649,7 +730,8 @@ def scene_clutter_density(scene: Scene, settings=None) -> float:
     """
     aoi = scene.aoi
     n_false = expected_clutter_count(aoi, scene.clutter_density_per_m2)
-    n_false += expected_false_alarms_per_frame(scene.radar, aoi.max_range_m, settings)
+    settings = settings or processing_settings(scene)
+    n_false += expected_false_alarms_per_frame(scene.radar, settings)
     # V = (r_max − r_min) · 2 az_max · 2 v_max
     volume = (
         (aoi.max_range_m - aoi.min_range_m)

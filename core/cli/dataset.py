@@ -28,8 +28,7 @@ def run(args: argparse.Namespace) -> int:
 
     from core.cli.progress import ProgressBar
     from core.errors import InputError
-    from core.pipeline import build_dataset
-    from core.scene import paper_scenes
+    from core.pipeline import paper_dataset
 
     t0 = time.perf_counter()
     if args.seed < 0:
@@ -38,11 +37,10 @@ def run(args: argparse.Namespace) -> int:
         raise InputError(f"--trajectories must be >= 1, got {args.trajectories}")
     if args.jobs is not None and args.jobs < 1:
         raise InputError(f"--jobs must be >= 1, got {args.jobs}")
-    scenes = paper_scenes(args.seed, args.trajectories)
-    ds = build_dataset(
-        scenes,
+    ds = paper_dataset(
+        args.seed,
+        args.trajectories,
         fidelity=args.fidelity,
-        seed=args.seed,
         jobs=args.jobs,
         progress=ProgressBar("dataset"),
         use_cache=not args.no_cache,

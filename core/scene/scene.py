@@ -36,7 +36,8 @@ SCENE_KEYS = (
     "static_reflectors",
     "persons",
 )
-PERSON_KEYS = ("trajectory", "rcs_dbsm")
+PERSON_KEYS = ("trajectory", "rcs_dbsm", "model")
+PERSON_MODELS = ("point", "extended")
 REFLECTOR_KEYS = ("x_m", "y_m", "z_m", "rcs_dbsm")
 RCS_RANGE_DBSM = (-60.0, 60.0)
 WAYPOINT_SPEED_RANGE_MPS = (0.05, 3.0)
@@ -64,17 +65,26 @@ class Person:
     """One walking person: a point scatterer on the trajectory at z = 0.
 
     ``rcs_dbsm`` fixes the RCS; ``None`` draws it from eq. (5), N(−8, 16) dBsm, every frame.
+    ``model``: ``"point"`` (the paper's, default) or ``"extended"`` (torso, arms and legs with
+    micro-Doppler, :mod:`core.scene.body`; the RCS is split over the body scatterers).
     ``spec`` is the trajectory's JSON description (kept so that the scene saves as written).
     """
 
     trajectory: Trajectory
     rcs_dbsm: float | None = None
+    model: str = "point"
     spec: Mapping[str, Any] = field(default_factory=dict, compare=False)
+
+    def __post_init__(self) -> None:
+        if self.model not in PERSON_MODELS:
+            raise InputError(f"model must be one of {list(PERSON_MODELS)}, got {self.model!r}")
 
     def to_dict(self) -> dict:
         d: dict[str, Any] = {"trajectory": dict(self.spec)}
         if self.rcs_dbsm is not None:
             d["rcs_dbsm"] = self.rcs_dbsm
+        if self.model != "point":
+            d["model"] = self.model
         return d
 
 
@@ -414,7 +424,12 @@ def _parse_scene(data: Any, base_dir: Path) -> Scene:
         rcs = p.get("rcs_dbsm")
         if rcs is not None:
             rcs = _number(rcs, f"{where}.rcs_dbsm", *RCS_RANGE_DBSM)
-        persons.append(Person(trajectory=traj, rcs_dbsm=rcs, spec=dict(p["trajectory"])))
+        model = p.get("model", "point")
+        if model not in PERSON_MODELS:
+            raise InputError(f"{where}.model must be one of {list(PERSON_MODELS)}, got {model!r}")
+        persons.append(
+            Person(trajectory=traj, rcs_dbsm=rcs, model=model, spec=dict(p["trajectory"]))
+        )
     return Scene(
         seed=seed,
         radar=radar,

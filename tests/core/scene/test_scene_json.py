@@ -140,3 +140,30 @@ def test_waypoint_outside_the_aoi(tmp_path: Path) -> None:
     data["persons"][1]["trajectory"]["waypoints"][2] = [0.0, 12.0, 1.0]
     with pytest.raises(InputError, match=r"persons\[1\].trajectory.waypoints\[2\]"):
         Scene.from_json(write(tmp_path, data))
+
+
+def test_radar_from_a_ti_cfg_relative_to_the_scene(tmp_path: Path) -> None:
+    from core.config import read_ti_cfg
+
+    cfg = ROOT / "resources" / "radar" / "long_range.cfg"
+    (tmp_path / "radar").mkdir()
+    (tmp_path / "radar" / "lr.cfg").write_text(cfg.read_text())
+    (tmp_path / "scenes").mkdir()
+    data = dict(SPEC_EXAMPLE, radar="../radar/lr.cfg")
+    scene = Scene.from_json(write(tmp_path / "scenes", data))
+    assert scene.radar == read_ti_cfg(cfg)
+    assert scene.persons[0].trajectory.frame_period_s == scene.radar.frame_period_s
+    assert json.loads(scene.to_json())["radar"] == "../radar/lr.cfg"
+
+
+def test_malformed_ti_cfg_names_its_line(tmp_path: Path) -> None:
+    lines = (ROOT / "resources" / "radar" / "paper.cfg").read_text().splitlines()
+    n = next(i for i, ln in enumerate(lines) if ln.startswith("profileCfg"))
+    fields = lines[n].split()
+    fields[2] = "sixty"  # startFreq
+    lines[n] = " ".join(fields)
+    (tmp_path / "bad.cfg").write_text("\n".join(lines) + "\n")
+    with pytest.raises(InputError) as exc:
+        Scene.from_json(write(tmp_path, dict(SPEC_EXAMPLE, radar="bad.cfg")))
+    assert f"bad.cfg:{n + 1}" in str(exc.value)
+    assert "\n" not in str(exc.value)
