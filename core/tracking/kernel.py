@@ -191,20 +191,16 @@ def _pda_update(x, P, xp, Pp, H, HP, R, L, nu, beta, beta0, mval, K, A, tmp, tmp
             for k in range(n):
                 s += A[i, k] * Pp[k, j]
             tmp[i, j] = s
-    # spread = Σβᵢ(νᵢ − ν̄)(νᵢ − ν̄)ᵀ + β₀ ν̄ν̄ᵀ, plus R weighted by (1 − β₀) for the Joseph term
-    sp = np.empty((3, 3))
+    # tmp2 = (1 − β₀) R + spread, spread = Σβᵢ(νᵢ − ν̄)(νᵢ − ν̄)ᵀ + β₀ ν̄ν̄ᵀ (= Σβνν' − ν̄ν̄')
+    c = 1.0 - beta0
     nbar = (nb0, nb1, nb2)
     for a in range(3):
         for b in range(3):
             s = beta0 * nbar[a] * nbar[b]
             for j in range(mval):
                 s += beta[j] * (nu[j, a] - nbar[a]) * (nu[j, b] - nbar[b])
-            sp[a, b] = s
-    # P = β₀ P⁻ + (1 − β₀) [A P⁻ Aᵀ + K R Kᵀ] + K spread Kᵀ
-    c = 1.0 - beta0
-    for a in range(3):
-        for b in range(3):
-            tmp2[a, b] = c * R[a, b] + sp[a, b]
+            tmp2[a, b] = c * R[a, b] + s
+    # P = β₀ P⁻ + (1 − β₀) [A P⁻ Aᵀ + K R Kᵀ] + K spread Kᵀ   (Joseph form inside)
     for i in range(n):
         for j in range(n):
             s = 0.0
@@ -222,6 +218,35 @@ def _pda_update(x, P, xp, Pp, H, HP, R, L, nu, beta, beta0, mval, K, A, tmp, tmp
             val = 0.5 * (P[i, j] + P[j, i])
             P[i, j] = val
             P[j, i] = val
+
+
+@njit(cache=True)
+def _healthy(x, P, psi, Lw):
+    """True when x, P, ψ are finite, ψ ∈ [0, 1] and P is symmetric positive definite."""
+    n = x.shape[0]
+    if not (0.0 <= psi <= 1.0):
+        return False
+    for i in range(n):
+        if not math.isfinite(x[i]):
+            return False
+        for j in range(n):
+            if not math.isfinite(P[i, j]) or P[i, j] != P[j, i]:
+                return False
+    # Cholesky: every pivot must be > 0
+    for j in range(n):
+        s = P[j, j]
+        for k in range(j):
+            s -= Lw[j, k] * Lw[j, k]
+        if not s > 0.0:
+            return False
+        d = math.sqrt(s)
+        Lw[j, j] = d
+        for i in range(j + 1, n):
+            t = P[i, j]
+            for k in range(j):
+                t -= Lw[i, k] * Lw[j, k]
+            Lw[i, j] = t / d
+    return True
 
 
 @njit(cache=True)
@@ -289,6 +314,9 @@ def _track_kernel(
     conf_xy,
     n_conf,
     n_tr,
+    check,
+    n_bad,
+    chol,
 ):
     n = F.shape[0]
     pdpg = p_d * p_g
@@ -479,6 +507,10 @@ def _track_kernel(
                         best = t
             n_conf[o] = nc
             n_tr[o] = nt
+            if check:
+                for t in range(nt):
+                    if not _healthy(X[t], P[t], psi[t], chol):
+                        n_bad[o] += 1
             if best >= 0:
                 has[o] = True
                 est_xy[o, 0] = X[best, 0]
@@ -496,6 +528,8 @@ def track_frames(
     trajectories: np.ndarray,
     params: TrackerParams,
     frame_period_s: float,
+    *,
+    check: bool = False,
 ):
     """Track the selected trajectories with the compiled kernel.
 
@@ -511,6 +545,9 @@ def track_frames(
         (K_sel,) indices of the trajectories to track.
     params, frame_period_s
         Tracker parameters and time step T (s).
+    check
+        Count, per frame, the live tracks whose state, covariance or ψ is unhealthy (non-finite,
+        ψ outside [0, 1], P not symmetric positive definite); returned as a 9th array.
 
     Returns
     -------
@@ -533,6 +570,7 @@ def track_frames(
     conf_xy = np.full((n_out, params.max_tracks, 2), np.nan)
     n_conf = np.zeros(n_out, dtype=np.int64)
     n_tr = np.zeros(n_out, dtype=np.int64)
+    n_bad = np.zeros(n_out, dtype=np.int64)
     nonparam = params.nonparametric
     _track_kernel(
         np.ascontiguousarray(z, dtype=np.float64),
@@ -564,5 +602,9 @@ def track_frames(
         conf_xy,
         n_conf,
         n_tr,
+        bool(check),
+        n_bad,
+        np.zeros((d, d)),
     )
-    return est_xy, has, est_psi, conf_xy, n_conf, n_tr, est_x, est_P
+    out = (est_xy, has, est_psi, conf_xy, n_conf, n_tr, est_x, est_P)
+    return (*out, n_bad) if check else out

@@ -77,13 +77,13 @@ class TrackerParams:
     """
 
     model: str = "cv"
-    q_coeff: float = 1.0
+    q_coeff: float = 2.0
     r11: float = 0.05
     r22: float = 0.03
     r33: float = 0.3
     p0: tuple[float, ...] = DEFAULT_P0["cv"]
     p_d: float = 0.9
-    p_te: float = 0.3
+    p_te: float = 0.2
     p11: float = 0.98
     p21: float = 0.0
     p_g: float = 0.99
