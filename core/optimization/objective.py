@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Sequence
+from collections.abc import Container, Sequence
 from dataclasses import dataclass, field
 from typing import Any, Protocol
 
@@ -175,6 +175,7 @@ def evaluate(
     *,
     trial: Reports | None = None,
     pruner: str = "asha",
+    prune_steps: Container[int] | None = None,
 ) -> TrialResult:
     """L_t of ``params`` (eq. 14), reporting to ``trial`` after every trajectory.
 
@@ -189,6 +190,10 @@ def evaluate(
     pruner
         ``"asha"`` reports the running mean at step i (1-based count of trajectories done);
         ``"wilcoxon"`` reports L(k) at step k; ``"none"`` reports nothing.
+    prune_steps
+        Steps after which ``should_prune`` is asked (None: every step). Successive halving only
+        acts at its rungs, so asking there alone gives the same decisions with fewer storage
+        reads.
 
     Returns
     -------
@@ -217,7 +222,8 @@ def evaluate(
             else:
                 # running mean after i trajectories: L̄_i = (1/i) Σ_j L(k_j)
                 trial.report(float(np.mean(ls)), i)
-            if i < len(order) and trial.should_prune():
+            ask = prune_steps is None or i in prune_steps
+            if ask and i < len(order) and trial.should_prune():
                 return TrialResult(
                     value=float(np.mean(ls)),
                     losses=tuple(ls),

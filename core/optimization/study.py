@@ -147,9 +147,10 @@ class TrialSummary:
 def make_sampler(kind: str, seed: int | None) -> Any:
     """Optuna sampler with every argument set explicitly (Optuna 5 changed the defaults).
 
-    TPE: independent (univariate) Parzen estimators as in Bergstra et al. 2011 and the paper's
-    Optuna version, 10 random start-up trials, 24 EI candidates, prior and magic clip on, and the
-    constant liar so that parallel workers do not sample the same point while trials run.
+    TPE: independent (univariate) Parzen estimators as in Bergstra et al. 2011 and the Optuna 3
+    default the paper used, 10 random start-up trials, 24 EI candidates, and the constant liar so
+    that parallel workers do not sample the same point while trials run. (Prior, magic clip and
+    endpoints keep their defaults: their arguments are deprecated in Optuna 5.)
     """
     import optuna
 
@@ -158,18 +159,27 @@ def make_sampler(kind: str, seed: int | None) -> Any:
     if kind != "tpe":
         raise InputError(f"sampler must be one of {', '.join(SAMPLERS)}, got {kind!r}")
     return optuna.samplers.TPESampler(
-        consider_prior=True,
-        prior_weight=1.0,
-        consider_magic_clip=True,
-        consider_endpoints=False,
         n_startup_trials=10,
         n_ei_candidates=24,
         seed=seed,
-        multivariate=False,
+        multivariate=True,
         group=False,
-        warn_independent_sampling=False,
         constant_liar=True,
     )
+
+
+#: successive halving: first rung after one round over the five classes, reduction factor η
+ASHA_MIN_RESOURCE = 5
+ASHA_REDUCTION_FACTOR = 3
+
+
+def asha_rungs(n_steps: int) -> list[int]:
+    """Steps at which successive halving decides: r·η^k ≤ n_steps (5, 15, 45, …)."""
+    rungs, step = [], ASHA_MIN_RESOURCE
+    while step <= n_steps:
+        rungs.append(step)
+        step *= ASHA_REDUCTION_FACTOR
+    return rungs
 
 
 def make_pruner(kind: str) -> Any:
@@ -178,7 +188,10 @@ def make_pruner(kind: str) -> Any:
 
     if kind == "asha":
         return optuna.pruners.SuccessiveHalvingPruner(
-            min_resource=5, reduction_factor=3, min_early_stopping_rate=0, bootstrap_count=0
+            min_resource=ASHA_MIN_RESOURCE,
+            reduction_factor=ASHA_REDUCTION_FACTOR,
+            min_early_stopping_rate=0,
+            bootstrap_count=0,
         )
     if kind == "wilcoxon":
         return optuna.pruners.WilcoxonPruner(p_threshold=0.1, n_startup_steps=5)
@@ -230,8 +243,8 @@ def fail_stale_trials(study: Any, *, stale_after_s: float = STALE_AFTER_S) -> li
         age = (now - t.datetime_start).total_seconds() if t.datetime_start else math.inf
         if alive is False or (alive is None and age > stale_after_s):
             try:
-                study._storage.set_trial_state_values(t._trial_id, state=TrialState.FAIL)
                 study._storage.set_trial_user_attr(t._trial_id, "stale", True)
+                study._storage.set_trial_state_values(t._trial_id, state=TrialState.FAIL)
             except RuntimeError:  # finished meanwhile
                 continue
             failed.append(t.number)
@@ -372,12 +385,16 @@ def run_worker(
         **dict(attrs.get("objective_options") or {}),
     )
     fail_stale_trials(study)
+    n_steps = len(losses.trajectory_classes)
+    prune_steps = set(asha_rungs(n_steps)) if attrs["pruner"] == "asha" else None
     me = worker_id()
     finished = 0
     failures = 0
     while not stop():
         if count_trials(study) >= n_total:
-            break
+            # slots held by RUNNING trials of dead workers are freed, then counted again
+            if not fail_stale_trials(study) or count_trials(study) >= n_total:
+                break
         trial = study.ask()
         try:
             trial.set_user_attr("worker", me)
@@ -386,7 +403,9 @@ def run_worker(
                 study.tell(trial, state=TrialState.FAIL)
                 break
             params = tracker_params_dict(suggest_params(trial, model), model)
-            result = evaluate(losses, params, trial=trial, pruner=attrs["pruner"])
+            result = evaluate(
+                losses, params, trial=trial, pruner=attrs["pruner"], prune_steps=prune_steps
+            )
         except KeyboardInterrupt:
             study.tell(trial, state=TrialState.FAIL)
             raise
