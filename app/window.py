@@ -180,6 +180,7 @@ class MainWindow(QtWidgets.QMainWindow):
     def _build_playback_bar(self) -> None:
         bar = QtWidgets.QToolBar("Playback", self)
         bar.setObjectName("playbackBar")
+        self.playback_bar = bar
         self.addToolBar(QtCore.Qt.BottomToolBarArea, bar)
         style = self.style()
         self.act_back = bar.addAction(
@@ -535,7 +536,7 @@ class MainWindow(QtWidgets.QMainWindow):
 
     # ---- drawing ----
     def _on_view_options(self, *_args) -> None:
-        self.top_view.colour_by = self.colour_combo.currentData()
+        self.top_view.set_colour_by(self.colour_combo.currentData())
         self.top_view.persistence = self.persistence_spin.value()
         self.top_view.trail_length = self.trail_spin.value()
         self._dirty = True
@@ -689,7 +690,7 @@ class MainWindow(QtWidgets.QMainWindow):
         except InputError:
             pass
         colour = s.value("view/colour_by", "snr", type=str)
-        self.top_view.colour_by = colour if colour in ("snr", "label") else "snr"
+        self.top_view.set_colour_by(colour if colour in ("snr", "label") else "snr")
         self.top_view.persistence = max(1, min(100, s.value("view/persistence", 5, type=int)))
         self.top_view.trail_length = max(1, min(1000, s.value("view/trail_length", 25, type=int)))
         self._sync_view_options()

@@ -50,7 +50,7 @@ class TopView(pg.PlotWidget):
         self.setAspectLocked(True)
         self.setLabel("bottom", "x", units="m")
         self.setLabel("left", "y", units="m")
-        self.setTitle("Top view")
+        self.setTitle("Top view — points by SNR 10 → 50 dB (dark → bright)")
         self.showGrid(x=True, y=True, alpha=0.2)
         self.addLegend(offset=(5, 5))
         self._snr_brushes = _snr_palette()
@@ -82,16 +82,26 @@ class TopView(pg.PlotWidget):
             name="gate (tentative)",
         )
         self.truth_now = pg.ScatterPlotItem(
-            symbol="star", size=16, brush=pg.mkBrush(255, 255, 255), pen=pg.mkPen("k"), name="truth"
+            symbol="star",
+            size=14,
+            brush=None,
+            pen=pg.mkPen((255, 255, 255), width=1.5),
+            name="truth",
         )
         self.addItem(self.truth_now)
         self.tracks = pg.ScatterPlotItem(size=13, pen=pg.mkPen("k", width=1), name="tracks")
         self.addItem(self.tracks)
         self.estimate = pg.ScatterPlotItem(
-            symbol="+", size=20, pen=pg.mkPen((255, 40, 40), width=3), name="estimate"
+            symbol="x", size=16, pen=pg.mkPen((255, 40, 40), width=2), brush=None, name="estimate"
         )
         self.addItem(self.estimate)
         self._labels: list[pg.TextItem] = []
+        # drawing order: gates and tracks under the points, truth and estimate on top
+        for z, item in enumerate(
+            (self.aoi, self.truth_path, self.trails, self.gates_tentative, self.gates_confirmed,
+             self.tracks, self.reflectors, self.points, self.truth_now, self.estimate)
+        ):  # fmt: skip
+            item.setZValue(z)
         self.waypoint_line = self.plot(
             pen=pg.mkPen((255, 0, 255), width=1, style=QtCore.Qt.DashLine), symbol=None
         )
@@ -168,6 +178,14 @@ class TopView(pg.PlotWidget):
         self.waypoint_added.emit(float(p.x()), float(p.y()))
 
     # ---- per frame ----------------------------------------------------------------------------
+    def set_colour_by(self, mode: str) -> None:
+        self.colour_by = mode
+        self.setTitle(
+            "Top view — points by SNR 10 → 50 dB (dark → bright)"
+            if mode == "snr"
+            else "Top view — points by label: person (orange), clutter (blue), noise (grey)"
+        )
+
     def _point_brushes(
         self, frames: Sequence[FrameData]
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -1,0 +1,69 @@
+"""A short study started from the panel completes in separate processes and fills the
+best-parameter table, while the event loop keeps running (a test QTimer measures it)."""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+import pytest
+from PySide6 import QtCore
+
+
+@pytest.mark.xfail(
+    reason="core.optimization objective reads DatasetEstimates.xy; core.tracking names it "
+    "estimate_xy (tune/tracker integration, being fixed on branch tune)",
+    strict=False,
+)
+def test_short_study_from_panel_keeps_event_loop_alive(
+    window, qtbot, tmp_path, long_scene_frames, long_scene_doc, fill_cache
+) -> None:
+    scene, frames = long_scene_frames
+    fill_cache(window, long_scene_doc, frames)
+    storage = tmp_path / "study.db"
+    panel = window.study_panel
+    panel.trials.setValue(4)
+    panel.jobs.setValue(1)
+    panel.storage.setText(str(storage))
+    panel.storage.editingFinished.emit()
+    assert window.study_model.form.storage == str(storage)
+
+    ticks: list[float] = []
+    timer = QtCore.QTimer()
+    timer.setInterval(10)
+    timer.timeout.connect(lambda: ticks.append(time.perf_counter()))
+    timer.start()
+    qtbot.wait(100)
+
+    panel.start_button.click()
+    assert window.study_model.running and not panel.start_button.isEnabled()
+    window.study_model.message.connect(lambda m: print("study:", m, flush=True))
+    finished = []
+    window.study.finished.connect(lambda: finished.append(True))
+    qtbot.waitUntil(lambda: bool(finished), timeout=120000)
+    timer.stop()
+
+    p = window.study_model.progress
+    assert p.n_complete + p.n_pruned == 4, window.errors
+    assert p.n_complete >= 1 and np.isfinite(p.best_loss) and p.best_loss > 0
+    assert panel.table.rowCount() == len(window.engine.param_specs("cv")) == 12
+    names = {panel.table.item(i, 0).text() for i in range(panel.table.rowCount())}
+    assert names == {s.name for s in window.engine.param_specs("cv")}
+    assert panel.progress_bar.value() == 4
+    assert f"complete {p.n_complete}" in panel.counts.text()
+    assert len(p.curve_t_s) == p.n_complete and np.all(np.diff(p.curve_best) <= 0)
+    assert not window.study_model.running and panel.start_button.isEnabled()
+
+    gaps = np.diff(ticks)
+    print(f"\nevent loop: {len(ticks)} ticks, longest gap {gaps.max() * 1e3:.0f} ms")
+    assert gaps.max() < 0.1
+
+    # apply best: the sliders take the best trial's parameters (and re-track)
+    panel.apply_button.click()
+    for name, value in p.best_params.items():
+        assert window.params_model.values[name] == pytest.approx(value)
+        assert window.tracker_panel.rows[name].spin.value() == pytest.approx(value, abs=1e-4)
+    # enqueue the current sliders as the next trial of the stored study
+    window.params_model.set_value("q_coeff", 3.0)
+    panel.enqueue_button.click()
+    assert "enqueued" in window.statusBar().currentMessage(), window.errors
