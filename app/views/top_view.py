@@ -123,8 +123,10 @@ class TopView(pg.PlotWidget):
         line = aoi_polyline(min_range_m, max_range_m, max_azimuth_deg)
         self.aoi.setData(line[:, 0], line[:, 1])
         half = max_range_m * np.sin(np.deg2rad(max_azimuth_deg))
-        self.setXRange(-half - 0.5, half + 0.5, padding=0)
-        self.setYRange(-0.2, max_range_m + 0.5, padding=0)
+        # one call: with the aspect locked the view widens whichever axis it must
+        self.getPlotItem().vb.setRange(
+            xRange=(-half - 0.5, half + 0.5), yRange=(-0.2, max_range_m + 0.5), padding=0
+        )
 
     def set_reflectors(self, xy_m: np.ndarray) -> None:
         xy = np.asarray(xy_m, dtype=float).reshape(-1, 2)
