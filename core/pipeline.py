@@ -741,3 +741,35 @@ def scene_clutter_density(scene: Scene, settings: ProcessingSettings | None = No
         * scene.radar.max_velocity_mps
     )
     return n_false / volume
+
+
+def paper_dataset_file(
+    seed: int = 0,
+    n_trajectories: int = 35,
+    *,
+    fidelity: str = "exact",
+    cache_dir: str | os.PathLike | None = None,
+    jobs: int | None = None,
+    progress: ProgressCallback | None = None,
+) -> Path:
+    """Path of the cached paper data set (simulated first if not cached).
+
+    For study workers, which should receive a file path rather than an in-memory data set: the
+    file lives in the cache under its content key, so it is never stale.
+    """
+    scenes = paper_scenes(seed, n_trajectories)
+    seeds = [s.seed for s in scenes]
+    root = Path(cache_dir) if cache_dir is not None else default_cache_dir()
+    key = dataset_key(scenes, fidelity=fidelity, seed=seed, seeds=seeds)
+    path = root / "datasets" / f"{key}.npz"
+    if not path.is_file():
+        build_dataset(
+            scenes,
+            seeds=seeds,
+            fidelity=fidelity,
+            seed=seed,
+            jobs=jobs,
+            cache_dir=root,
+            progress=progress,
+        )
+    return path

@@ -5,7 +5,7 @@ The public API is Qt-free and Optuna-free at its surface: the GUI uses :class:`S
 ``is_running()``), :func:`study_progress`, :func:`enqueue_params` and :data:`SEARCH_SPACE`.
 """
 
-from core.optimization.data import paper_dataset_path, resolve_dataset
+from core.optimization.data import resolve_dataset
 from core.optimization.objective import (
     QuadraticLosses,
     TrackerLosses,
@@ -67,7 +67,6 @@ __all__ = [
     "make_sampler",
     "normalize_url",
     "open_storage",
-    "paper_dataset_path",
     "prepare_study",
     "resolve_dataset",
     "round_robin_order",

@@ -120,7 +120,6 @@ class TrackerLosses:
     def __init__(self, dataset: Any, base_params: dict[str, Any] | None = None) -> None:
         self.dataset = dataset
         self.base_params = dict(base_params or {})
-        self._offsets = dataset.trajectory_offsets
 
     @property
     def trajectory_classes(self) -> tuple[str, ...]:
@@ -132,24 +131,10 @@ class TrackerLosses:
 
         tp = TrackerParams.from_dict({**self.base_params, **params})
         est = track_dataset(self.dataset, tp, trajectories=[k])
-        lo, hi = int(self._offsets[k]), int(self._offsets[k + 1])
-        xy, has = trajectory_estimates(est, k, lo, hi)
-        truth = self.dataset.truth_xy_m[lo:hi, 0, :]
-        value, mse, n_c = trajectory_loss(xy, has, truth)
+        # person 0 is the tracked person; est.frame_index are the trajectory's global frames
+        truth = self.dataset.truth_xy_m[est.frame_index, 0, :]
+        value, mse, n_c = trajectory_loss(est.estimate_xy, est.has_estimate, truth)
         return float(value), float(mse), int(n_c)
-
-
-def trajectory_estimates(est: Any, k: int, lo: int, hi: int) -> tuple[np.ndarray, np.ndarray]:
-    """Estimate positions ``(F_k, 2)`` and the has-estimate mask ``(F_k,)`` of trajectory k.
-
-    Accepts the tracker's estimates indexed by global frame (length F) or only the frames of the
-    tracked trajectories (length F_k).
-    """
-    xy = np.asarray(est.xy_m if hasattr(est, "xy_m") else est.xy)
-    has = np.asarray(est.has_estimate)
-    if len(has) >= hi:
-        return xy[lo:hi], has[lo:hi]
-    return xy[: hi - lo], has[: hi - lo]
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)

@@ -7,6 +7,8 @@ class a–e, ~750 frames). ``radartune dataset`` measures the full set (see docs
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import pytest
 
 from core.dataset import Dataset
@@ -17,10 +19,15 @@ SEED = 0
 
 
 @pytest.fixture(scope="session")
-def paper_subset(tmp_path_factory: pytest.TempPathFactory) -> Dataset:
-    cache = tmp_path_factory.mktemp("radartune-cache")
-    ds = paper_dataset(SEED, N_TRAJECTORIES, cache_dir=cache, jobs=2)
+def paper_cache(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The cache folder the session's paper subset is simulated into."""
+    return tmp_path_factory.mktemp("radartune-cache")
+
+
+@pytest.fixture(scope="session")
+def paper_subset(paper_cache: Path) -> Dataset:
+    ds = paper_dataset(SEED, N_TRAJECTORIES, cache_dir=paper_cache, jobs=2)
     # the second call reads the cached file: what the tests see is what the cache holds
-    again = paper_dataset(SEED, N_TRAJECTORIES, cache_dir=cache, jobs=2)
+    again = paper_dataset(SEED, N_TRAJECTORIES, cache_dir=paper_cache, jobs=2)
     assert again.n_frames == ds.n_frames
     return again

@@ -78,3 +78,12 @@ def test_a_trajectory_of_the_set_re_simulates_alone(paper_subset: Dataset) -> No
         for f in ("range_m", "azimuth_rad", "radial_velocity_mps", "snr_db", "source"):
             np.testing.assert_array_equal(getattr(fr.point_cloud, f), getattr(expected, f))
         np.testing.assert_array_equal(ds.truth_xy_m[first + fr.index], fr.truth_xy_m)
+
+
+def test_paper_dataset_file_is_the_cached_set(paper_subset: Dataset, paper_cache) -> None:
+    from core.pipeline import paper_dataset_file
+
+    cache = paper_cache
+    path = paper_dataset_file(0, N_TRAJECTORIES, cache_dir=cache)
+    assert path.parent == cache / "datasets" and path.is_file()
+    np.testing.assert_array_equal(Dataset.load(path).range_m, paper_subset.range_m)
