@@ -10,6 +10,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from core.errors import InputError
 from core.pointcloud import PointCloud
 
 
@@ -151,3 +152,55 @@ class ParamSpec:
     high: float
     log: bool
     label: str = ""
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class StudyForm:
+    """What the study panel edits."""
+
+    model: str = "cv"
+    n_trials: int = 50
+    n_jobs: int = 1
+    storage: str = "radartune-studies.db"
+    study_name: str = ""
+    seed: int = 0
+    #: "scene": the current scene's cached point clouds; "paper": the paper's 35 trajectories
+    dataset: str = "scene"
+
+    def __post_init__(self) -> None:
+        if self.model not in ("cv", "ca"):
+            raise InputError(f"model must be 'cv' or 'ca', got {self.model!r}", "model")
+        if self.n_trials < 1:
+            raise InputError(f"trials must be >= 1, got {self.n_trials}", "trials")
+        if self.n_jobs < 1:
+            raise InputError(f"jobs must be >= 1, got {self.n_jobs}", "jobs")
+        if not self.storage.strip():
+            raise InputError("storage must not be empty", "storage")
+        if self.dataset not in ("scene", "paper"):
+            raise InputError(
+                f"data set must be 'scene' or 'paper', got {self.dataset!r}", "dataset"
+            )
+
+    @property
+    def effective_name(self) -> str:
+        return self.study_name or f"radartune-{self.model}"
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class StudyProgress:
+    """A snapshot of a study (from its storage)."""
+
+    n_complete: int = 0
+    n_pruned: int = 0
+    n_failed: int = 0
+    n_running: int = 0
+    best_loss: float = float("nan")
+    best_params: dict = field(default_factory=dict)
+    best_model: str = "cv"
+    #: best-so-far loss against wall-clock seconds since the first trial started
+    curve_t_s: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    curve_best: np.ndarray = field(default_factory=lambda: np.zeros(0))
+
+    @property
+    def n_finished(self) -> int:
+        return self.n_complete + self.n_pruned + self.n_failed

@@ -69,6 +69,13 @@ class ClassParamSpec:
     help: str = ""
 
 
+def describe(exc: BaseException) -> str:
+    """One line for the user: an InputError as is, anything else with its type."""
+    if isinstance(exc, InputError):
+        return str(exc)
+    return f"{type(exc).__name__}: {exc}"
+
+
 # ---- scenes -----------------------------------------------------------------------------------
 def paper_document() -> dict:
     """The paper scene document (``resources/scenes/paper_class_c.json``)."""
@@ -490,8 +497,8 @@ def start_study(form, dataset_path: str | None = None) -> StudyProcesses:
 
 
 def study_progress(form):
-    """Read a study's trials into a :class:`app.study.StudyProgress`."""
-    from app.study import StudyProgress
+    """Read a study's trials into a :class:`app.data.StudyProgress`."""
+    from app.data import StudyProgress
     from core.optimization import study_progress as _progress
 
     url = storage_url(form.storage)

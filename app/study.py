@@ -1,72 +1,26 @@
-"""Study model and controller: Optuna studies run in separate processes (started through
-:mod:`core.optimization` via the engine); the GUI polls their progress from a pool thread, so
-the window never waits for a study or its storage."""
+"""Study model and controller. Studies run in separate processes: the study service
+(:mod:`app.study_service`, one helper process started with ``QProcess``) creates the study,
+starts its worker processes through :mod:`core.optimization`, and answers progress polls; the
+GUI only writes and reads JSON lines, so it never waits for a study or its storage, and Optuna
+never enters the GUI process."""
 
 from __future__ import annotations
 
 import dataclasses
+import json
+import os
+import sys
+import tempfile
 import time
-import traceback
-from dataclasses import dataclass, field
 from pathlib import Path
 
-import numpy as np
 from PySide6 import QtCore
 
-from app.workers import describe_error
+from app.data import StudyForm, StudyProgress
 from core.errors import InputError
 
-
-@dataclass(frozen=True, slots=True, kw_only=True)
-class StudyForm:
-    """What the study panel edits."""
-
-    model: str = "cv"
-    n_trials: int = 50
-    n_jobs: int = 1
-    storage: str = "radartune-studies.db"
-    study_name: str = ""
-    seed: int = 0
-    #: "scene": the current scene's cached point clouds; "paper": the paper's 35 trajectories
-    dataset: str = "scene"
-
-    def __post_init__(self) -> None:
-        if self.model not in ("cv", "ca"):
-            raise InputError(f"model must be 'cv' or 'ca', got {self.model!r}", "model")
-        if self.n_trials < 1:
-            raise InputError(f"trials must be >= 1, got {self.n_trials}", "trials")
-        if self.n_jobs < 1:
-            raise InputError(f"jobs must be >= 1, got {self.n_jobs}", "jobs")
-        if not self.storage.strip():
-            raise InputError("storage must not be empty", "storage")
-        if self.dataset not in ("scene", "paper"):
-            raise InputError(
-                f"data set must be 'scene' or 'paper', got {self.dataset!r}", "dataset"
-            )
-
-    @property
-    def effective_name(self) -> str:
-        return self.study_name or f"radartune-{self.model}"
-
-
-@dataclass(frozen=True, slots=True, kw_only=True)
-class StudyProgress:
-    """A snapshot of a study (from its storage)."""
-
-    n_complete: int = 0
-    n_pruned: int = 0
-    n_failed: int = 0
-    n_running: int = 0
-    best_loss: float = float("nan")
-    best_params: dict = field(default_factory=dict)
-    best_model: str = "cv"
-    #: best-so-far loss against wall-clock seconds since the first trial started
-    curve_t_s: np.ndarray = field(default_factory=lambda: np.zeros(0))
-    curve_best: np.ndarray = field(default_factory=lambda: np.zeros(0))
-
-    @property
-    def n_finished(self) -> int:
-        return self.n_complete + self.n_pruned + self.n_failed
+#: stderr of the study service process (tracebacks, worker start-up messages)
+SERVICE_LOG = Path(tempfile.gettempdir()) / "radartune-study-service.log"
 
 
 class StudyModel(QtCore.QObject):
@@ -97,43 +51,86 @@ class StudyModel(QtCore.QObject):
             self.running_changed.emit(running)
 
 
-class _PollSignals(QtCore.QObject):
-    done = QtCore.Signal(int, object)
-    failed = QtCore.Signal(int, str)
-    started = QtCore.Signal(object)
-    start_failed = QtCore.Signal(str)
+class StudyService(QtCore.QObject):
+    """The GUI's end of :mod:`app.study_service`: a ``QProcess`` spoken to in JSON lines.
 
+    Requests never block: :meth:`request` writes a line and returns; the answer arrives as a
+    call of the given callback from the event loop.
+    """
 
-class _StartJob(QtCore.QRunnable):
-    def __init__(self, engine, form, dataset_path, signals) -> None:
-        super().__init__()
-        self._engine, self._form, self._path, self._signals = engine, form, dataset_path, signals
+    def __init__(self, parent=None) -> None:
+        super().__init__(parent)
+        self._proc: QtCore.QProcess | None = None
+        self._buffer = b""
+        self._next_id = 0
+        self._callbacks: dict[int, tuple] = {}
+        self.n_pending = 0
 
-    def run(self) -> None:
-        try:
-            handle = self._engine.start_study(self._form, self._path)
-            self._signals.started.emit(handle)
-        except Exception as exc:
-            traceback.print_exc()
-            self._signals.start_failed.emit(describe_error(exc))
+    def _ensure(self) -> QtCore.QProcess:
+        if self._proc is None or self._proc.state() == QtCore.QProcess.NotRunning:
+            proc = QtCore.QProcess(self)
+            env = QtCore.QProcessEnvironment.systemEnvironment()
+            root = str(Path(__file__).resolve().parents[1])
+            old = env.value("PYTHONPATH", "")
+            env.insert("PYTHONPATH", root + (os.pathsep + old if old else ""))
+            proc.setProcessEnvironment(env)
+            proc.setWorkingDirectory(str(Path.cwd()))
+            proc.setProcessChannelMode(QtCore.QProcess.SeparateChannels)
+            proc.setStandardErrorFile(str(SERVICE_LOG))
+            proc.readyReadStandardOutput.connect(self._on_output)
+            proc.finished.connect(self._on_finished)
+            proc.start(sys.executable, ["-m", "app.study_service"])
+            self._proc = proc
+            self._buffer = b""
+        return self._proc
 
+    def request(self, op: str, on_result, on_error, **payload) -> None:
+        proc = self._ensure()
+        self._next_id += 1
+        self._callbacks[self._next_id] = (on_result, on_error)
+        self.n_pending += 1
+        line = json.dumps({"id": self._next_id, "op": op, **payload}) + "\n"
+        proc.write(line.encode())
 
-class _PollJob(QtCore.QRunnable):
-    def __init__(self, engine, form, ticket, signals) -> None:
-        super().__init__()
-        self._engine, self._form, self._ticket, self._signals = engine, form, ticket, signals
+    def _on_output(self) -> None:
+        self._buffer += bytes(self._proc.readAllStandardOutput())
+        *lines, self._buffer = self._buffer.split(b"\n")
+        for raw in lines:
+            if not raw.strip():
+                continue
+            try:
+                msg = json.loads(raw)
+            except json.JSONDecodeError:
+                continue
+            cbs = self._callbacks.pop(msg.get("id"), None)
+            if cbs is None:
+                continue
+            self.n_pending -= 1
+            on_result, on_error = cbs
+            if msg.get("ok"):
+                on_result(msg.get("result"))
+            else:
+                on_error(str(msg.get("error")))
 
-    def run(self) -> None:
-        try:
-            progress = self._engine.study_progress(self._form)
-            self._signals.done.emit(self._ticket, progress)
-        except Exception as exc:
-            traceback.print_exc()
-            self._signals.failed.emit(self._ticket, describe_error(exc))
+    def _on_finished(self, *_args) -> None:
+        pending, self._callbacks = self._callbacks, {}
+        self.n_pending = 0
+        for _on_result, on_error in pending.values():
+            on_error(f"study service stopped (see {SERVICE_LOG})")
+
+    def shutdown(self, timeout_ms: int = 30000) -> None:
+        """Stop the study's workers and the service process (blocks: close, tests only)."""
+        if self._proc is None or self._proc.state() == QtCore.QProcess.NotRunning:
+            return
+        self._proc.write(b'{"id": null, "op": "shutdown"}\n')
+        self._proc.closeWriteChannel()
+        if not self._proc.waitForFinished(timeout_ms):
+            self._proc.kill()
+            self._proc.waitForFinished(5000)
 
 
 class StudyController(QtCore.QObject):
-    """Starts and stops study processes and polls their progress (never blocking the GUI)."""
+    """Starts, polls and stops studies through the study service (never blocking the GUI)."""
 
     finished = QtCore.Signal()
     start_failed = QtCore.Signal(str)
@@ -142,86 +139,78 @@ class StudyController(QtCore.QObject):
         super().__init__(parent)
         self._engine = engine
         self._model = model
-        self._handle = None
-        self._pool = QtCore.QThreadPool(self)
-        self._pool.setMaxThreadCount(1)
-        self._signals = _PollSignals()
-        self._signals.done.connect(self._on_progress)
-        self._signals.failed.connect(self._on_poll_failed)
-        self._signals.started.connect(self._on_started)
-        self._signals.start_failed.connect(self._on_start_failed)
-        self._starting = False
+        self.service = StudyService(self)
         self._timer = QtCore.QTimer(self)
         self._timer.setInterval(poll_ms)
         self._timer.timeout.connect(self._poll)
-        self._ticket = 0
+        self._running = False
         self._polling = False
-        self._final_poll = False
-        self.dashboard_url: str | None = None
         self._dashboard = None
         self.t_started = 0.0
-        self._stop_requested = False
 
     @property
     def running(self) -> bool:
-        return self._handle is not None or self._starting
+        return self._running
+
+    def _form_dict(self) -> dict:
+        return dataclasses.asdict(self._model.form)
 
     def start(self, dataset_path: str | None = None) -> None:
-        """Create the study and start its processes from a pool thread (Optuna's import and
-        the study creation take seconds; the window keeps running)."""
-        if self.running:
+        """Create the study and start its worker processes (in the service process)."""
+        if self._running:
             raise InputError("a study is already running", "study")
         form = self._model.form
         Path(form.storage).expanduser().resolve().parent.mkdir(parents=True, exist_ok=True)
-        self._starting = True
-        self._stop_requested = False
+        self._running = True
         self._model.set_running(True)
         self._model.message.emit(f"starting study {form.effective_name} …")
-        self._pool.start(_StartJob(self._engine, form, dataset_path, self._signals))
+        self.service.request(
+            "start", self._on_started, self._on_start_failed,
+            form=self._form_dict(), dataset=dataset_path,
+        )  # fmt: skip
 
-    def _on_started(self, handle) -> None:
-        self._starting = False
-        self._handle = handle
+    def _on_started(self, _result) -> None:
         self.t_started = time.perf_counter()
         form = self._model.form
         self._model.message.emit(f"study {form.effective_name} started ({form.n_jobs} process(es))")
-        if self._stop_requested:
-            self._handle.stop()
         self._timer.start()
 
     def _on_start_failed(self, message: str) -> None:
-        self._starting = False
+        self._running = False
         self._model.set_running(False)
         self._model.message.emit(f"cannot start study: {message}")
         self.start_failed.emit(message)
 
     def stop(self) -> None:
-        if self._handle is not None:
-            self._handle.stop()
-            self._model.message.emit("stopping study …")
-        elif self._starting:
-            self._stop_requested = True
+        if self._running:
+            self.service.request("stop", lambda _r: None, self._model.message.emit)
+            self._model.message.emit("stopping study (workers finish their current trial) …")
 
     def _poll(self) -> None:
-        if self._handle is not None and not self._handle.alive():
-            self._handle = None
-            self._final_poll = True
         if self._polling:
             return
         self._polling = True
-        self._ticket += 1
-        self._pool.start(_PollJob(self._engine, self._model.form, self._ticket, self._signals))
+        self.service.request(
+            "progress", self._on_progress, self._on_poll_failed, form=self._form_dict()
+        )
 
     def refresh(self) -> None:
-        """Poll once (e.g. to show an existing storage)."""
-        self._poll()
+        """Poll once to show what an existing storage holds (no-op for a missing file)."""
+        storage = self._model.form.storage
+        if "://" in storage and not storage.startswith(("sqlite", "journal")):
+            self._poll()
+        elif Path(storage.split(":///")[-1]).expanduser().is_file():
+            self._poll()
 
-    def _on_progress(self, ticket: int, progress: StudyProgress) -> None:
+    def _on_progress(self, result: dict) -> None:
+        from app.study_service import progress_from_dict
+
         self._polling = False
+        progress = progress_from_dict(result)
         self._model.set_progress(progress)
-        if self._final_poll:
-            self._final_poll = False
+        if self._running and not result.get("alive", False) and self._timer.isActive():
             self._timer.stop()
+            self._running = False
             self._model.set_running(False)
             self._model.message.emit(
                 f"study finished: {progress.n_complete} complete, {progress.n_pruned} pruned, "
@@ -229,33 +218,31 @@ class StudyController(QtCore.QObject):
             )
             self.finished.emit()
 
-    def _on_poll_failed(self, ticket: int, message: str) -> None:
+    def _on_poll_failed(self, message: str) -> None:
         self._polling = False
         self._model.message.emit(f"study progress: {message}")
-        if self._final_poll:
-            self._final_poll = False
+        if self._running and self._timer.isActive() and "stopped" in message:
             self._timer.stop()
+            self._running = False
             self._model.set_running(False)
             self.finished.emit()
 
-    def enqueue(self, values: dict, model: str) -> None:
-        self._engine.enqueue_trial(self._model.form, values, model)
-        self._model.message.emit("current sliders enqueued as the next trial")
+    def enqueue(self, values: dict, model: str, on_error=None) -> None:
+        self.service.request(
+            "enqueue",
+            lambda _r: self._model.message.emit("current sliders enqueued as the next trial"),
+            on_error or self._model.message.emit,
+            form=self._form_dict(), values=values, model=model,
+        )  # fmt: skip
 
     def open_dashboard(self) -> str:
-        if self._dashboard is None:
+        if self._dashboard is None or not self._dashboard.alive():
             self._dashboard = self._engine.serve_dashboard(self._model.form)
         return self._dashboard.url
 
-    def shutdown(self, timeout_ms: int = 10000) -> None:
+    def shutdown(self, timeout_ms: int = 30000) -> None:
         self._timer.stop()
-        self._pool.waitForDone(timeout_ms)  # a start in flight delivers its handle first
-        QtCore.QCoreApplication.sendPostedEvents(self)
-        if self._handle is not None:
-            self._handle.stop()
-            self._handle.join(timeout_ms / 1000)
-            self._handle = None
+        self.service.shutdown(timeout_ms)
         if self._dashboard is not None:
             self._dashboard.shutdown()
             self._dashboard = None
-        self._pool.waitForDone(timeout_ms)

@@ -28,7 +28,7 @@ from app.study import StudyController, StudyModel
 from app.views.psi_view import PsiView
 from app.views.rd_view import RangeDopplerView
 from app.views.top_view import TopView
-from app.workers import SimulationController, TrackingController, describe_error
+from app.workers import SimulationController, TrackingController, describe_error, freeze_heap
 from core.config import PAPER_RADAR
 from core.errors import InputError
 
@@ -163,6 +163,7 @@ class MainWindow(QtWidgets.QMainWindow):
             self.restore_settings()
         if load_scene:
             self.load_initial_scene(scene_path)
+        freeze_heap()
 
     # ---- construction helpers ----
     def _dock(self, title: str, widget: QtWidgets.QWidget, area) -> None:
@@ -467,6 +468,7 @@ class MainWindow(QtWidgets.QMainWindow):
         self._update_frame_label()
 
     def _on_cache_finished(self) -> None:
+        freeze_heap()  # the cached frames live as long as the scene
         self.tracker.request()
 
     def _on_tracked(self, fast_s: float, detail_s: float) -> None:
@@ -613,12 +615,11 @@ class MainWindow(QtWidgets.QMainWindow):
             self.show_error(f"cannot start study: {describe_error(exc)}")
 
     def enqueue_current(self) -> None:
-        try:
-            self.study.enqueue(self.params_model.values, self.params_model.model)
-        except InputError as exc:
-            self.show_error(str(exc))
-        except Exception as exc:
-            self.show_error(f"cannot enqueue: {describe_error(exc)}")
+        self.study.enqueue(
+            self.params_model.values,
+            self.params_model.model,
+            on_error=lambda m: self.show_error(f"cannot enqueue: {m}"),
+        )
 
     def open_dashboard(self) -> None:
         try:
