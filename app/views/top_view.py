@@ -50,7 +50,7 @@ class TopView(pg.PlotWidget):
         self.setAspectLocked(True)
         self.setLabel("bottom", "x", units="m")
         self.setLabel("left", "y", units="m")
-        self.setTitle("Top view — points by SNR 10 → 50 dB (dark → bright)")
+        self.setTitle("Top view · points: SNR 10–50 dB")
         self.showGrid(x=True, y=True, alpha=0.2)
         self.addLegend(offset=(5, 5))
         self._snr_brushes = _snr_palette()
@@ -117,16 +117,29 @@ class TopView(pg.PlotWidget):
         self.last_n_points = 0
         self.last_n_tracks = 0
         self.set_aoi(0.5, 10.0, 60.0)
+        # once the user pans or zooms, the view stays where they put it
+        self.getPlotItem().vb.sigRangeChangedManually.connect(self._stop_auto_fit)
 
     # ---- static content ---------------------------------------------------------------------
     def set_aoi(self, min_range_m: float, max_range_m: float, max_azimuth_deg: float) -> None:
         line = aoi_polyline(min_range_m, max_range_m, max_azimuth_deg)
         self.aoi.setData(line[:, 0], line[:, 1])
         half = max_range_m * np.sin(np.deg2rad(max_azimuth_deg))
-        # one call: with the aspect locked the view widens whichever axis it must
-        self.getPlotItem().vb.setRange(
-            xRange=(-half - 0.5, half + 0.5), yRange=(-0.2, max_range_m + 0.5), padding=0
-        )
+        self._aoi_rect = QtCore.QRectF(-half - 0.5, -0.2, 2 * half + 1.0, max_range_m + 0.7)
+        self._auto_fit = True
+        self.fit_aoi()
+
+    def fit_aoi(self) -> None:
+        """Show the whole AOI (the aspect lock widens whichever axis it must)."""
+        self.getPlotItem().vb.setRange(rect=self._aoi_rect, padding=0)
+
+    def resizeEvent(self, event) -> None:
+        super().resizeEvent(event)
+        if getattr(self, "_auto_fit", False):
+            self.fit_aoi()
+
+    def _stop_auto_fit(self, *_args) -> None:
+        self._auto_fit = False
 
     def set_reflectors(self, xy_m: np.ndarray) -> None:
         xy = np.asarray(xy_m, dtype=float).reshape(-1, 2)
@@ -183,9 +196,9 @@ class TopView(pg.PlotWidget):
     def set_colour_by(self, mode: str) -> None:
         self.colour_by = mode
         self.setTitle(
-            "Top view — points by SNR 10 → 50 dB (dark → bright)"
+            "Top view · points: SNR 10–50 dB"
             if mode == "snr"
-            else "Top view — points by label: person (orange), clutter (blue), noise (grey)"
+            else "Top view · points: person / clutter / noise"
         )
 
     def _point_brushes(
