@@ -10,6 +10,7 @@ and grabs each view with ``QWidget.grab()``. Settings go to a temporary file, ne
 from __future__ import annotations
 
 import argparse
+import shutil
 import sys
 import tempfile
 import time
@@ -101,6 +102,7 @@ def main(argv: list[str] | None = None) -> int:
     save(w.scene_panel, "scene_waypoints.png")
     save(w.top_view, "top_view_waypoints.png")
     w.shutdown()
+    shutil.rmtree(tmp, ignore_errors=True)
     print("\n".join(str(out / s) for s in shots))
     return 0
 

@@ -85,6 +85,7 @@ class StudyPanel(QtWidgets.QWidget):
         self.curve_plot.setLabel("bottom", "wall-clock time", units="s")
         self.curve_plot.setLabel("left", "loss L_t [m²]")
         self.curve_plot.setLogMode(y=True)
+        self.curve_plot.getAxis("left").enableAutoSIPrefix(False)
         self.curve_plot.setMinimumHeight(140)
         self.curve = self.curve_plot.plot(
             pen=pg.mkPen((255, 140, 0), width=2), symbol="o", symbolSize=4, stepMode=None

@@ -11,7 +11,7 @@ from PySide6 import QtCore
 
 
 def test_short_study_from_panel_keeps_event_loop_alive(
-    window, qtbot, tmp_path, long_scene_frames, long_scene_doc, fill_cache
+    window, qtbot, tmp_path, long_scene_frames, long_scene_doc, fill_cache, monkeypatch
 ) -> None:
     scene, frames = long_scene_frames
     fill_cache(window, long_scene_doc, frames)
@@ -78,3 +78,22 @@ def test_short_study_from_panel_keeps_event_loop_alive(
     panel.enqueue_button.click()
     qtbot.waitUntil(lambda: any("enqueued" in m for _, m in events), timeout=30000)
     assert not window.errors
+
+    # the dashboard serves this storage (the browser call is intercepted)
+    opened = []
+    monkeypatch.setattr("webbrowser.open", lambda url: opened.append(url))
+    panel.dashboard_button.click()
+    qtbot.waitUntil(lambda: bool(opened), timeout=10000)
+    import json
+    import urllib.request
+
+    for _ in range(60):
+        try:
+            with urllib.request.urlopen(opened[0] + "api/studies", timeout=2) as r:
+                studies = json.loads(r.read())["study_summaries"]
+            break
+        except OSError:
+            qtbot.wait(500)
+    else:
+        raise AssertionError("optuna-dashboard did not answer")
+    assert [s["study_name"] for s in studies] == ["radartune-cv"]
