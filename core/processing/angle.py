@@ -16,9 +16,16 @@ azimuth position differ by ``pi sin(el)`` in phase: ``sin(el) = arg(sum x_e conj
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 
 from core.config import RadarConfig
+
+
+def _frozen(a: np.ndarray) -> np.ndarray:
+    a.flags.writeable = False
+    return a
 
 
 def _parabolic_offset(a: np.ndarray, b: np.ndarray, c: np.ndarray) -> np.ndarray:
@@ -45,8 +52,13 @@ def azimuth_row(radar: RadarConfig) -> tuple[np.ndarray, np.ndarray]:
     The row is the set of channels at the lowest elevation position; where two channels share
     an azimuth position the first is used.
     """
-    el = np.asarray(radar.elevation_positions)
-    az = np.asarray(radar.azimuth_positions)
+    return _azimuth_row(radar.azimuth_positions, radar.elevation_positions)
+
+
+@functools.lru_cache(maxsize=32)
+def _azimuth_row(az_pos: tuple, el_pos: tuple) -> tuple[np.ndarray, np.ndarray]:
+    el = np.asarray(el_pos)
+    az = np.asarray(az_pos)
     base = el.min()
     channels, positions, seen = [], [], set()
     for v in np.flatnonzero(el == base):
@@ -55,13 +67,18 @@ def azimuth_row(radar: RadarConfig) -> tuple[np.ndarray, np.ndarray]:
             channels.append(v)
             positions.append(int(az[v]))
     pos = np.asarray(positions)
-    return np.asarray(channels), pos - pos.min()
+    return _frozen(np.asarray(channels)), _frozen(pos - pos.min())
 
 
 def elevation_pairs(radar: RadarConfig) -> tuple[np.ndarray, np.ndarray]:
     """Pairs ``(elevated channel, row channel)`` at the same azimuth position, one above."""
-    el = np.asarray(radar.elevation_positions)
-    az = np.asarray(radar.azimuth_positions)
+    return _elevation_pairs(radar.azimuth_positions, radar.elevation_positions)
+
+
+@functools.lru_cache(maxsize=32)
+def _elevation_pairs(az_pos: tuple, el_pos: tuple) -> tuple[np.ndarray, np.ndarray]:
+    el = np.asarray(el_pos)
+    az = np.asarray(az_pos)
     base = el.min()
     upper, lower = [], []
     for v in np.flatnonzero(el == base + 1):
@@ -69,7 +86,7 @@ def elevation_pairs(radar: RadarConfig) -> tuple[np.ndarray, np.ndarray]:
         if match.size:
             upper.append(v)
             lower.append(match[0])
-    return np.asarray(upper, dtype=np.int64), np.asarray(lower, dtype=np.int64)
+    return _frozen(np.asarray(upper, dtype=np.int64)), _frozen(np.asarray(lower, dtype=np.int64))
 
 
 def tdm_compensate(channels: np.ndarray, doppler_bin: np.ndarray, radar: RadarConfig) -> np.ndarray:

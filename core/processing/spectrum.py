@@ -126,13 +126,40 @@ def remove_static_clutter(range_cube: np.ndarray) -> np.ndarray:
     return x - x.mean(axis=1, keepdims=True, dtype=np.complex64)
 
 
-def doppler_fft(range_cube: np.ndarray, window_name: str = "hann", *, workers: int | None = None):
+@functools.lru_cache(maxsize=64)
+def _doppler_taps(window_name: str, n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Window with the fftshift folded in, and the non-zero bins of its DFT (index, value)."""
+    w = window(window_name, n).astype(np.float64)
+    if n % 2 == 0:
+        # fftshift folded into the window: X[k - N/2] <-> x[m] * (-1)^m
+        w = w * np.where(np.arange(n) % 2 == 0, 1.0, -1.0)
+    W = np.fft.fft(w)
+    if n % 2 == 1:
+        W = np.fft.fftshift(W)
+    idx = np.flatnonzero(np.abs(W) > 1e-9 * np.abs(W).max())
+    return w.astype(np.float32), idx, W[idx].astype(np.complex64)
+
+
+def doppler_fft(
+    range_cube: np.ndarray,
+    window_name: str = "hann",
+    *,
+    remove_static: bool = False,
+    workers: int | None = None,
+) -> np.ndarray:
     """Doppler FFT along loops, zero velocity centred.
 
     Parameters
     ----------
     range_cube
         ``[virtual channel, loop, range bin]``, complex.
+    window_name
+        Window along loops.
+    remove_static
+        Static clutter removal folded into the FFT (same result as
+        :func:`remove_static_clutter` first, one pass less): the FFT is linear, so
+        ``FFT(w (x - mean x)) = FFT(w x) - mean(x) W``, and the window's DFT ``W`` is non-zero
+        on a few bins only (periodic Hann: 3).
 
     Returns
     -------
@@ -142,14 +169,15 @@ def doppler_fft(range_cube: np.ndarray, window_name: str = "hann", *, workers: i
     """
     x = np.asarray(range_cube)
     n = x.shape[1]
-    w = window(window_name, n)
-    if n % 2 == 0:
-        # fftshift folded into the window: X[k - N/2] <-> x[m] * (-1)^m
-        w = w * np.where(np.arange(n) % 2 == 0, 1.0, -1.0).astype(np.float32)
+    w, idx, taps = _doppler_taps(window_name, n)
     y = x.transpose(0, 2, 1) * w  # one pass: transpose to [v, range, loop] and window
     out = scipy.fft.fft(y.astype(np.complex64, copy=False), axis=-1, workers=workers)
     if n % 2 == 1:
         out = np.fft.fftshift(out, axes=-1)
+    if remove_static:
+        mu = x.mean(axis=1, dtype=np.complex64)  # [v, range]
+        # Y_j = X_j - mean * W_j on the bins where the window's DFT is non-zero
+        out[:, :, idx] -= mu[:, :, None] * taps
     return out
 
 

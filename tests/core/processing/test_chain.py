@@ -183,3 +183,47 @@ def test_same_seed_same_frame_other_seed_other_noise() -> None:
     np.testing.assert_array_equal(a.point_cloud.range_m, b.point_cloud.range_m)
     assert not np.array_equal(a.rd_map_db, c.rd_map_db)
     assert len(a.point_cloud) == len(a.detections)
+
+
+def test_fused_clutter_removal_equals_separate_stage() -> None:
+    sc = Scatterers.concatenate(
+        [scat([2.0, 6.0, 0.0], [0.0, 0.0, 0.0], 10.0, -1), radial(4.0, 10.0, 1.3)]
+    )
+    rc = range_fft(synthesize_signal(RADAR, sc, IDEAL))
+    for name in ("hann", "rect", "blackman"):
+        a = doppler_fft(remove_static_clutter(rc), name)
+        b = doppler_fft(rc, name, remove_static=True)
+        assert np.max(np.abs(a - b)) < 1e-5 * np.max(np.abs(a))
+
+
+def test_truncated_map_gives_the_same_points() -> None:
+    sc = Scatterers.concatenate([radial(3.0, 5.0, 0.8), radial(9.8, -40.0, -2.0, 3.0, -1)])
+    a = simulate_frame(RADAR, sc, np.random.default_rng(12), antenna=IDEAL)
+    b = simulate_frame(RADAR, sc, np.random.default_rng(12), antenna=IDEAL, keep_rd_map=True)
+    np.testing.assert_array_equal(a.detections, b.detections)
+    np.testing.assert_allclose(a.point_cloud.range_m, b.point_cloud.range_m)
+    np.testing.assert_allclose(a.point_cloud.azimuth_rad, b.point_cloud.azimuth_rad)
+    assert b.rd_map_db.shape == (256, 32)
+
+
+@pytest.mark.parametrize("name", ["long_range", "high_velocity"])
+def test_variant_radars_run_through_the_chain(name: str) -> None:
+    from pathlib import Path
+
+    from core.config import read_ti_cfg
+
+    radar = read_ti_cfg(Path(__file__).resolve().parents[3] / "resources" / "radar" / f"{name}.cfg")
+    antenna = AntennaGain.ideal(radar)
+    t_mid = 0.5 * radar.n_loops * radar.n_tx * radar.chirp_period_s
+    vr = 12.0 if name == "high_velocity" else -2.0  # 12 m/s is unambiguous only on this radar
+    az = np.radians(-25.0)
+    u = np.array([np.sin(az), np.cos(az), 0.0])
+    sc = scat((6.0 - vr * t_mid) * u, vr * u, 5.0, 0)
+    out = simulate_frame(radar, sc, np.random.default_rng(13), antenna=antenna, keep_rd_map=True)
+    assert out.rd_map_db.shape == (radar.n_samples, radar.n_loops)
+    pc = out.point_cloud
+    i = np.argmax(pc.snr_db)
+    assert pc.source[i] == 0
+    assert pc.range_m[i] == pytest.approx(6.0, abs=radar.range_resolution_m / 2)
+    assert np.degrees(pc.azimuth_rad[i]) == pytest.approx(-25.0, abs=1.0)
+    assert pc.radial_velocity_mps[i] == pytest.approx(vr, rel=0.05)
