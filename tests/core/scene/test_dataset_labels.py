@@ -87,3 +87,26 @@ def test_paper_dataset_file_is_the_cached_set(paper_subset: Dataset, paper_cache
     path = paper_dataset_file(0, N_TRAJECTORIES, cache_dir=cache)
     assert path.parent == cache / "datasets" and path.is_file()
     np.testing.assert_array_equal(Dataset.load(path).range_m, paper_subset.range_m)
+
+
+def test_tangential_walker_is_hidden_radial_walker_is_seen() -> None:
+    """Same speed (0.5 m/s), same place: across the line of sight |vr| <= 0.04 m/s, inside the
+    zero-Doppler notch of static clutter removal; along it vr = -0.5 m/s (1.1 bins)."""
+    from core.pipeline import simulate_scene
+    from core.scene import Person, Scene, profile_trajectory
+
+    def walker(v0):
+        traj = profile_trajectory(
+            initial_position_m=[-0.4, 5.0],
+            initial_velocity_mps=v0,
+            acceleration_mps2=[0.0, 0.0],
+            frames=20,
+        )
+        scene = Scene(seed=5, clutter_density_per_m2=0.0, persons=(Person(trajectory=traj),))
+        run = simulate_scene(scene)
+        return np.mean([np.any(c.source == 0) for c in run.clouds])
+
+    tangential = walker([0.5, 0.0])
+    radial = walker([0.0, -0.5])
+    assert radial >= 0.95
+    assert tangential <= 0.3
