@@ -134,6 +134,8 @@ class TrackerLosses:
 
         tp = TrackerParams.from_dict({**self.base_params, **params})
         est = track_dataset(self.dataset, tp, trajectories=list(ks))
+        if not len(ks):
+            return []
         # person 0 is the tracked person; est.frame_index are the tracked global frames
         truth = self.dataset.truth_xy_m[est.frame_index, 0, :]
         out = []
