@@ -128,14 +128,19 @@ class TrackerLosses:
     def trajectory_classes(self) -> tuple[str, ...]:
         return tuple(str(c) for c in self.dataset.trajectory_class)
 
+    def warm_up(self, model: str) -> None:
+        """Load the compiled tracker (numba) before the first trial, so trial times are honest."""
+        flat = {b.name: b.high for b in search_space(model)}
+        self.losses(tracker_params_dict(flat, model), [0])
+
     def losses(self, params: dict[str, Any], ks: Sequence[int]) -> list[tuple[float, float, int]]:
         from core.evaluation import trajectory_loss
         from core.tracking import TrackerParams, track_dataset
 
-        tp = TrackerParams.from_dict({**self.base_params, **params})
-        est = track_dataset(self.dataset, tp, trajectories=list(ks))
         if not len(ks):
             return []
+        tp = TrackerParams.from_dict({**self.base_params, **params})
+        est = track_dataset(self.dataset, tp, trajectories=list(ks))
         # person 0 is the tracked person; est.frame_index are the tracked global frames
         truth = self.dataset.truth_xy_m[est.frame_index, 0, :]
         out = []
