@@ -41,8 +41,8 @@ class TrajectoryLosses(Protocol):
         """Class label of each trajectory, length K."""
         ...
 
-    def loss(self, params: dict[str, Any], k: int) -> tuple[float, float, int]:
-        """``(L(k), MSE(k), N_c(k))`` of trajectory ``k`` for TrackerParams JSON ``params``."""
+    def losses(self, params: dict[str, Any], ks: Sequence[int]) -> list[tuple[float, float, int]]:
+        """``(L(k), MSE(k), N_c(k))`` of each trajectory ``k`` in ``ks`` for TrackerParams JSON."""
         ...
 
 
@@ -84,7 +84,10 @@ class QuadraticLosses:
             return self.classes
         return tuple("abcde"[k % 5] for k in range(self.n_trajectories))
 
-    def loss(self, params: dict[str, Any], k: int) -> tuple[float, float, int]:
+    def losses(self, params: dict[str, Any], ks: Sequence[int]) -> list[tuple[float, float, int]]:
+        return [self._loss(params, k) for k in ks]
+
+    def _loss(self, params: dict[str, Any], k: int) -> tuple[float, float, int]:
         if self.delay_s:
             time.sleep(self.delay_s)
         p = dict(params)
@@ -125,16 +128,27 @@ class TrackerLosses:
     def trajectory_classes(self) -> tuple[str, ...]:
         return tuple(str(c) for c in self.dataset.trajectory_class)
 
-    def loss(self, params: dict[str, Any], k: int) -> tuple[float, float, int]:
+    def warm_up(self, model: str) -> None:
+        """Load the compiled tracker (numba) before the first trial, so trial times are honest."""
+        flat = {b.name: b.high for b in search_space(model)}
+        self.losses(tracker_params_dict(flat, model), [0])
+
+    def losses(self, params: dict[str, Any], ks: Sequence[int]) -> list[tuple[float, float, int]]:
         from core.evaluation import trajectory_loss
         from core.tracking import TrackerParams, track_dataset
 
+        if not len(ks):
+            return []
         tp = TrackerParams.from_dict({**self.base_params, **params})
-        est = track_dataset(self.dataset, tp, trajectories=[k])
-        # person 0 is the tracked person; est.frame_index are the trajectory's global frames
+        est = track_dataset(self.dataset, tp, trajectories=list(ks))
+        # person 0 is the tracked person; est.frame_index are the tracked global frames
         truth = self.dataset.truth_xy_m[est.frame_index, 0, :]
-        value, mse, n_c = trajectory_loss(est.estimate_xy, est.has_estimate, truth)
-        return float(value), float(mse), int(n_c)
+        out = []
+        for i in range(len(ks)):
+            s = slice(int(est.offsets[i]), int(est.offsets[i + 1]))
+            value, mse, n_c = trajectory_loss(est.estimate_xy[s], est.has_estimate[s], truth[s])
+            out.append((float(value), float(mse), int(n_c)))
+        return out
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -189,40 +203,50 @@ def evaluate(
     order = round_robin_order(losses.trajectory_classes)
     if not order:
         raise InputError("the data set has no trajectories")
+    n = len(order)
+    # Trajectories are tracked in chunks that end where the pruner is asked (every step for
+    # Wilcoxon, the rungs for ASHA, once without pruning): the values reported after each
+    # trajectory are the same, with fewer calls into the tracker.
+    if trial is None or pruner == "none":
+        ends = [n]
+    elif prune_steps is None:
+        ends = list(range(1, n + 1))
+    else:
+        ends = sorted({i for i in prune_steps if 0 < i < n} | {n})
     ls: list[float] = []
     ms: list[float] = []
     ns: list[int] = []
-    done: list[int] = []
-    for i, k in enumerate(order, start=1):
-        value, mse, n_c = losses.loss(params, k)
-        if not math.isfinite(value):
-            raise FloatingPointError(f"trajectory {k}: loss is {value}")
-        ls.append(value)
-        ms.append(mse)
-        ns.append(n_c)
-        done.append(k)
-        if trial is not None and pruner != "none":
-            if pruner == "wilcoxon":
-                trial.report(value, k)
-            else:
-                # running mean after i trajectories: L̄_i = (1/i) Σ_j L(k_j)
-                trial.report(float(np.mean(ls)), i)
-            ask = prune_steps is None or i in prune_steps
-            if ask and i < len(order) and trial.should_prune():
-                return TrialResult(
-                    value=float(np.mean(ls)),
-                    losses=tuple(ls),
-                    mse=tuple(ms),
-                    n_c=tuple(ns),
-                    order=tuple(done),
-                    pruned=True,
-                )
+    start = 0
+    for end in ends:
+        for value, mse, n_c in losses.losses(params, order[start:end]):
+            k = order[len(ls)]
+            if not math.isfinite(value):
+                raise FloatingPointError(f"trajectory {k}: loss is {value}")
+            ls.append(value)
+            ms.append(mse)
+            ns.append(n_c)
+            if trial is not None and pruner != "none":
+                if pruner == "wilcoxon":
+                    trial.report(value, k)
+                else:
+                    # running mean after i trajectories: L̄_i = (1/i) Σ_j L(k_j)
+                    trial.report(float(np.mean(ls)), len(ls))
+        start = end
+        if trial is not None and pruner != "none" and end < n and trial.should_prune():
+            return TrialResult(
+                value=float(np.mean(ls)),
+                losses=tuple(ls),
+                mse=tuple(ms),
+                n_c=tuple(ns),
+                order=tuple(order[:end]),
+                pruned=True,
+            )
     return TrialResult(
         value=float(np.mean(ls)),
         losses=tuple(ls),
         mse=tuple(ms),
         n_c=tuple(ns),
-        order=tuple(done),
+        order=tuple(order),
         pruned=False,
     )
 

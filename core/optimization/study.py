@@ -384,6 +384,8 @@ def run_worker(
         load_dataset_for(attrs, dataset_path),
         **dict(attrs.get("objective_options") or {}),
     )
+    if hasattr(losses, "warm_up"):
+        losses.warm_up(model)
     fail_stale_trials(study)
     n_steps = len(losses.trajectory_classes)
     prune_steps = set(asha_rungs(n_steps)) if attrs["pruner"] == "asha" else None
