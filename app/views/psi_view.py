@@ -51,10 +51,14 @@ class PsiView(pg.GraphicsLayoutWidget):
         self.ospa_curve = self.metric_plot.plot(pen=pg.mkPen((60, 140, 255), width=1), name="OSPA")
         self.cursor2 = pg.InfiniteLine(angle=90, pen=pg.mkPen((200, 200, 200), width=1))
         self.metric_plot.addItem(self.cursor2)
+        self.metric_text = pg.LabelItem(justify="left", color=(230, 230, 230), size="9pt")
+        self.addItem(self.metric_text, row=2, col=0)
         self.ci.layout.setRowStretchFactor(0, 3)
         self.ci.layout.setRowStretchFactor(1, 2)
         self.set_thresholds(0.9, 0.1)
         self._frame_period_s = 0.08
+        self._result: TrackingResult | None = None
+        self._metric_text = ""
         self.n_draws = 0
 
     def set_thresholds(self, confirm: float, delete: float) -> None:
@@ -64,6 +68,7 @@ class PsiView(pg.GraphicsLayoutWidget):
     def set_result(self, result: TrackingResult | None, frame_period_s: float) -> None:
         """Redraw the curves of a whole tracker run."""
         self._frame_period_s = frame_period_s
+        self._result = result
         if result is None or result.n_frames == 0:
             for c in (self.psi_all, self.psi_confirmed, self.rmse_curve, self.ospa_curve):
                 c.setData([], [])
@@ -82,3 +87,16 @@ class PsiView(pg.GraphicsLayoutWidget):
         t = index * self._frame_period_s
         self.cursor.setValue(t)
         self.cursor2.setValue(t)
+        r = self._result
+        if r is None or index >= r.n_frames:
+            text = "running loss – · RMSE – · OSPA –"
+        else:
+            rmse = r.running_rmse_m[index]
+            rmse_t = "–" if rmse != rmse else f"{rmse:.3f} m"
+            text = (
+                f"t = {t:.2f} s · running loss L = {r.running_loss[index]:.3g} m² · "
+                f"RMSE {rmse_t} · OSPA {r.ospa_m[index]:.3f} m"
+            )
+        if text != self._metric_text:
+            self._metric_text = text
+            self.metric_text.setText(text)

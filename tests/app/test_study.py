@@ -97,3 +97,22 @@ def test_short_study_from_panel_keeps_event_loop_alive(
     else:
         raise AssertionError("optuna-dashboard did not answer")
     assert [s["study_name"] for s in studies] == ["radartune-cv"]
+
+
+def test_stop_ends_a_running_study_early(
+    window, qtbot, tmp_path, long_scene_frames, long_scene_doc, fill_cache
+) -> None:
+    scene, frames = long_scene_frames
+    fill_cache(window, long_scene_doc, frames)
+    window.study_model.set_form(n_trials=500, n_jobs=1, storage=str(tmp_path / "stop.db"))
+    window.study_panel.start_button.click()
+    qtbot.waitUntil(lambda: window.study_model.progress.n_finished >= 2, timeout=120000)
+    assert window.study_panel.stop_button.isEnabled()
+    window.study_panel.stop_button.click()
+    finished = []
+    window.study.finished.connect(lambda: finished.append(True))
+    qtbot.waitUntil(lambda: bool(finished), timeout=60000)
+    p = window.study_model.progress
+    assert 2 <= p.n_finished < 500
+    assert p.n_running == 0  # the worker finished its trial; nothing is left RUNNING
+    assert window.study_panel.start_button.isEnabled()
