@@ -89,12 +89,12 @@ class PsiView(pg.GraphicsLayoutWidget):
         self.cursor2.setValue(t)
         r = self._result
         if r is None or index >= r.n_frames:
-            text = "running loss – · RMSE – · OSPA –"
+            text = "running loss –<br>RMSE – · OSPA –"
         else:
             rmse = r.running_rmse_m[index]
             rmse_t = "–" if rmse != rmse else f"{rmse:.3f} m"
             text = (
-                f"t = {t:.2f} s · running loss L = {r.running_loss[index]:.3g} m² · "
+                f"t = {t:.2f} s · running loss L = {r.running_loss[index]:.3g} m²<br>"
                 f"RMSE {rmse_t} · OSPA {r.ospa_m[index]:.3f} m"
             )
         if text != self._metric_text:
