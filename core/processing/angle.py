@@ -22,6 +22,8 @@ import numpy as np
 
 from core.config import RadarConfig
 
+_TINY = float(np.finfo(np.float64).tiny)
+
 
 def _frozen(a: np.ndarray) -> np.ndarray:
     a.flags.writeable = False
@@ -39,7 +41,7 @@ def _parabolic_offset(a: np.ndarray, b: np.ndarray, c: np.ndarray) -> np.ndarray
 
 def log_parabolic_offset(left: np.ndarray, peak: np.ndarray, right: np.ndarray) -> np.ndarray:
     """Sub-bin offset of a spectral peak from the log powers of the peak and its neighbours."""
-    tiny = np.finfo(np.float64).tiny
+    tiny = _TINY
     la, lb, lc = (
         np.log(np.maximum(np.asarray(v, dtype=np.float64), tiny)) for v in (left, peak, right)
     )
@@ -144,15 +146,16 @@ def estimate_angles(
     row = np.zeros((n_det, fft_size), dtype=np.complex128)
     row[:, row_pos] = x[:, row_ch]
     # X_k = sum_p x_p exp(-j 2 pi k p / N): peaks at k = N u / 2
-    spec = np.fft.fftshift(np.fft.fft(row, axis=1), axes=1)
+    spec = np.fft.fft(row, axis=1)  # index k <-> k (k < N/2) or k - N
     power = spec.real**2 + spec.imag**2
     k = np.argmax(power, axis=1)
     i = np.arange(n_det)
     delta = log_parabolic_offset(
         power[i, (k - 1) % fft_size], power[i, k], power[i, (k + 1) % fft_size]
     )
-    # u = sin(az) cos(el) = 2 (k - N/2 + delta) / N
-    u = 2.0 * (k - fft_size // 2 + delta) / fft_size
+    k_signed = np.where(k >= fft_size // 2, k - fft_size, k)
+    # u = sin(az) cos(el) = 2 (k + delta) / N, k centred
+    u = 2.0 * (k_signed + delta) / fft_size
     el = np.zeros(n_det)
     if elevation:
         upper, lower = elevation_pairs(radar)

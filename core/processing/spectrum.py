@@ -87,12 +87,19 @@ def clutter_removal_noise_profile(name: str, n: int) -> np.ndarray:
 
     ``g_k = 1 - |W_k|^2 / (N sum w^2)`` with ``W_k`` the window's DFT; zero velocity centred
     (index ``j`` is bin ``j - N/2``). Periodic Hann: 1/3 at zero Doppler, 5/6 next to it, 1
-    elsewhere; rectangular: 0 at zero Doppler.
+    elsewhere; rectangular: 0 at zero Doppler. Returns a read-only float64 array ``(n,)``.
     """
+    return _noise_profile(name, int(n))
+
+
+@functools.lru_cache(maxsize=64)
+def _noise_profile(name: str, n: int) -> np.ndarray:
     w = window(name, n).astype(np.float64)
     W = np.fft.fftshift(np.fft.fft(w))
     # E|Y_k|^2 / E|Y_k|^2 (no removal) = 1 - |W_k|^2 / (N sum w^2)
-    return 1.0 - np.abs(W) ** 2 / (n * np.sum(w**2))
+    g = 1.0 - np.abs(W) ** 2 / (n * np.sum(w**2))
+    g.flags.writeable = False
+    return g
 
 
 def range_fft(cube: np.ndarray, window_name: str = "hann", *, workers: int | None = None):
