@@ -75,7 +75,14 @@ def run(args: argparse.Namespace) -> int:
         objective=args.objective,
         objective_options=_options(args.objective_option),
     )
-    path = resolve_dataset(args.dataset) if settings.objective == "tracker" else None
+    path = None
+    if settings.objective == "tracker":
+        if args.dataset in (None, "", "paper") or str(args.dataset).startswith("paper:"):
+            print(
+                "data set: the paper's (simulated once and cached; minutes the first time)",
+                file=sys.stderr,
+            )
+        path = resolve_dataset(args.dataset)
     handle = start_study(settings, dataset_path=path)
     bar = None
     if not args.no_progress:

@@ -328,7 +328,10 @@ def load_dataset_for(attrs: dict[str, Any], dataset_path: str | None) -> Any:
     if not path:
         raise InputError("the study records no data set; pass --dataset PATH")
     if not Path(path).is_file():
-        raise InputError(f"data set {path!r} does not exist")
+        raise InputError(
+            f"data set {path!r} (recorded in the study) does not exist here; "
+            "pass --dataset PATH to this machine's copy"
+        )
     return Dataset.load(path)
 
 

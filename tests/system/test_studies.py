@@ -236,3 +236,26 @@ def test_unreachable_database_is_one_line_exit_2() -> None:
     out = cli("tune", "--model", "cv", "--storage", f"postgresql://u:pw@127.0.0.1:{port}/x", *QUAD)
     _one_line_exit_2(out, "cannot open")
     assert "pw" not in out.stderr
+
+
+def test_gui_handle_stops_workers_cleanly(tmp_path: Path) -> None:
+    from core.optimization import StudySettings, start_study
+
+    url = f"sqlite:///{tmp_path}/gui.db"
+    s = StudySettings(model="ca", n_trials=500, n_jobs=2, storage=url, objective="quadratic",
+                      objective_options={"n_trajectories": 5, "delay_s": 0.05})  # fmt: skip
+    handle = start_study(s, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    try:
+        deadline = time.monotonic() + 120
+        while time.monotonic() < deadline:
+            summaries, best = study_progress(url, s.name)
+            if best is not None:
+                break
+            time.sleep(0.2)
+        assert handle.is_running()
+    finally:
+        handle.stop(timeout=60)
+    assert not handle.is_running()
+    assert handle.returncodes() == [0, 0]  # SIGTERM: finish the trial, exit normally
+    states = [t.state for t in study_progress(url, s.name)[0]]
+    assert "RUNNING" not in states and 0 < states.count("COMPLETE") < 500
