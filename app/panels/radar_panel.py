@@ -16,8 +16,8 @@ FIELDS = (
     ("ramp_time_s", "ramp time Tc", "µs", 1e-6, 2, 1.0, 1000.0),
     ("idle_time_s", "idle time Tidle", "µs", 1e-6, 2, 0.0, 1000.0),
     ("sample_rate_hz", "sample rate Fs", "MHz", 1e6, 3, 0.1, 50.0),
-    ("n_samples", "ADC samples Nadc", "", 1, 0, 8, 4096),
-    ("n_loops", "loops Nc", "", 1, 0, 1, 1024),
+    ("n_samples", "ADC samples Nadc", "", 1, 0, 32, 4096),
+    ("n_loops", "loops Nc", "", 1, 0, 16, 1024),
     ("n_tx", "TX antennas", "", 1, 0, 1, 3),
     ("n_rx", "RX antennas", "", 1, 0, 1, 4),
     ("frame_period_s", "frame period Δt", "ms", 1e-3, 2, 1.0, 10000.0),
@@ -28,6 +28,9 @@ FIELDS = (
     ("receiver_bandwidth_hz", "noise bandwidth Be", "MHz", 1e6, 3, 0.01, 100.0),
     ("temperature_k", "temperature T", "K", 1, 1, 1.0, 1000.0),
 )
+
+#: fields that come with the antenna layout (tx_order, virtual array positions), not edited alone
+READ_ONLY = ("n_tx", "n_rx")
 
 #: derived value, label, display unit, SI per display unit, format
 DERIVED = (
@@ -71,6 +74,11 @@ class RadarPanel(QtWidgets.QWidget):
             if unit:
                 spin.setSuffix(f" {unit}")
             spin.valueChanged.connect(lambda v, n=name, s=scale: self._on_field(n, v, s))
+            if name in READ_ONLY:
+                spin.setEnabled(False)
+                spin.setToolTip(
+                    "set by the antenna layout (TX order, virtual array): load a TI .cfg to change"
+                )
             form.addRow(label, spin)
             self.spins[name] = spin
         outer.addWidget(fields)

@@ -280,6 +280,14 @@ class ScenePanel(QtWidgets.QWidget):
             if spin.value() > spin.minimum() and name in allowed
         }
         sx, sy = values.pop("start_x_m", None), values.pop("start_y_m", None)
+        if (sx is None) != (sy is None):
+            # one coordinate given: keep the other where the current trajectory starts
+            scene = self.model.scene
+            i = self.model.selected_person
+            if scene is not None and i < len(scene.persons):
+                x0, y0 = scene.persons[i].trajectory.position_m[0]
+                sx = round(float(x0), 2) if sx is None else sx
+                sy = round(float(y0), 2) if sy is None else sy
         if sx is not None and sy is not None:
             values["start_m"] = [sx, sy]
         traj.update(values)

@@ -69,6 +69,7 @@ def test_radar_panel_both_ways_and_derived_values(window) -> None:
     assert panel.spins["n_samples"].value() == 128
     assert panel.spins["n_loops"].value() == 32
     assert d["max_range_m"].text() == "14.41 m"  # max range does not depend on Nadc
+    assert not panel.spins["n_tx"].isEnabled()  # comes with the antenna layout
     # an invalid combination is refused with a message, the model keeps its value
     panel.spins["frame_period_s"].setValue(1.0)  # 1 ms is shorter than the chirps of a frame
     assert model.radar.frame_period_s == pytest.approx(0.08)
@@ -83,6 +84,15 @@ def test_scene_panel_both_ways(window, qtbot) -> None:
     panel.clutter.setValue(0.05)
     assert model.document["clutter_density_per_m2"] == pytest.approx(0.05)
     assert model.scene.clutter_density_per_m2 == pytest.approx(0.05)
+    # one start coordinate: the other is kept where the trajectory starts now
+    x0, y0 = model.scene.persons[0].trajectory.position_m[0]
+    panel.class_params["start_x_m"].setValue(round(float(x0), 2) + 0.1)
+    start = model.document["persons"][0]["trajectory"].get("start_m")
+    assert start is not None and start[1] == pytest.approx(y0, abs=0.01), window.errors
+    assert panel.class_params["start_y_m"].value() == pytest.approx(y0, abs=0.01)
+    assert model.scene.persons[0].trajectory.position_m[0][0] == pytest.approx(
+        round(float(x0), 2) + 0.1
+    )
     panel.class_combo.setCurrentIndex(4)  # e — circle
     traj = model.document["persons"][0]["trajectory"]
     assert traj["class"] == "e"
