@@ -10,7 +10,6 @@ from __future__ import annotations
 import json
 import math
 import os
-import shutil
 import socket
 import subprocess
 import sys
@@ -539,20 +538,22 @@ def enqueue_trial(form, values: dict[str, float], model: str) -> None:
 
 
 class Dashboard:
-    """optuna-dashboard for a storage, served by a child process on a free local port."""
+    """optuna-dashboard for a storage: ``radartune dashboard`` (core's server, which creates the
+    schema first) in a child process on a free local port, so the GUI never serves HTTP."""
 
     def __init__(self, storage: str) -> None:
-        exe = shutil.which("optuna-dashboard", path=str(Path(sys.executable).parent))
-        if exe is None:
-            raise InputError("optuna-dashboard is not installed", "dashboard")
         with socket.socket() as s:
             s.bind(("127.0.0.1", 0))
             self.port = s.getsockname()[1]
         self.url = f"http://127.0.0.1:{self.port}/"
+        env = dict(os.environ)
+        env["PYTHONPATH"] = os.pathsep.join([str(ROOT), env.get("PYTHONPATH", "")]).rstrip(
+            os.pathsep
+        )
+        cmd = [sys.executable, "-m", "core.cli", "dashboard", "--storage", storage]
+        cmd += ["--port", str(self.port), "--no-browser"]
         self._proc = subprocess.Popen(
-            [exe, storage, "--host", "127.0.0.1", "--port", str(self.port)],
-            stdout=subprocess.DEVNULL,
-            stderr=subprocess.DEVNULL,
+            cmd, cwd=str(ROOT), env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL
         )
 
     def alive(self) -> bool:
@@ -565,6 +566,7 @@ class Dashboard:
                 self._proc.wait(5)
             except subprocess.TimeoutExpired:
                 self._proc.kill()
+                self._proc.wait(5)
 
 
 def serve_dashboard(form) -> Dashboard:
