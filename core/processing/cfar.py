@@ -127,29 +127,43 @@ class Cfar(Protocol):
         ...
 
 
+@functools.lru_cache(maxsize=128)
+def _window_indices(size: int, n: int, g: int, cyclic: bool):
+    """Cumulative-sum indices of the left/right training windows and their validity."""
+    idx = np.arange(size)
+    if cyclic:
+        pad = n + g
+        c = idx + pad
+        ok = np.ones(size, dtype=bool)
+        out = (c - g, c - g - n, c + g + 1 + n, c + g + 1, ok, ok)
+    else:
+        out = (
+            np.clip(idx - g, 0, size),
+            np.clip(idx - g - n, 0, size),
+            np.clip(idx + g + 1 + n, 0, size),
+            np.clip(idx + g + 1, 0, size),
+            idx - g - n >= 0,
+            idx + g + n <= size - 1,
+        )
+    for a in out:
+        a.flags.writeable = False
+    return out
+
+
 def _side_sums(p: np.ndarray, n: int, g: int, cyclic: bool):
     """Left/right training sums along axis 0 of ``p`` (float64) and their validity (N,)."""
     size = p.shape[0]
-    idx = np.arange(size)
+    l_hi, l_lo, r_hi, r_lo, ok_left, ok_right = _window_indices(size, n, g, cyclic)
     if cyclic:
         pad = n + g
         reps = -(-pad // size)
         tiled = np.concatenate([p] * (2 * reps + 1), axis=0)
-        q = tiled[reps * size - pad : reps * size + size + pad]
-        cs = np.concatenate([np.zeros((1, *p.shape[1:])), np.cumsum(q, axis=0)], axis=0)
-        c = idx + pad
-        left = cs[c - g] - cs[c - g - n]
-        right = cs[c + g + 1 + n] - cs[c + g + 1]
-        ok = np.ones(size, dtype=bool)
-        return left, right, ok, ok
-    cs = np.concatenate([np.zeros((1, *p.shape[1:])), np.cumsum(p, axis=0)], axis=0)
-    ok_left = idx - g - n >= 0
-    ok_right = idx + g + n <= size - 1
-    lo = np.clip(idx - g, 0, size)
-    left = cs[lo] - cs[np.clip(idx - g - n, 0, size)]
-    hi = np.clip(idx + g + 1, 0, size)
-    right = cs[np.clip(idx + g + 1 + n, 0, size)] - cs[hi]
-    return left, right, ok_left, ok_right
+        p = tiled[reps * size - pad : reps * size + size + pad]
+    cs = np.empty((p.shape[0] + 1, *p.shape[1:]))
+    cs[0] = 0.0
+    np.cumsum(p, axis=0, out=cs[1:])
+    # Z_left = sum of the n cells before the guard;  Z_right = the n cells after it
+    return cs[l_hi] - cs[l_lo], cs[r_hi] - cs[r_lo], ok_left, ok_right
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)

@@ -87,12 +87,19 @@ def clutter_removal_noise_profile(name: str, n: int) -> np.ndarray:
 
     ``g_k = 1 - |W_k|^2 / (N sum w^2)`` with ``W_k`` the window's DFT; zero velocity centred
     (index ``j`` is bin ``j - N/2``). Periodic Hann: 1/3 at zero Doppler, 5/6 next to it, 1
-    elsewhere; rectangular: 0 at zero Doppler.
+    elsewhere; rectangular: 0 at zero Doppler. Returns a read-only float64 array ``(n,)``.
     """
+    return _noise_profile(name, int(n))
+
+
+@functools.lru_cache(maxsize=64)
+def _noise_profile(name: str, n: int) -> np.ndarray:
     w = window(name, n).astype(np.float64)
     W = np.fft.fftshift(np.fft.fft(w))
     # E|Y_k|^2 / E|Y_k|^2 (no removal) = 1 - |W_k|^2 / (N sum w^2)
-    return 1.0 - np.abs(W) ** 2 / (n * np.sum(w**2))
+    g = 1.0 - np.abs(W) ** 2 / (n * np.sum(w**2))
+    g.flags.writeable = False
+    return g
 
 
 def range_fft(cube: np.ndarray, window_name: str = "hann", *, workers: int | None = None):
@@ -112,9 +119,11 @@ def range_fft(cube: np.ndarray, window_name: str = "hann", *, workers: int | Non
         ``k * range_resolution_m`` (complex sampling: all bins are positive ranges).
     """
     x = np.asarray(cube)
-    if window_name != "rect":
-        x = x * window(window_name, x.shape[-1])
-    return scipy.fft.fft(x.astype(np.complex64, copy=False), axis=-1, workers=workers)
+    if window_name == "rect":
+        return scipy.fft.fft(x.astype(np.complex64, copy=False), axis=-1, workers=workers)
+    # the windowed copy is ours: transform it in place
+    y = (x * window(window_name, x.shape[-1])).astype(np.complex64, copy=False)
+    return scipy.fft.fft(y, axis=-1, workers=workers, overwrite_x=True)
 
 
 def remove_static_clutter(range_cube: np.ndarray) -> np.ndarray:
@@ -166,19 +175,22 @@ def doppler_fft(
     numpy.ndarray
         Doppler cube ``[virtual channel, range bin, Doppler bin]``, complex64; index ``j`` is
         Doppler bin ``j - n_loops // 2`` (velocity ``(j - n_loops // 2) * velocity_resolution``).
+        A transposed view of a ``[v, Doppler, range]`` array (the FFT runs along loops without
+        a transposing copy); ``numpy.ascontiguousarray`` gives a contiguous copy if needed.
     """
     x = np.asarray(range_cube)
     n = x.shape[1]
     w, idx, taps = _doppler_taps(window_name, n)
-    y = x.transpose(0, 2, 1) * w  # one pass: transpose to [v, range, loop] and window
-    out = scipy.fft.fft(y.astype(np.complex64, copy=False), axis=-1, workers=workers)
+    y = (x * w[:, None]).astype(np.complex64, copy=False)
+    # FFT along loops in place; the result is returned as a [v, range, Doppler] view
+    out = scipy.fft.fft(y, axis=1, workers=workers, overwrite_x=True)
     if n % 2 == 1:
-        out = np.fft.fftshift(out, axes=-1)
+        out = np.fft.fftshift(out, axes=1)
     if remove_static:
         mu = x.mean(axis=1, dtype=np.complex64)  # [v, range]
         # Y_j = X_j - mean * W_j on the bins where the window's DFT is non-zero
-        out[:, :, idx] -= mu[:, :, None] * taps
-    return out
+        out[:, idx, :] -= mu[:, None, :] * taps[:, None]
+    return out.transpose(0, 2, 1)
 
 
 def range_doppler_map(doppler_cube: np.ndarray) -> np.ndarray:

@@ -99,11 +99,30 @@ def signal_parameters(radar: RadarConfig, scatterers: Scatterers, antenna: Anten
     )
 
 
+def visible(radar: RadarConfig, scatterers: Scatterers) -> np.ndarray:
+    """``(N,)`` bool: in front of the antennas (|az| < 90 deg, the domain of eq. 1) and closer
+    than the maximum range (the IF filter; beyond it complex sampling would alias the range)."""
+    return (np.abs(scatterers.azimuth_rad) < np.pi / 2) & (scatterers.range_m < radar.max_range_m)
+
+
 def synthesize_signal(radar: RadarConfig, scatterers: Scatterers, antenna: AntennaGain):
-    """Noise-free baseband cube ``[virtual channel, loop, ADC sample]``, complex64, volts."""
+    """Noise-free baseband cube ``[virtual channel, loop, ADC sample]``, complex64, volts.
+
+    Only :func:`visible` scatterers contribute.
+    """
     out = np.zeros((radar.n_virtual, radar.n_loops, radar.n_samples), dtype=np.complex64)
     if len(scatterers) == 0:
         return out
+    keep = visible(radar, scatterers)
+    if not keep.all():
+        scatterers = Scatterers(
+            position_m=scatterers.position_m[keep],
+            velocity_mps=scatterers.velocity_mps[keep],
+            rcs_dbsm=scatterers.rcs_dbsm[keep],
+            source=scatterers.source[keep],
+        )
+        if len(scatterers) == 0:
+            return out
     amp, ranges, steer = signal_parameters(radar, scatterers, antenna)
     # phase 4 pi R / lambda;  beat phase per sample 2 pi (2 S R / c) / Fs
     phase_per_m = 4 * np.pi / radar.wavelength_m

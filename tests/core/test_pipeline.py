@@ -59,14 +59,22 @@ def assert_clouds_identical(a, b) -> None:
 
 
 def test_clutter_density_of_the_paper_scene() -> None:
+    from core.processing import expected_false_alarms_per_frame
+
     scene = Scene.from_json(ROOT / "resources/scenes/paper_class_c.json")
-    # (λ·A + false alarms) / (Δr · Δaz · 2 v_max) = (2.0892 + 5.5e-4) / (9.5 · 2.0944 · 14.482)
-    rho = scene_clutter_density(scene)
-    assert rho == pytest.approx(0.0073, abs=0.0001)
-    assert rho == pytest.approx((2.0892 + 5.5e-4) / (9.5 * 2.0944 * 14.482), rel=2e-3)
-    # without clutter only the chain's own false alarms remain: ~2e-6
+    volume = 9.5 * (2 * np.pi / 3) * 2 * scene.radar.max_velocity_mps  # 288.1 m·rad·m/s
+    assert volume == pytest.approx(288.1, abs=0.1)
+    # SPEC's "about 0.0073" is the clutter term: λ·A / V = 2.0892 / 288.1
     quiet = dataclasses.replace(scene, clutter_density_per_m2=0.0)
-    assert 0 < scene_clutter_density(quiet) < 1e-5
+    rho_fa = scene_clutter_density(quiet)
+    rho = scene_clutter_density(scene)
+    assert rho - rho_fa == pytest.approx(0.00725, abs=0.00001)
+    # plus the chain's own noise detections (joint two-stage CFAR): ~0.20 per frame
+    n_fa = expected_false_alarms_per_frame(scene.radar, pipeline.processing_settings(scene))
+    assert 0.1 < n_fa < 0.3
+    assert rho_fa == pytest.approx(n_fa / volume, rel=1e-12)
+    assert rho == pytest.approx((2.0892 + n_fa) / volume, rel=1e-4)
+    assert rho == pytest.approx(0.00795, abs=0.0001)
 
 
 # ---- the plan ---------------------------------------------------------------------------------
@@ -105,9 +113,13 @@ def test_stages_declare_consistent_needs_and_products() -> None:
         produced |= set(s.produces)
 
 
-def test_unknown_fidelity_is_an_input_error() -> None:
+def test_unknown_fidelity_consumer_or_stage_is_an_input_error() -> None:
     with pytest.raises(InputError, match="fidelity"):
         plan(short_scene(), fidelity="approximate")
+    with pytest.raises(InputError, match="consumer"):
+        plan(short_scene(), consumer="printer")
+    with pytest.raises(InputError, match="clutterr"):
+        plan(short_scene(), force=("clutterr",))
 
 
 # ---- skipped stages are not executed and change nothing --------------------------------------
