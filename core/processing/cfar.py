@@ -302,18 +302,51 @@ class Detections:
 
 def _local_maxima(rd: np.ndarray, r: np.ndarray, d: np.ndarray) -> np.ndarray:
     """True where ``rd[r, d]`` >= its 8 neighbours (range edges open, Doppler cyclic)."""
+    return _local_maxima_kernel(np.asarray(rd), np.asarray(r), np.asarray(d))
+
+
+@numba.njit(cache=True, nogil=True)
+def _local_maxima_kernel(rd, r, d):  # pragma: no cover
     n_r, n_d = rd.shape
-    keep = np.ones(len(r), dtype=bool)
-    for dr in (-1, 0, 1):
-        rr = r + dr
-        inside = (rr >= 0) & (rr < n_r)
-        rr = np.clip(rr, 0, n_r - 1)
-        for dd in (-1, 0, 1):
-            if dr == 0 and dd == 0:
+    keep = np.ones(len(r), dtype=np.bool_)
+    for t in range(len(r)):
+        centre = rd[r[t], d[t]]
+        for dr in (-1, 0, 1):
+            rr = r[t] + dr
+            if rr < 0 or rr >= n_r:
                 continue
-            neighbour = rd[rr, (d + dd) % n_d]
-            keep &= ~inside | (rd[r, d] >= neighbour)
+            for dd in (-1, 0, 1):
+                if (dr != 0 or dd != 0) and rd[rr, (d[t] + dd) % n_d] > centre:
+                    keep[t] = False
     return keep
+
+
+@functools.lru_cache(maxsize=64)
+def _cfar_plan(radar: RadarConfig, settings: ProcessingSettings, n_r: int, n_d: int, L: int):
+    """What two_stage_cfar needs besides the map (range limits, whitening, thresholds)."""
+    k = np.arange(n_r) * radar.range_resolution_m
+    inside = np.flatnonzero((k >= settings.min_range_m) & (k <= settings.max_range_m))
+    if inside.size == 0:
+        return None
+    lo, hi = int(inside[0]), int(inside[-1])
+    rc, dc = settings.range_cfar, settings.doppler_cfar
+    ne_r = ne_d = None
+    profile = None
+    dead = np.zeros(n_d, dtype=np.bool_)
+    if settings.cfar_noise_model:
+        ne_r = _effective(settings.range_window, radar.n_samples, rc.n_train)
+        ne_d = _effective(settings.doppler_window, n_d, dc.n_train)
+        if settings.static_clutter_removal:
+            g = clutter_removal_noise_profile(settings.doppler_window, n_d)
+            dead = g < 0.01
+            profile = np.where(dead, 1.0, g)
+            profile.flags.writeable = False
+    dead.flags.writeable = False
+    # the range stage needs training cells beyond the limits: run it on a margin around them
+    margin = rc.n_train + rc.n_guard
+    a, b = max(0, lo - margin), min(n_r, hi + 1 + margin)
+    args = (*_kernel_args(make_cfar(rc, L, ne_r)), *_kernel_args(make_cfar(dc, L, ne_d)))
+    return lo, hi, a, b, profile, dead, args
 
 
 _METHOD_CODE = {"ca": 0, "caso": 1, "cago": 2}
@@ -430,41 +463,20 @@ def two_stage_cfar(
     rd = np.asarray(rd_map)
     L = radar.n_virtual if n_channels is None else n_channels
     n_r, n_d = rd.shape
-    k = np.arange(n_r) * radar.range_resolution_m
-    in_range = (k >= settings.min_range_m) & (k <= settings.max_range_m)
-    lo, hi = np.flatnonzero(in_range)[[0, -1]] if in_range.any() else (0, -1)
-    if hi < lo:
+    plan = _cfar_plan(radar, settings, n_r, n_d, L)
+    if plan is None:
         return _empty_detections()
-    rc, dc = settings.range_cfar, settings.doppler_cfar
-    ne_r = ne_d = None
-    profile = None
-    if settings.cfar_noise_model:
-        ne_r = _effective(settings.range_window, radar.n_samples, rc.n_train)
-        ne_d = _effective(settings.doppler_window, n_d, dc.n_train)
-        if settings.static_clutter_removal:
-            profile = clutter_removal_noise_profile(settings.doppler_window, n_d)
-    # the range stage needs training cells beyond the limits: run it on a margin around them
-    margin = rc.n_train + rc.n_guard
-    a, b = max(0, lo - margin), min(n_r, hi + 1 + margin)
+    lo, hi, a, b, profile, dead, kernel_args = plan
     if profile is None:
-        sub = rd[a:b]
+        sub = np.asarray(rd[a:b], dtype=np.float64)
     else:
         # whiten: equal noise in every Doppler bin; bins the removal empties (rectangular
         # window: zero Doppler) carry nothing and are never detected
-        dead = profile < 0.01
-        profile = np.where(dead, 1.0, profile)
-        sub = np.where(dead, 0.0, rd[a:b] / profile)
-    cr, cd = make_cfar(rc, L, ne_r), make_cfar(dc, L, ne_d)
-    dead_cols = np.zeros(n_d, dtype=np.bool_) if profile is None else dead
+        sub = rd[a:b] / profile
+        if dead.any():
+            sub[:, dead] = 0.0
     # both stages in one compiled pass (same arithmetic as CaCfar/CasoCfar/CagoCfar.detect)
-    rr, d, noise = _two_stage_kernel(
-        np.ascontiguousarray(sub, dtype=np.float64),
-        lo - a,
-        hi - a,
-        dead_cols,
-        *_kernel_args(cr),
-        *_kernel_args(cd),
-    )
+    rr, d, noise = _two_stage_kernel(np.ascontiguousarray(sub), lo - a, hi - a, dead, *kernel_args)
     r = rr + a
     if settings.peak_grouping and r.size:
         keep = _local_maxima(rd, r, d)
