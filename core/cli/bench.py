@@ -15,7 +15,7 @@ import json
 import platform
 from pathlib import Path
 
-BENCHMARKS = ("sim", "track", "tune", "fidelity")
+BENCHMARKS = ("sim", "track", "tune", "fidelity", "dataset")
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:

@@ -1,0 +1,39 @@
+"""``radartune report --storage URL --out DIR``: Table I, best parameters, loss against time."""
+
+from __future__ import annotations
+
+import argparse
+import shlex
+import sys
+
+
+def add_parser(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("report", help="write the tuning report (Table I, plots, best parameters)")
+    p.add_argument("--storage", required=True, help="storage URL holding the studies")
+    p.add_argument("--out", required=True, help="folder to write report.md, PNGs and JSON into")
+    p.add_argument("--dataset", default=None, help="training data set (default: the studies')")
+    p.add_argument(
+        "--generalisation",
+        default="paper:1",
+        help="second data set from another seed (default: %(default)s; 'none' skips it)",
+    )
+    p.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    from core.optimization.report import write_report
+
+    gen = None if args.generalisation in ("none", "") else args.generalisation
+    command = "radartune " + " ".join(shlex.quote(a) for a in sys.argv[1:])
+    r = write_report(
+        args.storage, args.out, dataset=args.dataset, generalisation_dataset=gen, command=command
+    )
+    for model, m in r["models"].items():
+        line = f"{model.upper()}: L_t = {m['training']['loss_total_x1e3']:.4f} x1e-3"
+        if "generalisation" in m:
+            line += f" (other seed: {m['generalisation']['loss_total_x1e3']:.4f} x1e-3)"
+        print(line)
+    if "conclusion" in r:
+        print(f"CV/CA = {r['conclusion']['cv_over_ca']:.3f}")
+    print(f"written: {args.out}/report.md")
+    return 0

@@ -1,0 +1,280 @@
+"""The objective: track the cached data set with a trial's parameters and return L_t (eq. 14).
+
+A trial never simulates: it tracks the cached point clouds of a :class:`core.dataset.Dataset`.
+Trajectories are evaluated one at a time in round-robin class order (a, b, c, d, e, a, …) and
+after each one the trial reports to the pruner:
+
+- successive halving (ASHA, the default): the running mean loss after ``i`` trajectories,
+  ``L̄_i = (1/i) Σ_{j≤i} L(k_j)`` at step ``i`` — an unbiased estimate of L_t at every rung
+  because every prefix of a round-robin order covers the classes evenly;
+- Wilcoxon: the loss of the trajectory itself, ``L(k_i)`` at step ``k_i``, because the Wilcoxon
+  signed-rank test pairs the per-instance values of a trial with those of the best trial.
+
+Two loss sources share one interface (:class:`TrajectoryLosses`): :class:`TrackerLosses` (the real
+IPDA tracker on a data set) and :class:`QuadraticLosses` (a cheap deterministic function with a
+known minimum and the same shape, used to test and benchmark the study machinery — storage,
+resume, kill, reproducibility — without depending on the tracker's speed).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Container, Sequence
+from dataclasses import dataclass, field
+from typing import Any, Protocol
+
+import numpy as np
+
+from core.errors import InputError
+from core.optimization.space import check_model, search_space, tracker_params_dict
+
+#: score of a trajectory without any confirmed frame (SPEC §5), m²
+NO_CONFIRMATION_LOSS = 1.0
+
+
+class TrajectoryLosses(Protocol):
+    """Per-trajectory paper loss for a parameter set."""
+
+    @property
+    def trajectory_classes(self) -> tuple[str, ...]:
+        """Class label of each trajectory, length K."""
+        ...
+
+    def losses(self, params: dict[str, Any], ks: Sequence[int]) -> list[tuple[float, float, int]]:
+        """``(L(k), MSE(k), N_c(k))`` of each trajectory ``k`` in ``ks`` for TrackerParams JSON."""
+        ...
+
+
+def round_robin_order(classes: Sequence[str]) -> list[int]:
+    """Trajectory indices ordered round-robin over the classes.
+
+    Classes are visited in sorted order, each class's trajectories in their data-set order:
+    ``classes = [a, a, b, b, c]`` → ``[0, 2, 4, 1, 3]``.
+    """
+    by_class: dict[str, list[int]] = {}
+    for k, c in enumerate(classes):
+        by_class.setdefault(str(c), []).append(k)
+    queues = [by_class[c] for c in sorted(by_class)]
+    order: list[int] = []
+    for i in range(max((len(q) for q in queues), default=0)):
+        order.extend(q[i] for q in queues if i < len(q))
+    return order
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class QuadraticLosses:
+    """Deterministic test objective with the shape of the tracker loss and a known minimum.
+
+    In the unit cube of the search space (log-scaled where the space is), with ``u`` the trial's
+    point and ``c`` the optimum: ``L(k) = L_min·(1 + w_k·Σ_i (u_i − c_i)²)``, ``w_k = 1 + k/K``.
+    The optimum ``c`` is the centre of the cube. ``delay_s`` sleeps per trajectory to make trials
+    last long enough to be killed mid-trial in tests.
+    """
+
+    model: str
+    n_trajectories: int = 10
+    loss_min: float = 1e-4
+    delay_s: float = 0.0
+    classes: tuple[str, ...] = field(default=())
+
+    @property
+    def trajectory_classes(self) -> tuple[str, ...]:
+        if self.classes:
+            return self.classes
+        return tuple("abcde"[k % 5] for k in range(self.n_trajectories))
+
+    def losses(self, params: dict[str, Any], ks: Sequence[int]) -> list[tuple[float, float, int]]:
+        return [self._loss(params, k) for k in ks]
+
+    def _loss(self, params: dict[str, Any], k: int) -> tuple[float, float, int]:
+        if self.delay_s:
+            time.sleep(self.delay_s)
+        p = dict(params)
+        for i, v in enumerate(p.get("p0", [])):
+            p[f"p0_{i}{i}"] = v
+        d2 = 0.0
+        for b in search_space(self.model):
+            v = float(p[b.name])
+            if b.log:
+                u = (math.log(v) - math.log(b.low)) / (math.log(b.high) - math.log(b.low))
+            else:
+                u = (v - b.low) / (b.high - b.low)
+            d2 += (u - 0.5) ** 2
+        w = 1.0 + k / max(self.n_trajectories, 1)
+        # L(k) = L_min (1 + w_k |u - c|^2)
+        value = self.loss_min * (1.0 + w * d2)
+        n_c = 100
+        return value, value * n_c, n_c
+
+
+class TrackerLosses:
+    """The paper's loss of the real IPDA tracker on a cached data set.
+
+    Parameters
+    ----------
+    dataset
+        The cached point clouds and truth (:class:`core.dataset.Dataset`).
+    base_params
+        TrackerParams JSON keys that are not optimised (``p_g``, thresholds, ``clutter_density``);
+        the trial's parameters override them.
+    """
+
+    def __init__(self, dataset: Any, base_params: dict[str, Any] | None = None) -> None:
+        self.dataset = dataset
+        self.base_params = dict(base_params or {})
+
+    @property
+    def trajectory_classes(self) -> tuple[str, ...]:
+        return tuple(str(c) for c in self.dataset.trajectory_class)
+
+    def warm_up(self, model: str) -> None:
+        """Load the compiled tracker (numba) before the first trial, so trial times are honest."""
+        flat = {b.name: b.high for b in search_space(model)}
+        self.losses(tracker_params_dict(flat, model), [0])
+
+    def losses(self, params: dict[str, Any], ks: Sequence[int]) -> list[tuple[float, float, int]]:
+        from core.evaluation import trajectory_loss
+        from core.tracking import TrackerParams, track_dataset
+
+        if not len(ks):
+            return []
+        tp = TrackerParams.from_dict({**self.base_params, **params})
+        est = track_dataset(self.dataset, tp, trajectories=list(ks))
+        # person 0 is the tracked person; est.frame_index are the tracked global frames
+        truth = self.dataset.truth_xy_m[est.frame_index, 0, :]
+        out = []
+        for i in range(len(ks)):
+            s = slice(int(est.offsets[i]), int(est.offsets[i + 1]))
+            value, mse, n_c = trajectory_loss(est.estimate_xy[s], est.has_estimate[s], truth[s])
+            out.append((float(value), float(mse), int(n_c)))
+        return out
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class TrialResult:
+    """Outcome of evaluating one parameter set on all (or a pruned prefix of) trajectories."""
+
+    value: float
+    losses: tuple[float, ...]
+    mse: tuple[float, ...]
+    n_c: tuple[int, ...]
+    order: tuple[int, ...]
+    pruned: bool
+
+
+class Reports(Protocol):
+    def report(self, value: float, step: int) -> None: ...
+    def should_prune(self) -> bool: ...
+
+
+def evaluate(
+    losses: TrajectoryLosses,
+    params: dict[str, Any],
+    *,
+    trial: Reports | None = None,
+    pruner: str = "asha",
+    prune_steps: Container[int] | None = None,
+) -> TrialResult:
+    """L_t of ``params`` (eq. 14), reporting to ``trial`` after every trajectory.
+
+    Parameters
+    ----------
+    losses
+        Loss source.
+    params
+        TrackerParams JSON.
+    trial
+        Optuna trial (or anything with ``report``/``should_prune``); None: no reporting.
+    pruner
+        ``"asha"`` reports the running mean at step i (1-based count of trajectories done);
+        ``"wilcoxon"`` reports L(k) at step k; ``"none"`` reports nothing.
+    prune_steps
+        Steps after which ``should_prune`` is asked (None: every step). Successive halving only
+        acts at its rungs, so asking there alone gives the same decisions with fewer storage
+        reads.
+
+    Returns
+    -------
+    TrialResult
+        ``value`` is L_t in m² (the running mean at the pruning point if pruned). A NaN or
+        infinite trajectory loss is an error (the tracker must never produce one).
+    """
+    order = round_robin_order(losses.trajectory_classes)
+    if not order:
+        raise InputError("the data set has no trajectories")
+    n = len(order)
+    # Trajectories are tracked in chunks that end where the pruner is asked (every step for
+    # Wilcoxon, the rungs for ASHA, once without pruning): the values reported after each
+    # trajectory are the same, with fewer calls into the tracker.
+    if trial is None or pruner == "none":
+        ends = [n]
+    elif prune_steps is None:
+        ends = list(range(1, n + 1))
+    else:
+        ends = sorted({i for i in prune_steps if 0 < i < n} | {n})
+    ls: list[float] = []
+    ms: list[float] = []
+    ns: list[int] = []
+    start = 0
+    for end in ends:
+        for value, mse, n_c in losses.losses(params, order[start:end]):
+            k = order[len(ls)]
+            if not math.isfinite(value):
+                raise FloatingPointError(f"trajectory {k}: loss is {value}")
+            ls.append(value)
+            ms.append(mse)
+            ns.append(n_c)
+            if trial is not None and pruner != "none":
+                if pruner == "wilcoxon":
+                    trial.report(value, k)
+                else:
+                    # running mean after i trajectories: L̄_i = (1/i) Σ_j L(k_j)
+                    trial.report(float(np.mean(ls)), len(ls))
+        start = end
+        if trial is not None and pruner != "none" and end < n and trial.should_prune():
+            return TrialResult(
+                value=float(np.mean(ls)),
+                losses=tuple(ls),
+                mse=tuple(ms),
+                n_c=tuple(ns),
+                order=tuple(order[:end]),
+                pruned=True,
+            )
+    return TrialResult(
+        value=float(np.mean(ls)),
+        losses=tuple(ls),
+        mse=tuple(ms),
+        n_c=tuple(ns),
+        order=tuple(order),
+        pruned=False,
+    )
+
+
+def make_losses(objective: str, model: str, dataset: Any = None, **kwargs: Any) -> TrajectoryLosses:
+    """Loss source by name: ``"tracker"`` (needs ``dataset``) or ``"quadratic"`` (tests)."""
+    check_model(model)
+    if objective == "tracker":
+        if dataset is None:
+            raise InputError("objective 'tracker' needs a data set")
+        return TrackerLosses(dataset, kwargs.get("base_params"))
+    if objective == "quadratic":
+        return QuadraticLosses(
+            model=model,
+            n_trajectories=int(kwargs.get("n_trajectories", 10)),
+            delay_s=float(kwargs.get("delay_s", 0.0)),
+        )
+    raise InputError(f"objective must be 'tracker' or 'quadratic', got {objective!r}")
+
+
+__all__ = [
+    "NO_CONFIRMATION_LOSS",
+    "QuadraticLosses",
+    "TrackerLosses",
+    "TrajectoryLosses",
+    "TrialResult",
+    "evaluate",
+    "make_losses",
+    "round_robin_order",
+    "tracker_params_dict",
+]

@@ -1,0 +1,168 @@
+"""Study storages: SQLite file (default), Optuna journal file, PostgreSQL.
+
+URL forms accepted (validated here, so a bad URL is one clear line):
+
+- ``sqlite:///relative/path.db`` or ``sqlite:////absolute/path.db`` — embedded, nothing to
+  install; fine for a few processes on one machine;
+- ``journal:///path.log`` (or ``journal:////abs/path.log``) — Optuna's journal file, append-only,
+  made for several processes on one machine;
+- ``postgresql://user@host:port/db`` (``postgresql+psycopg2://`` too) — workers on several
+  machines;
+- ``memory://NAME`` — Optuna's in-memory storage, shared by name inside one process only
+  (tests, previews; never for workers);
+- a plain path ending in ``.db``/``.sqlite``/``.sqlite3`` (SQLite) or ``.log``/``.journal``
+  (journal).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+from core.errors import InputError
+
+DEFAULT_STORAGE = "sqlite:///radartune-studies.db"
+
+_SQLITE_SUFFIXES = (".db", ".sqlite", ".sqlite3")
+_JOURNAL_SUFFIXES = (".log", ".journal", ".jsonl")
+
+
+def normalize_url(url: str) -> str:
+    """Canonical URL (``sqlite:///…``, ``journal:///…`` or ``postgresql…://…``).
+
+    Raises
+    ------
+    InputError
+        Unknown scheme, or a file URL without a path.
+    """
+    url = str(url).strip()
+    if not url:
+        raise InputError("storage URL is empty")
+    if "://" not in url:
+        suffix = Path(url).suffix.lower()
+        if suffix in _SQLITE_SUFFIXES:
+            return f"sqlite:///{url}"
+        if suffix in _JOURNAL_SUFFIXES:
+            return f"journal:///{url}"
+        raise InputError(
+            f"storage {url!r}: expected sqlite:///FILE.db, journal:///FILE.log, "
+            "postgresql://USER@HOST:PORT/DB or a path ending in .db or .log"
+        )
+    scheme = url.split("://", 1)[0].lower()
+    if scheme in ("sqlite", "journal"):
+        if not file_path(url).name:
+            raise InputError(f"storage {url!r}: no file name after {scheme}:///")
+        return url
+    if scheme == "memory":
+        return url
+    if scheme in ("postgresql", "postgres", "postgresql+psycopg2"):
+        return "postgresql+psycopg2://" + url.split("://", 1)[1]
+    raise InputError(
+        f"storage {url!r}: unknown scheme {scheme!r} (use sqlite, journal or postgresql)"
+    )
+
+
+def file_path(url: str) -> Path:
+    """The file of a ``sqlite:///`` or ``journal:///`` URL (three slashes: relative path)."""
+    rest = url.split("://", 1)[1]
+    if not rest.startswith("/"):
+        raise InputError(f"storage {url!r}: a file URL needs three slashes, e.g. sqlite:///x.db")
+    return Path(rest[1:])
+
+
+def absolute_url(url: str) -> str:
+    """The URL with a file path made absolute (workers may run in another folder)."""
+    url = normalize_url(url)
+    if kind(url) in ("sqlite", "journal"):
+        scheme = url.split("://", 1)[0]
+        return f"{scheme}:///{file_path(url).resolve()}"
+    return url
+
+
+def kind(url: str) -> str:
+    """``"sqlite"``, ``"journal"`` or ``"postgresql"``."""
+    scheme = normalize_url(url).split("://", 1)[0]
+    return "postgresql" if scheme.startswith("postgres") else scheme
+
+
+_MEMORY: dict[str, Any] = {}
+
+
+def open_storage(url: str, *, create: bool = True) -> Any:
+    """Open (and for files create) an Optuna storage; one clear :class:`InputError` on failure.
+
+    SQLite gets a 60 s busy timeout so that several processes can share the file. The schema
+    is created on open (optuna-dashboard crashes on an empty SQLite file otherwise).
+
+    Parameters
+    ----------
+    url
+        Storage URL, see the module docstring.
+    create
+        If false, a missing SQLite or journal file is an error instead of being created.
+    """
+    import optuna
+    import sqlalchemy.exc
+
+    url = normalize_url(url)
+    k = kind(url)
+    if k == "memory":
+        return _MEMORY.setdefault(url, optuna.storages.InMemoryStorage())
+    if k in ("sqlite", "journal"):
+        path = file_path(url)
+        if not path.parent.is_dir():
+            raise InputError(f"storage {url!r}: folder {str(path.parent)!r} does not exist")
+        if not create and not path.exists():
+            raise InputError(f"storage {url!r}: file {str(path)!r} does not exist")
+        if path.exists() and path.is_dir():
+            raise InputError(f"storage {url!r}: {str(path)!r} is a folder")
+    try:
+        if k == "journal":
+            from optuna.storages.journal import JournalFileBackend, JournalFileOpenLock
+
+            path = file_path(url)
+            backend = JournalFileBackend(str(path), lock_obj=JournalFileOpenLock(str(path)))
+            return optuna.storages.JournalStorage(backend)
+        engine_kwargs: dict[str, Any] = {}
+        if k == "sqlite":
+            engine_kwargs = {"creator": _sqlite_connector(file_path(url))}
+        else:
+            engine_kwargs = {"connect_args": {"connect_timeout": 10}, "pool_pre_ping": True}
+        return optuna.storages.RDBStorage(url, engine_kwargs=engine_kwargs)
+    except (sqlalchemy.exc.SQLAlchemyError, OSError) as exc:
+        first = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
+        raise InputError(f"storage {redact(url)!r}: cannot open: {first}") from None
+    except Exception as exc:  # optuna raises RuntimeError / ValueError for bad databases
+        first = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
+        raise InputError(f"storage {redact(url)!r}: cannot open: {first}") from None
+
+
+def _sqlite_connector(path: Path) -> Any:
+    """SQLite connections in WAL mode with ``synchronous=NORMAL`` and a 60 s busy timeout.
+
+    WAL lets readers (progress polling, the dashboard) run beside the writing workers, and
+    NORMAL syncs at checkpoints instead of every commit: each trial makes ~30 small commits
+    (parameters, intermediate values, state), which cost ~2 ms each with a full fsync. A
+    process crash (SIGKILL) loses nothing committed; a power cut may lose the last commits.
+    WAL needs a local file system (not NFS).
+    """
+    import sqlite3
+
+    def connect() -> sqlite3.Connection:
+        conn = sqlite3.connect(str(path), timeout=60.0, check_same_thread=False)
+        conn.execute("PRAGMA journal_mode=WAL")
+        conn.execute("PRAGMA synchronous=NORMAL")
+        return conn
+
+    return connect
+
+
+def redact(url: str) -> str:
+    """URL with any password replaced by ``***`` (for messages and logs)."""
+    if "://" not in url or "@" not in url:
+        return url
+    scheme, rest = url.split("://", 1)
+    creds, host = rest.rsplit("@", 1)
+    if ":" in creds:
+        creds = creds.split(":", 1)[0] + ":***"
+    return f"{scheme}://{creds}@{host}"

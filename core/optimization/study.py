@@ -1,0 +1,610 @@
+"""Studies: create or resume, run workers, cap the total, survive crashes, read progress.
+
+One study per motion model. The study's settings live in its user attributes (``model``,
+``objective``, ``dataset``, ``n_trials``, ``sampler``, ``pruner``, ``seed``), so that a worker
+joining from another machine needs only the storage URL and the study name, and a study of the
+other model under the same name is refused.
+
+Total cap ("exactly the asked total"): the total counts trials that finished COMPLETE or PRUNED.
+A worker asks for a trial, then counts the trials numbered below it that are COMPLETE, PRUNED,
+RUNNING or WAITING; if that count already reaches ``n_trials`` the new trial is surplus and is
+closed as FAIL with the user attribute ``surplus=True`` (Optuna cannot delete trials). Trial
+numbers are assigned atomically by every storage, so two workers can never both take the last
+slot. A trial that fails (tracker error) frees its slot, so the total is still reached.
+
+Crashes: every trial records its worker ``host:pid:start-ticks``. On resume, a RUNNING trial whose
+worker is on this host and no longer alive is marked FAIL at once; one from another host is
+marked FAIL when it has run longer than ``stale_after_s`` (trials take seconds).
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+import math
+import os
+import signal
+import socket
+import subprocess
+import sys
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from core.errors import InputError
+from core.optimization.objective import evaluate, make_losses
+from core.optimization.space import check_model, flat_params, suggest_params, tracker_params_dict
+from core.optimization.storage import (
+    DEFAULT_STORAGE,
+    absolute_url,
+    normalize_url,
+    open_storage,
+    redact,
+)
+
+SAMPLERS = ("tpe", "random")
+PRUNERS = ("asha", "wilcoxon", "none")
+OBJECTIVES = ("tracker", "quadratic")
+#: states that occupy a slot of the total
+_OCCUPYING = ("COMPLETE", "PRUNED", "RUNNING", "WAITING")
+#: consecutive failed trials after which a worker gives up (a broken objective)
+MAX_CONSECUTIVE_FAILURES = 5
+STALE_AFTER_S = 600.0
+ROOT = Path(__file__).resolve().parents[2]
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class StudySettings:
+    """Everything needed to start (or resume) a study; Qt- and Optuna-free.
+
+    Parameters
+    ----------
+    model
+        Motion model, ``"cv"`` or ``"ca"``.
+    n_trials
+        Total number of counted (COMPLETE + PRUNED) trials over all workers and runs.
+    n_jobs
+        Worker processes started on this machine.
+    storage
+        Storage URL (``sqlite:///…``, ``journal:///…``, ``postgresql://…``).
+    study_name
+        None: ``radartune-<model>``.
+    seed
+        Base seed; worker i gets its own seed derived from it.
+    sampler
+        ``"tpe"`` or ``"random"`` (baseline).
+    pruner
+        ``"asha"`` (successive halving), ``"wilcoxon"`` or ``"none"``.
+    dataset
+        Path of a data set ``.npz``; None: the paper's data set (seed 0, 35 trajectories, cached).
+    objective
+        ``"tracker"`` (the IPDA tracker on the data set) or ``"quadratic"`` (test objective).
+    objective_options
+        Options of the quadratic objective (``n_trajectories``, ``delay_s``).
+    """
+
+    model: str = "cv"
+    n_trials: int = 300
+    n_jobs: int = 1
+    storage: str = DEFAULT_STORAGE
+    study_name: str | None = None
+    seed: int = 0
+    sampler: str = "tpe"
+    pruner: str = "asha"
+    dataset: str | None = None
+    objective: str = "tracker"
+    objective_options: dict[str, float] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        check_model(self.model)
+        if int(self.n_trials) < 1:
+            raise InputError(f"n_trials must be >= 1, got {self.n_trials}")
+        if int(self.n_jobs) < 1:
+            raise InputError(f"n_jobs must be >= 1, got {self.n_jobs}")
+        if self.sampler not in SAMPLERS:
+            raise InputError(f"sampler must be one of {', '.join(SAMPLERS)}, got {self.sampler!r}")
+        if self.pruner not in PRUNERS:
+            raise InputError(f"pruner must be one of {', '.join(PRUNERS)}, got {self.pruner!r}")
+        if self.objective not in OBJECTIVES:
+            raise InputError(
+                f"objective must be one of {', '.join(OBJECTIVES)}, got {self.objective!r}"
+            )
+        normalize_url(self.storage)
+
+    @property
+    def name(self) -> str:
+        """The study name (default ``radartune-<model>``)."""
+        return self.study_name or f"radartune-{self.model}"
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class TrialSummary:
+    """One trial as the GUI and the report see it (no Optuna types).
+
+    ``params`` are the flat Optuna parameters (``q_coeff``, ``p0_00``, …); ``value`` is L_t in m²
+    (the running mean at the pruning point for a PRUNED trial); ``duration_s`` is None while
+    RUNNING.
+    """
+
+    number: int
+    state: str
+    value: float | None
+    params: dict[str, float]
+    duration_s: float | None
+    datetime_start: dt.datetime | None
+    datetime_complete: dt.datetime | None
+    worker: str = ""
+
+    def tracker_params(self, model: str) -> dict[str, Any]:
+        """The trial's parameters as TrackerParams JSON."""
+        return tracker_params_dict(self.params, model)
+
+
+# ---- samplers and pruners ---------------------------------------------------------------------
+def make_sampler(kind: str, seed: int | None) -> Any:
+    """Optuna sampler with every argument set explicitly (Optuna 5 changed the defaults).
+
+    TPE: independent (univariate) Parzen estimators as in Bergstra et al. 2011 and the Optuna 3
+    default the paper used, 10 random start-up trials, 24 EI candidates, and the constant liar so
+    that parallel workers do not sample the same point while trials run. (Prior, magic clip and
+    endpoints keep their defaults: their arguments are deprecated in Optuna 5.)
+    """
+    import optuna
+
+    if kind == "random":
+        return optuna.samplers.RandomSampler(seed=seed)
+    if kind != "tpe":
+        raise InputError(f"sampler must be one of {', '.join(SAMPLERS)}, got {kind!r}")
+    return optuna.samplers.TPESampler(
+        n_startup_trials=10,
+        n_ei_candidates=24,
+        seed=seed,
+        multivariate=True,
+        group=False,
+        constant_liar=True,
+    )
+
+
+#: successive halving: first rung after one round over the five classes, reduction factor η
+ASHA_MIN_RESOURCE = 5
+ASHA_REDUCTION_FACTOR = 3
+
+
+def asha_rungs(n_steps: int) -> list[int]:
+    """Steps at which successive halving decides: r·η^k ≤ n_steps (5, 15, 45, …)."""
+    rungs, step = [], ASHA_MIN_RESOURCE
+    while step <= n_steps:
+        rungs.append(step)
+        step *= ASHA_REDUCTION_FACTOR
+    return rungs
+
+
+def make_pruner(kind: str) -> Any:
+    """ASHA: rungs at 5, 15 trajectories (one and three rounds over the five classes), η = 3."""
+    import optuna
+
+    if kind == "asha":
+        return optuna.pruners.SuccessiveHalvingPruner(
+            min_resource=ASHA_MIN_RESOURCE,
+            reduction_factor=ASHA_REDUCTION_FACTOR,
+            min_early_stopping_rate=0,
+            bootstrap_count=0,
+        )
+    if kind == "wilcoxon":
+        return optuna.pruners.WilcoxonPruner(p_threshold=0.1, n_startup_steps=5)
+    if kind == "none":
+        return optuna.pruners.NopPruner()
+    raise InputError(f"pruner must be one of {', '.join(PRUNERS)}, got {kind!r}")
+
+
+# ---- worker identity and crash recovery -------------------------------------------------------
+def _start_ticks(pid: int) -> str | None:
+    """Start time of a process in clock ticks (Linux ``/proc``), to tell a reused pid apart."""
+    try:
+        stat = Path(f"/proc/{pid}/stat").read_text()
+    except OSError:
+        return None
+    return stat.rsplit(")", 1)[1].split()[19]
+
+
+def worker_id() -> str:
+    """``host:pid:start-ticks`` of this process."""
+    pid = os.getpid()
+    return f"{socket.gethostname()}:{pid}:{_start_ticks(pid) or 0}"
+
+
+def _worker_alive(wid: str) -> bool | None:
+    """True/False for a worker on this host, None if it runs on another host."""
+    try:
+        host, pid, ticks = wid.rsplit(":", 2)
+    except ValueError:
+        return None
+    if host != socket.gethostname():
+        return None
+    now = _start_ticks(int(pid))
+    return now is not None and now == ticks
+
+
+def fail_stale_trials(study: Any, *, stale_after_s: float = STALE_AFTER_S) -> list[int]:
+    """Mark FAIL the RUNNING trials whose worker died; return their numbers.
+
+    A RUNNING trial of a dead worker on this host fails at once; one without a worker record
+    or from another host fails when it has run longer than ``stale_after_s``.
+    """
+    from optuna.trial import TrialState
+
+    failed = []
+    now = dt.datetime.now()
+    for t in study.get_trials(deepcopy=False, states=(TrialState.RUNNING,)):
+        alive = _worker_alive(str(t.user_attrs.get("worker", "")))
+        age = (now - t.datetime_start).total_seconds() if t.datetime_start else math.inf
+        if alive is False or (alive is None and age > stale_after_s):
+            try:
+                study._storage.set_trial_user_attr(t._trial_id, "stale", True)
+                study._storage.set_trial_state_values(t._trial_id, state=TrialState.FAIL)
+            except RuntimeError:  # finished meanwhile
+                continue
+            failed.append(t.number)
+    return failed
+
+
+# ---- creating, loading ------------------------------------------------------------------------
+def _load_existing(storage: Any, name: str) -> Any | None:
+    import optuna
+
+    try:
+        return optuna.load_study(study_name=name, storage=storage)
+    except KeyError:
+        return None
+
+
+def prepare_study(settings: StudySettings, *, dataset_path: str | None = None) -> Any:
+    """Create the study (once, before any worker starts) or resume it; return the Optuna study.
+
+    Refuses — with one :class:`InputError` line and without touching the study — a study of the
+    other model, objective or data set under the same name. On resume the total ``n_trials`` is
+    updated and trials left RUNNING by a crash are marked FAIL.
+    """
+    import optuna
+
+    optuna.logging.set_verbosity(optuna.logging.WARNING)
+    storage = open_storage(settings.storage)
+    attrs = {
+        "model": settings.model,
+        "objective": settings.objective,
+        "dataset": dataset_path or settings.dataset or "",
+        "sampler": settings.sampler,
+        "pruner": settings.pruner,
+        "seed": int(settings.seed),
+        "objective_options": dict(settings.objective_options),
+        "space": "paper-eq15",
+    }
+    study = _load_existing(storage, settings.name)
+    if study is not None:
+        old = study.user_attrs
+        for key in ("model", "objective", "sampler", "pruner"):
+            if old.get(key) != attrs[key]:
+                raise InputError(
+                    f"study {settings.name!r} in {redact(settings.storage)} has {key}="
+                    f"{old.get(key)!r}, asked {attrs[key]!r}; use another --study name"
+                )
+        if old.get("dataset") and attrs["dataset"] and old["dataset"] != attrs["dataset"]:
+            raise InputError(
+                f"study {settings.name!r} was run on data set {old['dataset']!r}, asked "
+                f"{attrs['dataset']!r}; use another --study name"
+            )
+        fail_stale_trials(study)
+    else:
+        study = optuna.create_study(
+            storage=storage, study_name=settings.name, direction="minimize", load_if_exists=True
+        )
+        for key, value in attrs.items():
+            study.set_user_attr(key, value)
+    study.set_user_attr("n_trials", int(settings.n_trials))
+    return study
+
+
+def count_trials(study: Any, *, below: int | None = None) -> int:
+    """Trials occupying a slot of the total (COMPLETE, PRUNED, RUNNING, WAITING)."""
+    from optuna.trial import TrialState
+
+    states = tuple(TrialState[s] for s in _OCCUPYING)
+    trials = study.get_trials(deepcopy=False, states=states)
+    if below is None:
+        return len(trials)
+    return sum(1 for t in trials if t.number < below)
+
+
+def load_dataset_for(attrs: dict[str, Any], dataset_path: str | None) -> Any:
+    """The data set a worker tracks: ``dataset_path`` or the study's recorded path."""
+    if attrs.get("objective") != "tracker":
+        return None
+    from core.dataset import Dataset
+
+    path = dataset_path or attrs.get("dataset")
+    if not path:
+        raise InputError("the study records no data set; pass --dataset PATH")
+    if not Path(path).is_file():
+        raise InputError(
+            f"data set {path!r} (recorded in the study) does not exist here; "
+            "pass --dataset PATH to this machine's copy"
+        )
+    return Dataset.load(path)
+
+
+def run_worker(
+    storage: str,
+    study_name: str,
+    *,
+    seed: int | None,
+    dataset_path: str | None = None,
+    stop: Callable[[], bool] = lambda: False,
+    log: Callable[[str], None] = lambda s: None,
+) -> int:
+    """Run trials of an existing study until the total is reached or ``stop()`` is true.
+
+    Parameters
+    ----------
+    storage, study_name
+        The study to join (created beforehand by :func:`prepare_study`).
+    seed
+        This worker's sampler seed.
+    dataset_path
+        Overrides the data-set path recorded in the study (another machine's file system).
+    stop
+        Checked before every trial; the running trial is always finished and told.
+
+    Returns
+    -------
+    int
+        Trials this worker finished (COMPLETE or PRUNED).
+    """
+    import optuna
+    from optuna.trial import TrialState
+
+    optuna.logging.set_verbosity(optuna.logging.WARNING)
+    store = open_storage(storage, create=False)
+    probe = _load_existing(store, study_name)
+    if probe is None:
+        raise InputError(f"no study {study_name!r} in {redact(storage)}")
+    attrs = dict(probe.user_attrs)
+    if "model" not in attrs:
+        raise InputError(f"study {study_name!r} was not created by radartune (no model attribute)")
+    model = attrs["model"]
+    n_total = int(attrs["n_trials"])
+    study = optuna.load_study(
+        study_name=study_name,
+        storage=store,
+        sampler=make_sampler(attrs["sampler"], seed),
+        pruner=make_pruner(attrs["pruner"]),
+    )
+    losses = make_losses(
+        attrs["objective"],
+        model,
+        load_dataset_for(attrs, dataset_path),
+        **dict(attrs.get("objective_options") or {}),
+    )
+    if hasattr(losses, "warm_up"):
+        losses.warm_up(model)
+    fail_stale_trials(study)
+    n_steps = len(losses.trajectory_classes)
+    prune_steps = set(asha_rungs(n_steps)) if attrs["pruner"] == "asha" else None
+    me = worker_id()
+    finished = 0
+    failures = 0
+    while not stop():
+        if count_trials(study) >= n_total:
+            # slots held by RUNNING trials of dead workers are freed, then counted again
+            if not fail_stale_trials(study) or count_trials(study) >= n_total:
+                break
+        trial = study.ask()
+        try:
+            trial.set_user_attr("worker", me)
+            if count_trials(study, below=trial.number) >= n_total:
+                trial.set_user_attr("surplus", True)
+                study.tell(trial, state=TrialState.FAIL)
+                break
+            params = tracker_params_dict(suggest_params(trial, model), model)
+            result = evaluate(
+                losses, params, trial=trial, pruner=attrs["pruner"], prune_steps=prune_steps
+            )
+        except KeyboardInterrupt:
+            study.tell(trial, state=TrialState.FAIL)
+            raise
+        except InputError:
+            study.tell(trial, state=TrialState.FAIL)
+            raise
+        except Exception as exc:  # a tracker error fails the trial, not the study
+            trial.set_user_attr("error", f"{type(exc).__name__}: {exc}"[:500])
+            study.tell(trial, state=TrialState.FAIL)
+            log(f"trial {trial.number} failed: {type(exc).__name__}: {exc}")
+            failures += 1
+            if failures >= MAX_CONSECUTIVE_FAILURES:
+                raise InputError(
+                    f"{failures} trials in a row failed; last: {type(exc).__name__}: {exc}"
+                ) from None
+            continue
+        failures = 0
+        if result.pruned:
+            study.tell(trial, state=TrialState.PRUNED)
+        else:
+            study.tell(trial, result.value)
+        finished += 1
+    return finished
+
+
+def worker_seeds(seed: int, n_jobs: int, n_existing: int) -> list[int]:
+    """One seed per worker from (base seed, trials already in the study).
+
+    Including the number of existing trials keeps a resumed random-sampling study from
+    replaying the points of its first run.
+    """
+    ss = np.random.SeedSequence([int(seed), int(n_existing)])
+    return [int(c.generate_state(1)[0]) for c in ss.spawn(n_jobs)]
+
+
+# ---- processes --------------------------------------------------------------------------------
+class StudyHandle:
+    """Worker processes of a running study (returned by :func:`start_study`)."""
+
+    def __init__(self, settings: StudySettings, procs: list[subprocess.Popen]) -> None:
+        self.settings = settings
+        self.procs = procs
+
+    def is_running(self) -> bool:
+        """True while any worker process is alive."""
+        return any(p.poll() is None for p in self.procs)
+
+    def returncodes(self) -> list[int | None]:
+        return [p.poll() for p in self.procs]
+
+    def wait(self, timeout: float | None = None) -> bool:
+        """Wait for the workers; True if all have exited."""
+        end = None if timeout is None else time.monotonic() + timeout
+        for p in self.procs:
+            try:
+                p.wait(None if end is None else max(0.0, end - time.monotonic()))
+            except subprocess.TimeoutExpired:
+                return False
+        return True
+
+    def stop(self, timeout: float = 30.0) -> None:
+        """Ask every worker to stop after its current trial; kill those that do not in time.
+
+        A killed worker's RUNNING trial is marked FAIL at once.
+        """
+        for p in self.procs:
+            if p.poll() is None:
+                p.send_signal(signal.SIGTERM)
+        if not self.wait(timeout):
+            for p in self.procs:
+                if p.poll() is None:
+                    p.kill()
+            self.wait(10.0)
+            import optuna
+
+            study = optuna.load_study(
+                study_name=self.settings.name, storage=open_storage(self.settings.storage)
+            )
+            fail_stale_trials(study)
+
+
+def worker_command(
+    storage: str, study_name: str, seed: int, dataset_path: str | None = None
+) -> list[str]:
+    """The ``radartune worker`` command line for one worker process."""
+    cmd = [sys.executable, "-m", "core.cli", "worker", "--storage", storage, "--study", study_name]
+    cmd += ["--seed", str(seed)]
+    if dataset_path:
+        cmd += ["--dataset", str(dataset_path)]
+    return cmd
+
+
+def start_study(
+    settings: StudySettings,
+    *,
+    dataset_path: str | None = None,
+    stdout: Any = None,
+    stderr: Any = None,
+) -> StudyHandle:
+    """Create or resume the study, then start ``n_jobs`` worker processes; return their handle.
+
+    The study is created here, once, before any worker starts. Each worker gets its own seed.
+    ``dataset_path`` (default ``settings.dataset``) must be the cached ``.npz`` for the tracker
+    objective (see :func:`core.optimization.data.resolve_dataset`).
+    """
+    path = dataset_path or settings.dataset
+    if path:
+        path = str(Path(path).resolve())
+    settings = replace(settings, storage=absolute_url(settings.storage))
+    study = prepare_study(settings, dataset_path=path)
+    n_existing = len(study.get_trials(deepcopy=False))
+    seeds = worker_seeds(settings.seed, settings.n_jobs, n_existing)
+    env = dict(os.environ)
+    env["PYTHONPATH"] = os.pathsep.join([str(ROOT), env.get("PYTHONPATH", "")]).rstrip(os.pathsep)
+    procs = [
+        subprocess.Popen(
+            worker_command(settings.storage, settings.name, s, path),
+            cwd=str(ROOT),
+            env=env,
+            stdout=stdout,
+            stderr=stderr,
+        )
+        for s in seeds
+    ]
+    return StudyHandle(settings, procs)
+
+
+# ---- reading ----------------------------------------------------------------------------------
+def _summary(t: Any) -> TrialSummary:
+    dur = None
+    if t.datetime_start is not None and t.datetime_complete is not None:
+        dur = (t.datetime_complete - t.datetime_start).total_seconds()
+    value = t.value if t.state.name == "COMPLETE" else None
+    if t.state.name == "PRUNED":
+        iv = t.intermediate_values
+        value = iv[max(iv)] if iv else None
+    return TrialSummary(
+        number=t.number,
+        state=t.state.name,
+        value=None if value is None else float(value),
+        params={k: float(v) for k, v in t.params.items()},
+        duration_s=dur,
+        datetime_start=t.datetime_start,
+        datetime_complete=t.datetime_complete,
+        worker=str(t.user_attrs.get("worker", "")),
+    )
+
+
+def study_progress(storage: str, name: str) -> tuple[list[TrialSummary], TrialSummary | None]:
+    """All trials of a study and the best COMPLETE one (None before the first completes)."""
+    store = open_storage(storage, create=False)
+    study = _load_existing(store, name)
+    if study is None:
+        raise InputError(f"no study {name!r} in {redact(storage)}")
+    trials = study.get_trials(deepcopy=False)
+    summaries = [_summary(t) for t in trials]
+    done = [s for s in summaries if s.state == "COMPLETE" and s.value is not None]
+    best = min(done, key=lambda s: (s.value, s.number)) if done else None
+    return summaries, best
+
+
+def study_model(storage: str, name: str) -> str:
+    """The motion model recorded in a study."""
+    store = open_storage(storage, create=False)
+    study = _load_existing(store, name)
+    if study is None:
+        raise InputError(f"no study {name!r} in {redact(storage)}")
+    return str(study.user_attrs.get("model", ""))
+
+
+def list_studies(storage: str) -> list[str]:
+    """Names of the studies in a storage."""
+    import optuna
+
+    return [s.study_name for s in optuna.get_all_study_summaries(open_storage(storage))]
+
+
+def enqueue_params(storage: str, name: str, params: dict[str, Any]) -> None:
+    """Queue TrackerParams JSON as the next trial of a study (``study.enqueue_trial``).
+
+    The parameters must match the study's model and lie inside the paper's bounds.
+    """
+    import optuna
+
+    store = open_storage(storage, create=False)
+    study = _load_existing(store, name)
+    if study is None:
+        raise InputError(f"no study {name!r} in {redact(storage)}")
+    model = study.user_attrs.get("model")
+    if params.get("model", "cv") != model:
+        raise InputError(f"parameters are for model {params.get('model')!r}, study is {model!r}")
+    optuna.load_study(study_name=name, storage=store).enqueue_trial(flat_params(params))
+
+
+def counted(summaries: Sequence[TrialSummary]) -> int:
+    """Trials that count toward the total: COMPLETE and PRUNED."""
+    return sum(1 for s in summaries if s.state in ("COMPLETE", "PRUNED"))

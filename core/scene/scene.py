@@ -1,0 +1,514 @@
+"""Scene: radar, AOI, clutter, static reflectors and persons; JSON in and out (SPEC §6)."""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import tempfile
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from core.config import PAPER_RADAR, RadarConfig
+from core.errors import InputError
+from core.scene.aoi import AOI
+from core.scene.trajectory import (
+    TRAJECTORY_CLASSES,
+    Trajectory,
+    generate_trajectory,
+    profile_trajectory,
+    validate_class_parameters,
+    waypoint_trajectory,
+)
+
+SCHEMA_VERSION = 1
+PAPER_CLUTTER_DENSITY_PER_M2 = 0.02
+SCENE_KEYS = (
+    "schema_version",
+    "radar",
+    "seed",
+    "clutter_density_per_m2",
+    "aoi",
+    "static_reflectors",
+    "persons",
+)
+PERSON_KEYS = ("trajectory", "rcs_dbsm", "model")
+PERSON_MODELS = ("point", "extended")
+REFLECTOR_KEYS = ("x_m", "y_m", "z_m", "rcs_dbsm")
+RCS_RANGE_DBSM = (-60.0, 60.0)
+WAYPOINT_SPEED_RANGE_MPS = (0.05, 3.0)
+MAX_PROFILE_FRAMES = 100_000
+MIN_SCATTERER_RANGE_M = 0.1
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class StaticReflector:
+    """A fixed point reflector (wall, furniture): v = 0, so static clutter removal removes it."""
+
+    x_m: float
+    y_m: float
+    z_m: float = 0.0
+    rcs_dbsm: float = 10.0
+
+    def to_dict(self) -> dict:
+        d = {"x_m": self.x_m, "y_m": self.y_m, "rcs_dbsm": self.rcs_dbsm}
+        if self.z_m != 0.0:
+            d["z_m"] = self.z_m
+        return d
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Person:
+    """One walking person: a point scatterer on the trajectory at z = 0.
+
+    ``rcs_dbsm`` fixes the RCS; ``None`` draws it from eq. (5), N(−8, 16) dBsm, every frame.
+    ``model``: ``"point"`` (the paper's, default) or ``"extended"`` (torso, arms and legs with
+    micro-Doppler, :mod:`core.scene.body`; the RCS is split over the body scatterers).
+    ``spec`` is the trajectory's JSON description (kept so that the scene saves as written).
+    """
+
+    trajectory: Trajectory
+    rcs_dbsm: float | None = None
+    model: str = "point"
+    spec: Mapping[str, Any] = field(default_factory=dict, compare=False)
+
+    def __post_init__(self) -> None:
+        if self.model not in PERSON_MODELS:
+            raise InputError(f"model must be one of {list(PERSON_MODELS)}, got {self.model!r}")
+
+    def to_dict(self) -> dict:
+        d: dict[str, Any] = {"trajectory": dict(self.spec)}
+        if self.rcs_dbsm is not None:
+            d["rcs_dbsm"] = self.rcs_dbsm
+        if self.model != "point":
+            d["model"] = self.model
+        return d
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Scene:
+    """Everything the radar sees over a run of frames.
+
+    ``radar_spec`` is how the radar was given in JSON (``"paper"``, a ``.cfg`` path relative to
+    the scene file, or a dict of fields); ``radar`` is the resolved configuration.
+    """
+
+    seed: int = 0
+    radar: RadarConfig = PAPER_RADAR
+    radar_spec: str | Mapping[str, Any] = "paper"
+    clutter_density_per_m2: float = PAPER_CLUTTER_DENSITY_PER_M2
+    aoi: AOI = field(default_factory=AOI)
+    static_reflectors: tuple[StaticReflector, ...] = ()
+    persons: tuple[Person, ...] = ()
+
+    def __post_init__(self) -> None:
+        if not (isinstance(self.seed, int) and not isinstance(self.seed, bool) and self.seed >= 0):
+            raise InputError(f"seed must be an integer >= 0, got seed={self.seed!r}")
+        d = self.clutter_density_per_m2
+        if not (isinstance(d, int | float) and math.isfinite(d) and 0 <= d <= 1):
+            raise InputError(
+                f"clutter_density_per_m2 must be in [0, 1] m^-2, got clutter_density_per_m2={d!r}"
+            )
+
+    # ---- derived -----------------------------------------------------------------------------
+    @property
+    def n_frames(self) -> int:
+        """Frames simulated: the longest trajectory (1 for a scene without persons)."""
+        return max((p.trajectory.n_frames for p in self.persons), default=1)
+
+    @property
+    def n_persons(self) -> int:
+        return len(self.persons)
+
+    @property
+    def is_planar(self) -> bool:
+        """True when every reflector has z = 0 (persons are always at z = 0)."""
+        return all(r.z_m == 0.0 for r in self.static_reflectors)
+
+    @property
+    def trajectory_class(self) -> str:
+        """The class of the first person's trajectory (``"drawn"`` for waypoints/profiles)."""
+        if not self.persons:
+            return "drawn"
+        c = self.persons[0].trajectory.trajectory_class
+        return c if c in TRAJECTORY_CLASSES else "drawn"
+
+    def truth(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Ground truth per frame.
+
+        Returns
+        -------
+        t_s
+            Frame times, shape ``(F,)``, s.
+        xy_m, v_mps
+            Shape ``(F, n_persons, 2)``; NaN after a person's trajectory has ended.
+        """
+        f = self.n_frames
+        xy = np.full((f, self.n_persons, 2), np.nan)
+        v = np.full((f, self.n_persons, 2), np.nan)
+        for i, p in enumerate(self.persons):
+            n = p.trajectory.n_frames
+            xy[:n, i] = p.trajectory.position_m
+            v[:n, i] = p.trajectory.velocity_mps
+        return np.arange(f) * self.radar.frame_period_s, xy, v
+
+    # ---- JSON --------------------------------------------------------------------------------
+    def to_dict(self, *, resolve_radar: bool = False) -> dict:
+        """The scene as JSON-ready data; ``resolve_radar`` writes the radar as its fields
+        (self-contained: no ``.cfg`` path relative to a scene file)."""
+        if resolve_radar:
+            radar: Any = self.radar.to_dict()
+        elif isinstance(self.radar_spec, str):
+            radar = self.radar_spec
+        else:
+            radar = dict(self.radar_spec)
+        return {
+            "schema_version": SCHEMA_VERSION,
+            "radar": radar,
+            "seed": self.seed,
+            "clutter_density_per_m2": self.clutter_density_per_m2,
+            "aoi": self.aoi.to_dict(),
+            "static_reflectors": [r.to_dict() for r in self.static_reflectors],
+            "persons": [p.to_dict() for p in self.persons],
+        }
+
+    def to_json(self, path: str | os.PathLike | None = None) -> str:
+        """The scene as JSON text; with ``path``, also written atomically (temp file + rename)."""
+        text = json.dumps(self.to_dict(), indent=2) + "\n"
+        if path is not None:
+            write_text_atomic(Path(path), text)
+        return text
+
+    def canonical_json(self) -> str:
+        """Compact, key-sorted JSON including the resolved radar (for hashing)."""
+        return json.dumps(self.to_dict(resolve_radar=True), sort_keys=True, separators=(",", ":"))
+
+    @classmethod
+    def from_json(cls, path: str | os.PathLike) -> Scene:
+        """Load a scene file; errors name the file and the line (syntax) or the field."""
+        path = Path(path)
+        try:
+            text = path.read_text(encoding="utf-8")
+        except FileNotFoundError:
+            raise InputError("scene file not found", str(path)) from None
+        except (OSError, UnicodeDecodeError) as exc:
+            raise InputError(f"cannot read scene file ({exc})", str(path)) from None
+        try:
+            data = json.loads(text)
+        except json.JSONDecodeError as exc:
+            raise InputError(
+                f"invalid JSON: {exc.msg} (column {exc.colno})", f"{path}:{exc.lineno}"
+            ) from None
+        return cls.from_dict(data, source=str(path), base_dir=path.parent)
+
+    @classmethod
+    def from_json_text(cls, text: str, source: str = "<scene>") -> Scene:
+        try:
+            data = json.loads(text)
+        except json.JSONDecodeError as exc:
+            raise InputError(
+                f"invalid JSON: {exc.msg} (column {exc.colno})", f"{source}:{exc.lineno}"
+            ) from None
+        return cls.from_dict(data, source=source)
+
+    @classmethod
+    def from_dict(
+        cls, data: Any, *, source: str | None = None, base_dir: str | os.PathLike | None = None
+    ) -> Scene:
+        """Build from parsed JSON (SPEC §6). Errors name ``source`` and the field."""
+        try:
+            return _parse_scene(data, Path(base_dir) if base_dir else Path.cwd())
+        except InputError as exc:
+            if exc.source is None and source is not None:
+                raise InputError(exc.message, source) from None
+            raise
+
+
+def write_text_atomic(path: Path, text: str) -> None:
+    """Write to a temporary file in the same folder, then rename."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8") as fh:
+            fh.write(text)
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+# ---- parsing -----------------------------------------------------------------------------------
+
+
+def _check_keys(obj: Any, allowed: tuple[str, ...], where: str) -> dict:
+    if not isinstance(obj, dict):
+        raise InputError(f"{where} must be a JSON object, got {type(obj).__name__}")
+    unknown = sorted(set(obj) - set(allowed))
+    if unknown:
+        raise InputError(f"{where}: unknown key(s) {unknown}; expected some of {list(allowed)}")
+    return obj
+
+
+def _all_numbers(d: dict) -> bool:
+    return all(
+        isinstance(v, int | float) and not isinstance(v, bool) and math.isfinite(v)
+        for k, v in d.items()
+        if k in ("x_m", "y_m", "z_m")
+    )
+
+
+def _number(value: Any, where: str, lo: float | None = None, hi: float | None = None) -> float:
+    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
+        raise InputError(f"{where} must be a finite number, got {value!r}")
+    if (lo is not None and value < lo) or (hi is not None and value > hi):
+        raise InputError(f"{where} must be in [{lo}, {hi}], got {value!r}")
+    return float(value)
+
+
+def _integer(value: Any, where: str, lo: int = 0, hi: int | None = None) -> int:
+    if isinstance(value, bool) or not isinstance(value, int):
+        raise InputError(f"{where} must be an integer, got {value!r}")
+    if value < lo or (hi is not None and value > hi):
+        raise InputError(f"{where} must be in [{lo}, {hi}], got {value!r}")
+    return value
+
+
+def _vector(value: Any, where: str) -> np.ndarray:
+    if not isinstance(value, list) or len(value) != 2:
+        raise InputError(f"{where} must be a list [x, y], got {value!r}")
+    return np.array([_number(v, f"{where}[{i}]") for i, v in enumerate(value)])
+
+
+def _parse_radar(spec: Any, base_dir: Path) -> RadarConfig:
+    if spec == "paper":
+        return PAPER_RADAR
+    if isinstance(spec, str):
+        cfg = (base_dir / spec).resolve()
+        if not cfg.is_file():
+            raise InputError(f"radar: TI .cfg file {spec!r} not found (looked for {str(cfg)!r})")
+        try:
+            from core.config import read_ti_cfg  # added by the radar chain (branch sim)
+        except ImportError:
+            raise InputError("radar: TI .cfg import is not available in this build") from None
+        return read_ti_cfg(cfg)
+    if isinstance(spec, dict):
+        try:
+            return RadarConfig.from_dict(spec)
+        except InputError as exc:
+            raise InputError(f"radar: {exc.message}") from None
+    raise InputError(
+        f"radar must be 'paper', a path to a TI .cfg or an object of fields, got {spec!r}"
+    )
+
+
+def _parse_trajectory(
+    spec: Any, where: str, scene_seed: int, index: int, aoi: AOI, dt: float
+) -> Trajectory:
+    if not isinstance(spec, dict):
+        raise InputError(f"{where} must be a JSON object, got {type(spec).__name__}")
+    if "class" in spec:
+        params = {k: v for k, v in spec.items() if k not in ("class", "seed")}
+        cls = spec["class"]
+        if not isinstance(cls, str) or cls not in TRAJECTORY_CLASSES:
+            raise InputError(
+                f"{where}.class: unknown trajectory class {cls!r}; "
+                f"expected one of {list(TRAJECTORY_CLASSES)}"
+            )
+        validate_class_parameters(cls, params, where)
+        if "seed" in spec:
+            seed = _integer(spec["seed"], f"{where}.seed")
+        else:
+            seed = person_seed(scene_seed, index)
+        try:
+            return generate_trajectory(
+                cls, np.random.default_rng(seed), aoi=aoi, frame_period_s=dt, **params
+            )
+        except InputError as exc:
+            raise InputError(f"{where}: {exc.message}") from None
+    if "waypoints" in spec:
+        _check_keys(spec, ("waypoints",), where)
+        w = spec["waypoints"]
+        if not isinstance(w, list) or len(w) < 2:
+            raise InputError(f"{where}.waypoints must list at least 2 [x_m, y_m, speed_mps]")
+        rows = []
+        for i, row in enumerate(w):
+            f = f"{where}.waypoints[{i}]"
+            if not isinstance(row, list) or len(row) != 3:
+                raise InputError(f"{f} must be [x_m, y_m, speed_mps], got {row!r}")
+            x, y = _number(row[0], f"{f}[0]"), _number(row[1], f"{f}[1]")
+            s = _number(row[2], f"{f}[2] (speed_mps)", *WAYPOINT_SPEED_RANGE_MPS)
+            if not aoi.contains(np.array([x, y])):
+                raise InputError(f"{f}: point ({x}, {y}) lies outside the AOI")
+            rows.append((x, y, s))
+        try:
+            return waypoint_trajectory(np.array(rows), frame_period_s=dt)
+        except InputError as exc:
+            raise InputError(f"{where}: {exc.message}") from None
+    if "initial_position_m" in spec:
+        keys = ("initial_position_m", "initial_velocity_mps", "acceleration_mps2", "frames")
+        _check_keys(spec, keys, where)
+        for k in keys[:3]:
+            if k not in spec:
+                raise InputError(f"{where}: missing key {k!r}")
+        p0 = _vector(spec["initial_position_m"], f"{where}.initial_position_m")
+        v0 = _vector(spec["initial_velocity_mps"], f"{where}.initial_velocity_mps")
+        acc = spec["acceleration_mps2"]
+        if isinstance(acc, list) and acc and isinstance(acc[0], list):
+            a = np.array(
+                [_vector(row, f"{where}.acceleration_mps2[{i}]") for i, row in enumerate(acc)]
+            )
+        else:
+            a = _vector(acc, f"{where}.acceleration_mps2")
+        frames = spec.get("frames")
+        if frames is not None:
+            frames = _integer(frames, f"{where}.frames", 1, MAX_PROFILE_FRAMES)
+        try:
+            return profile_trajectory(
+                initial_position_m=p0,
+                initial_velocity_mps=v0,
+                acceleration_mps2=a,
+                frames=frames,
+                frame_period_s=dt,
+            )
+        except InputError as exc:
+            raise InputError(f"{where}: {exc.message}") from None
+    raise InputError(
+        f"{where} needs 'class' (a-e), 'waypoints' or 'initial_position_m' "
+        f"(explicit profile), got keys {sorted(spec)}"
+    )
+
+
+def person_seed(scene_seed: int, index: int) -> int:
+    """Trajectory seed of person ``index`` when its JSON gives none."""
+    return int(np.random.SeedSequence([scene_seed, index]).generate_state(1)[0])
+
+
+def _parse_scene(data: Any, base_dir: Path) -> Scene:
+    _check_keys(data, SCENE_KEYS, "scene")
+    if data.get("schema_version") != SCHEMA_VERSION:
+        raise InputError(
+            f"schema_version must be {SCHEMA_VERSION}, got {data.get('schema_version')!r}"
+        )
+    radar_spec = data.get("radar", "paper")
+    radar = _parse_radar(radar_spec, base_dir)
+    seed = _integer(data.get("seed", 0), "seed")
+    density = _number(data.get("clutter_density_per_m2", 0.0), "clutter_density_per_m2", 0, 1)
+    aoi_d = _check_keys(
+        data.get("aoi", {}), ("min_range_m", "max_range_m", "max_azimuth_deg"), "aoi"
+    )
+    aoi = AOI(**{k: _number(v, f"aoi.{k}") for k, v in aoi_d.items()})
+    if aoi.max_range_m > radar.max_range_m:
+        raise InputError(
+            f"aoi.max_range_m={aoi.max_range_m} exceeds the radar's maximum range "
+            f"{radar.max_range_m:.3f} m"
+        )
+    refl = data.get("static_reflectors", [])
+    if not isinstance(refl, list):
+        raise InputError("static_reflectors must be a list")
+    reflectors = []
+    for i, r in enumerate(refl):
+        where = f"static_reflectors[{i}]"
+        _check_keys(r, REFLECTOR_KEYS, where)
+        for k in ("x_m", "y_m"):
+            if k not in r:
+                raise InputError(f"{where}: missing key {k!r}")
+        r_m = math.hypot(r["x_m"], r["y_m"], r.get("z_m", 0.0)) if _all_numbers(r) else None
+        if r_m is not None and not MIN_SCATTERER_RANGE_M <= r_m <= radar.max_range_m:
+            raise InputError(
+                f"{where}: range {r_m:.3g} m must be in [{MIN_SCATTERER_RANGE_M}, "
+                f"{radar.max_range_m:.3f}] m (the radar's maximum range)"
+            )
+        reflectors.append(
+            StaticReflector(
+                x_m=_number(r["x_m"], f"{where}.x_m"),
+                y_m=_number(r["y_m"], f"{where}.y_m"),
+                z_m=_number(r.get("z_m", 0.0), f"{where}.z_m", -10, 10),
+                rcs_dbsm=_number(r.get("rcs_dbsm", 10.0), f"{where}.rcs_dbsm", *RCS_RANGE_DBSM),
+            )
+        )
+    persons_d = data.get("persons", [])
+    if not isinstance(persons_d, list):
+        raise InputError("persons must be a list")
+    persons = []
+    for i, p in enumerate(persons_d):
+        where = f"persons[{i}]"
+        _check_keys(p, PERSON_KEYS, where)
+        if "trajectory" not in p:
+            raise InputError(f"{where}: missing key 'trajectory'")
+        traj = _parse_trajectory(
+            p["trajectory"], f"{where}.trajectory", seed, i, aoi, radar.frame_period_s
+        )
+        r_min = float(np.hypot(*traj.position_m.T).min())
+        if r_min < MIN_SCATTERER_RANGE_M:
+            raise InputError(
+                f"{where}.trajectory passes within {r_min:.3g} m of the radar "
+                f"(at least {MIN_SCATTERER_RANGE_M} m)"
+            )
+        rcs = p.get("rcs_dbsm")
+        if rcs is not None:
+            rcs = _number(rcs, f"{where}.rcs_dbsm", *RCS_RANGE_DBSM)
+        model = p.get("model", "point")
+        if model not in PERSON_MODELS:
+            raise InputError(f"{where}.model must be one of {list(PERSON_MODELS)}, got {model!r}")
+        persons.append(
+            Person(trajectory=traj, rcs_dbsm=rcs, model=model, spec=dict(p["trajectory"]))
+        )
+    return Scene(
+        seed=seed,
+        radar=radar,
+        radar_spec=radar_spec,
+        clutter_density_per_m2=density,
+        aoi=aoi,
+        static_reflectors=tuple(reflectors),
+        persons=tuple(persons),
+    )
+
+
+def class_scene(
+    trajectory_class: str,
+    trajectory_seed: int,
+    *,
+    seed: int = 0,
+    clutter_density_per_m2: float = PAPER_CLUTTER_DENSITY_PER_M2,
+    radar: RadarConfig = PAPER_RADAR,
+    aoi: AOI | None = None,
+    **class_params: Any,
+) -> Scene:
+    """A one-person scene whose trajectory is of a class a–e (the paper's set-up)."""
+    aoi = aoi or AOI()
+    traj = generate_trajectory(
+        trajectory_class,
+        np.random.default_rng(trajectory_seed),
+        aoi=aoi,
+        frame_period_s=radar.frame_period_s,
+        **class_params,
+    )
+    spec = {"class": trajectory_class, "seed": int(trajectory_seed), **class_params}
+    return Scene(
+        seed=seed,
+        radar=radar,
+        radar_spec="paper" if radar == PAPER_RADAR else radar.to_dict(),
+        clutter_density_per_m2=clutter_density_per_m2,
+        aoi=aoi,
+        persons=(Person(trajectory=traj, spec=spec),),
+    )
+
+
+def paper_scenes(seed: int, n_trajectories: int = 35) -> list[Scene]:
+    """The paper's data set: 7 trajectories per class, ordered round-robin a, b, c, d, e, a, …
+
+    Trajectory ``k`` has class ``"abcde"[k % 5]``; its trajectory seed and its scene seed come
+    from ``numpy.random.SeedSequence(seed).spawn(n_trajectories)`` (child ``k`` →
+    two 32-bit words), so the set depends on ``seed`` only.
+    """
+    if n_trajectories < 1:
+        raise InputError(f"n_trajectories must be >= 1, got {n_trajectories}")
+    scenes = []
+    for k, child in enumerate(np.random.SeedSequence(seed).spawn(n_trajectories)):
+        traj_seed, scene_seed = (int(s) for s in child.generate_state(2))
+        scenes.append(class_scene(TRAJECTORY_CLASSES[k % 5], traj_seed, seed=scene_seed))
+    return scenes

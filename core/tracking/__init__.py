@@ -1,0 +1,28 @@
+"""IPDA people tracker (SPEC §4): one role per module, :mod:`core.tracking.tracker` composes them.
+
+- :mod:`~core.tracking.params` — :class:`TrackerParams` (JSON in/out, validation)
+- :mod:`~core.tracking.models` — CV / CA direct discrete-time kinematic models
+- :mod:`~core.tracking.ekf` — h(x), analytic Jacobian, prediction, Joseph form
+- :mod:`~core.tracking.gating` — S, Cholesky, Mahalanobis gate, gate volume
+- :mod:`~core.tracking.ipda` — existence, likelihood ratios, δ, ψ, β, PDA update
+- :mod:`~core.tracking.initiation`, :mod:`~core.tracking.management` — birth, confirmation,
+  deletion, merging, cap, estimate
+- :mod:`~core.tracking.tracker` — :func:`run_tracker` (readable reference, every track)
+- :mod:`~core.tracking.kernel` — the same algorithm compiled with numba (hot path)
+- :mod:`~core.tracking.batch` — :func:`track_dataset` over a :class:`core.dataset.Dataset`
+- :mod:`~core.tracking.synthetic` — synthetic measurements for tests and the stability sweep
+"""
+
+from core.tracking.batch import DatasetEstimates, track_dataset
+from core.tracking.params import SEARCH_SPACE, TrackerParams
+from core.tracking.tracker import FrameTracks, TrackerResult, run_tracker
+
+__all__ = [
+    "SEARCH_SPACE",
+    "DatasetEstimates",
+    "FrameTracks",
+    "TrackerParams",
+    "TrackerResult",
+    "run_tracker",
+    "track_dataset",
+]

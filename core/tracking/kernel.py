@@ -1,0 +1,628 @@
+"""The IPDA tracker compiled with numba: the hot path of every Optuna trial.
+
+Same algorithm, same order of operations and the same decisions as the readable reference
+(:mod:`core.tracking.tracker`, which composes the role modules); this file trades readability for
+speed: the tracks live in preallocated arrays, the small matrix products are explicit loops on
+scratch buffers (no allocation per track and frame), and one call tracks every selected
+trajectory of a data set. ``tests/core/tracking/test_kernel.py`` checks that both paths agree to
+1e-10. See docs/decisions/tracker-01-numba-kernel.md for why numba.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+
+import numpy as np
+from numba import njit
+
+from core.tracking.gating import gate_threshold
+from core.tracking.initiation import initial_covariance
+from core.tracking.ipda import LOG_2PI
+from core.tracking.models import process_noise, transition_matrix
+from core.tracking.params import TrackerParams
+
+__all__ = ["track_frames"]
+
+MIN_RANGE_M = 1e-2  # same as core.tracking.ekf.MIN_RANGE_M
+
+
+@njit(cache=True)
+def _wrap(a):
+    w = ((a + math.pi) % (2.0 * math.pi)) - math.pi
+    if w == -math.pi:
+        w = math.pi
+    return w
+
+
+@njit(cache=True)
+def _safe_xy(x, y):
+    r = math.hypot(x, y)
+    if r >= MIN_RANGE_M:
+        return x, y, r
+    if r == 0.0:
+        return 0.0, MIN_RANGE_M, MIN_RANGE_M
+    s = MIN_RANGE_M / r
+    return x * s, y * s, MIN_RANGE_M
+
+
+@njit(cache=True)
+def _predict(x, P, F, f_cols, f_nnz, Q, xo, Po, tmp):
+    """x⁻ = F x, P⁻ = F P Fᵀ + Q using the sparsity of F (row i: columns f_cols[i, :f_nnz[i]])."""
+    n = x.shape[0]
+    # x⁻ = F x
+    for i in range(n):
+        s = 0.0
+        for q in range(f_nnz[i]):
+            k = f_cols[i, q]
+            s += F[i, k] * x[k]
+        xo[i] = s
+    # tmp = F P
+    for i in range(n):
+        for j in range(n):
+            s = 0.0
+            for q in range(f_nnz[i]):
+                k = f_cols[i, q]
+                s += F[i, k] * P[k, j]
+            tmp[i, j] = s
+    # P⁻ = (F P) Fᵀ + Q, upper triangle mirrored (symmetric by construction)
+    for i in range(n):
+        for j in range(i, n):
+            s = 0.0
+            for q in range(f_nnz[j]):
+                k = f_cols[j, q]
+                s += tmp[i, k] * F[j, k]
+            s += Q[i, j]
+            Po[i, j] = s
+            Po[j, i] = s
+
+
+@njit(cache=True)
+def _measure(x, zp, H):
+    """h(x) into zp (3,), Jacobian into H (3, n)."""
+    px, py, r = _safe_xy(x[0], x[1])
+    vx, vy = x[2], x[3]
+    r2 = r * r
+    r3 = r2 * r
+    zp[0] = r
+    zp[1] = math.atan2(px, py)
+    zp[2] = (px * vx + py * vy) / r
+    H[:, :] = 0.0
+    H[0, 0] = px / r
+    H[0, 1] = py / r
+    H[1, 0] = py / r2
+    H[1, 1] = -px / r2
+    cross = vx * py - vy * px
+    H[2, 0] = py * cross / r3
+    H[2, 1] = -px * cross / r3
+    H[2, 2] = px / r
+    H[2, 3] = py / r
+
+
+@njit(cache=True)
+def _innov_cov(H, P, R, S, HP):
+    n = P.shape[0]
+    # HP = H P⁻ (H is zero beyond the first 4 columns)
+    for i in range(3):
+        for j in range(n):
+            s = 0.0
+            for k in range(4):
+                s += H[i, k] * P[k, j]
+            HP[i, j] = s
+    # S = H P⁻ Hᵀ + R, upper triangle mirrored
+    for i in range(3):
+        for j in range(i, 3):
+            s = 0.0
+            for k in range(4):
+                s += HP[i, k] * H[j, k]
+            s += R[i, j]
+            S[i, j] = s
+            S[j, i] = s
+
+
+@njit(cache=True)
+def _chol3(S, L):
+    L[:, :] = 0.0
+    for j in range(3):
+        s = S[j, j]
+        for k in range(j):
+            s -= L[j, k] * L[j, k]
+        d = math.sqrt(s) if s > 0.0 else 1e-300
+        L[j, j] = d
+        for i in range(j + 1, 3):
+            t = S[i, j]
+            for k in range(j):
+                t -= L[i, k] * L[j, k]
+            L[i, j] = t / d
+
+
+@njit(cache=True)
+def _fwd3(L, b, w):
+    for i in range(3):
+        s = b[i]
+        for k in range(i):
+            s -= L[i, k] * w[k]
+        w[i] = s / L[i, i]
+
+
+@njit(cache=True)
+def _back3(L, b, w):
+    for i in range(2, -1, -1):
+        s = b[i]
+        for k in range(i + 1, 3):
+            s -= L[k, i] * w[k]
+        w[i] = s / L[i, i]
+
+
+@njit(cache=True)
+def _pda_update(x, P, xp, Pp, H, HP, R, L, nu, beta, beta0, mval, K, B, C, KT, T2, w, v):
+    """PDA update with the spread of means and the Joseph form into x, P."""
+    n = xp.shape[0]
+    # K = P⁻ Hᵀ S⁻¹: row i of K solves S kᵢ = (H P⁻)[:, i]
+    for i in range(n):
+        for r in range(3):
+            v[r] = HP[r, i]
+        _fwd3(L, v, w)
+        _back3(L, w, v)
+        for r in range(3):
+            K[i, r] = v[r]
+    # ν̄ = Σ βᵢ νᵢ
+    nb0 = 0.0
+    nb1 = 0.0
+    nb2 = 0.0
+    for j in range(mval):
+        nb0 += beta[j] * nu[j, 0]
+        nb1 += beta[j] * nu[j, 1]
+        nb2 += beta[j] * nu[j, 2]
+    # x = x⁻ + K ν̄
+    for i in range(n):
+        x[i] = xp[i] + K[i, 0] * nb0 + K[i, 1] * nb1 + K[i, 2] * nb2
+    # B = (I − K H) P⁻ = P⁻ − K (H P⁻)
+    for i in range(n):
+        for j in range(n):
+            B[i, j] = Pp[i, j] - (K[i, 0] * HP[0, j] + K[i, 1] * HP[1, j] + K[i, 2] * HP[2, j])
+    # C = B Hᵀ, so that (I − K H) P⁻ (I − K H)ᵀ = B − C Kᵀ
+    for i in range(n):
+        for r in range(3):
+            C[i, r] = B[i, 0] * H[r, 0] + B[i, 1] * H[r, 1] + B[i, 2] * H[r, 2] + B[i, 3] * H[r, 3]
+    # T2 = (1 − β₀) R + spread, spread = Σβᵢ(νᵢ − ν̄)(νᵢ − ν̄)ᵀ + β₀ ν̄ν̄ᵀ (= Σβνν' − ν̄ν̄')
+    c = 1.0 - beta0
+    nbar = (nb0, nb1, nb2)
+    for a in range(3):
+        for b in range(3):
+            s = beta0 * nbar[a] * nbar[b]
+            for j in range(mval):
+                s += beta[j] * (nu[j, a] - nbar[a]) * (nu[j, b] - nbar[b])
+            T2[a, b] = c * R[a, b] + s
+    # KT = K T2
+    for i in range(n):
+        for b in range(3):
+            KT[i, b] = K[i, 0] * T2[0, b] + K[i, 1] * T2[1, b] + K[i, 2] * T2[2, b]
+    # P = β₀ P⁻ + (1 − β₀) [(I − KH) P⁻ (I − KH)ᵀ] + K [(1 − β₀) R + spread] Kᵀ
+    #   = β₀ P⁻ + (1 − β₀) P_c + K (Σβνν' − ν̄ν̄') Kᵀ, P_c in the Joseph form
+    for i in range(n):
+        for j in range(i, n):
+            joseph = B[i, j] - (C[i, 0] * K[j, 0] + C[i, 1] * K[j, 1] + C[i, 2] * K[j, 2])
+            kt = KT[i, 0] * K[j, 0] + KT[i, 1] * K[j, 1] + KT[i, 2] * K[j, 2]
+            val = beta0 * Pp[i, j] + c * joseph + kt
+            P[i, j] = val
+            P[j, i] = val
+
+
+@njit(cache=True)
+def _healthy(x, P, psi, Lw):
+    """True when x, P, ψ are finite, ψ ∈ [0, 1] and P is symmetric positive definite."""
+    n = x.shape[0]
+    if not (0.0 <= psi <= 1.0):
+        return False
+    for i in range(n):
+        if not math.isfinite(x[i]):
+            return False
+        for j in range(n):
+            if not math.isfinite(P[i, j]) or P[i, j] != P[j, i]:
+                return False
+    # Cholesky: every pivot must be > 0
+    for j in range(n):
+        s = P[j, j]
+        for k in range(j):
+            s -= Lw[j, k] * Lw[j, k]
+        if not s > 0.0:
+            return False
+        d = math.sqrt(s)
+        Lw[j, j] = d
+        for i in range(j + 1, n):
+            t = P[i, j]
+            for k in range(j):
+                t -= Lw[i, k] * Lw[j, k]
+            Lw[i, j] = t / d
+    return True
+
+
+@njit(cache=True)
+def _better(psi_a, id_a, psi_b, id_b):
+    """True when track a ranks before track b (higher ψ, ties: older)."""
+    return psi_a > psi_b or (psi_a == psi_b and id_a < id_b)
+
+
+@njit(cache=True)
+def _compact(keep, nt, X, P, psi, conf, ids):
+    j = 0
+    for i in range(nt):
+        if keep[i]:
+            if j != i:
+                X[j] = X[i]
+                P[j] = P[i]
+                psi[j] = psi[i]
+                conf[j] = conf[i]
+                ids[j] = ids[i]
+            j += 1
+    return j
+
+
+@njit(cache=True)
+def _rank(nt, psi, ids, order):
+    for i in range(nt):
+        order[i] = i
+    for i in range(1, nt):  # insertion sort, stable, few tracks
+        t = order[i]
+        k = i - 1
+        while k >= 0 and _better(psi[t], ids[t], psi[order[k]], ids[order[k]]):
+            order[k + 1] = order[k]
+            k -= 1
+        order[k + 1] = t
+
+
+@njit(cache=True)
+def _track_kernel(
+    z,
+    f_off,
+    t_off,
+    sel,
+    out_offsets,
+    F,
+    f_cols,
+    f_nnz,
+    Q,
+    R,
+    P0,
+    gamma,
+    gamma2,
+    p_d,
+    p_g,
+    p_te,
+    p11,
+    p21,
+    rho_given,
+    nonparam,
+    confirm_th,
+    delete_th,
+    max_tracks,
+    est_xy,
+    has,
+    est_psi,
+    est_x,
+    est_P,
+    conf_xy,
+    n_conf,
+    n_tr,
+    check,
+    n_bad,
+    chol,
+):
+    n = F.shape[0]
+    pdpg = p_d * p_g
+    log_pg = math.log(p_g)
+    log_pdpg = math.log(pdpg)
+    a0 = math.log1p(-pdpg) if pdpg < 1.0 else -math.inf
+    # gate volume constant c₃ γ^{3/2}, c₃ = 4π/3
+    vol_c = 4.0 * math.pi / 3.0 * gamma**1.5
+    max_m = 0
+    for f in range(len(f_off) - 1):
+        max_m = max(max_m, f_off[f + 1] - f_off[f])
+    cap = max_tracks + max_m + 1
+    X = np.zeros((cap, n))
+    P = np.zeros((cap, n, n))
+    psi = np.zeros(cap)
+    conf = np.zeros(cap, dtype=np.bool_)
+    ids = np.zeros(cap, dtype=np.int64)
+    keep = np.zeros(cap, dtype=np.bool_)
+    order = np.zeros(cap, dtype=np.int64)
+    gated_any = np.zeros(max_m + 1, dtype=np.bool_)
+    d2 = np.zeros(max_m + 1)
+    nu = np.zeros((max_m + 1, 3))
+    idx = np.zeros(max_m + 1, dtype=np.int64)
+    beta = np.zeros(max_m + 1)
+    xp = np.zeros(n)
+    Pp = np.zeros((n, n))
+    tmp = np.zeros((n, n))
+    A = np.zeros((n, n))
+    K = np.zeros((n, 3))
+    C3 = np.zeros((n, 3))
+    KT = np.zeros((n, 3))
+    H = np.zeros((3, n))
+    HP = np.zeros((3, n))
+    S = np.zeros((3, 3))
+    L = np.zeros((3, 3))
+    tmp2 = np.zeros((3, 3))
+    zp = np.zeros(3)
+    w = np.zeros(3)
+    v = np.zeros(3)
+    for si in range(len(sel)):
+        k_traj = sel[si]
+        fa = t_off[k_traj]
+        fb = t_off[k_traj + 1]
+        o = out_offsets[si]
+        nt = 0
+        next_id = 0
+        for f in range(fa, fb):
+            za = f_off[f]
+            m = f_off[f + 1] - za
+            for j in range(m):
+                gated_any[j] = False
+            n_old = nt
+            for t in range(n_old):
+                _predict(X[t], P[t], F, f_cols, f_nnz, Q, xp, Pp, tmp)
+                # ψ⁻ = p11 ψ + p21 (1 − ψ)
+                pp = p11 * psi[t] + p21 * (1.0 - psi[t])
+                pp = min(1.0, max(0.0, pp))
+                _measure(xp, zp, H)
+                _innov_cov(H, Pp, R, S, HP)
+                _chol3(S, L)
+                mval = 0
+                for j in range(m):
+                    v[0] = z[za + j, 0] - zp[0]
+                    v[1] = _wrap(z[za + j, 1] - zp[1])
+                    v[2] = z[za + j, 2] - zp[2]
+                    _fwd3(L, v, w)
+                    dd = w[0] * w[0] + w[1] * w[1] + w[2] * w[2]
+                    if dd <= gamma:
+                        gated_any[j] = True
+                        nu[mval, 0] = v[0]
+                        nu[mval, 1] = v[1]
+                        nu[mval, 2] = v[2]
+                        d2[mval] = dd
+                        idx[mval] = j
+                        mval += 1
+                logdet = 2.0 * (math.log(L[0, 0]) + math.log(L[1, 1]) + math.log(L[2, 2]))
+                if mval == 0:
+                    # ψ = (1 − P_D P_G) ψ⁻ / (1 − P_D P_G ψ⁻); state unchanged
+                    if pp <= 0.0:
+                        psi[t] = 0.0
+                    elif pp >= 1.0:
+                        psi[t] = 1.0
+                    else:
+                        psi[t] = (1.0 - pdpg) * pp / (1.0 - pdpg * pp)
+                    X[t, :] = xp
+                    P[t, :, :] = Pp
+                    continue
+                if nonparam:
+                    m_hat = mval - pdpg * pp
+                    if m_hat <= 0.0:
+                        m_hat = float(mval)
+                    # ρ̂ = m̂ / V, V = c₃ γ^{3/2} √det S
+                    rho = m_hat / (vol_c * L[0, 0] * L[1, 1] * L[2, 2])
+                else:
+                    rho = rho_given
+                # log Λᵢ = −½dᵢ² − ½ log det S − (3/2) log 2π − log(P_G ρ)
+                # aᵢ = log(P_D P_G) + log Λᵢ
+                c0 = -0.5 * logdet - 1.5 * LOG_2PI - (log_pg + math.log(rho)) + log_pdpg
+                top = a0
+                for j in range(mval):
+                    beta[j] = -0.5 * d2[j] + c0
+                    if beta[j] > top:
+                        top = beta[j]
+                ssum = math.exp(a0 - top)
+                for j in range(mval):
+                    ssum += math.exp(beta[j] - top)
+                lse = top + math.log(ssum)
+                b0 = math.exp(a0 - lse)
+                for j in range(mval):
+                    beta[j] = math.exp(beta[j] - lse)
+                omd = math.exp(lse)  # 1 − δ
+                if pp <= 0.0:
+                    psi[t] = 0.0
+                elif pp >= 1.0:
+                    psi[t] = 1.0
+                else:
+                    # ψ = (1 − δ) ψ⁻ / ((1 − ψ⁻) + (1 − δ) ψ⁻)
+                    ps = omd * pp / ((1.0 - pp) + omd * pp)
+                    psi[t] = min(1.0, max(0.0, ps))
+                _pda_update(
+                    X[t], P[t], xp, Pp, H, HP, R, L, nu, beta, b0, mval, K, A, C3, KT, tmp2, w, v
+                )
+            # initiation: measurements outside every gate start tentative tracks
+            for j in range(m):
+                if not gated_any[j]:
+                    r = z[za + j, 0]
+                    az = z[za + j, 1]
+                    vr = z[za + j, 2]
+                    sa = math.sin(az)
+                    ca = math.cos(az)
+                    X[nt, :] = 0.0
+                    X[nt, 0] = r * sa
+                    X[nt, 1] = r * ca
+                    X[nt, 2] = vr * sa
+                    X[nt, 3] = vr * ca
+                    P[nt, :, :] = P0
+                    psi[nt] = p_te
+                    conf[nt] = False
+                    ids[nt] = next_id
+                    next_id += 1
+                    nt += 1
+            # confirmation (tracks updated this frame only), deletion
+            for t in range(nt):
+                if t < n_old and psi[t] >= confirm_th:
+                    conf[t] = True
+                keep[t] = psi[t] >= delete_th
+            nt = _compact(keep, nt, X, P, psi, conf, ids)
+            # merging: greedy in ψ order, within the 2-D gate of the combined position covariance
+            if nt > 1:
+                _rank(nt, psi, ids, order)
+                for t in range(nt):
+                    keep[t] = True
+                for ia in range(nt):
+                    a = order[ia]
+                    if not keep[a]:
+                        continue
+                    for ib in range(ia + 1, nt):
+                        b = order[ib]
+                        if not keep[b]:
+                            continue
+                        dx = X[a, 0] - X[b, 0]
+                        dy = X[a, 1] - X[b, 1]
+                        c00 = P[a, 0, 0] + P[b, 0, 0]
+                        c01 = P[a, 0, 1] + P[b, 0, 1]
+                        c11 = P[a, 1, 1] + P[b, 1, 1]
+                        # d² = Δpᵀ (P_a + P_b)⁻¹ Δp
+                        dd = (c11 * dx * dx - 2.0 * c01 * dx * dy + c00 * dy * dy) / (
+                            c00 * c11 - c01 * c01
+                        )
+                        if dd <= gamma2:
+                            keep[b] = False
+                nt = _compact(keep, nt, X, P, psi, conf, ids)
+            # cap: the lowest ψ go (ties: the youngest)
+            if nt > max_tracks:
+                _rank(nt, psi, ids, order)
+                for t in range(nt):
+                    keep[t] = False
+                for ia in range(max_tracks):
+                    keep[order[ia]] = True
+                nt = _compact(keep, nt, X, P, psi, conf, ids)
+            # outputs: the estimate is the confirmed track with the highest ψ (ties: older)
+            best = -1
+            nc = 0
+            for t in range(nt):
+                if conf[t]:
+                    conf_xy[o, nc, 0] = X[t, 0]
+                    conf_xy[o, nc, 1] = X[t, 1]
+                    nc += 1
+                    if best < 0 or _better(psi[t], ids[t], psi[best], ids[best]):
+                        best = t
+            n_conf[o] = nc
+            n_tr[o] = nt
+            if check:
+                for t in range(nt):
+                    if not _healthy(X[t], P[t], psi[t], chol):
+                        n_bad[o] += 1
+            if best >= 0:
+                has[o] = True
+                est_xy[o, 0] = X[best, 0]
+                est_xy[o, 1] = X[best, 1]
+                est_psi[o] = psi[best]
+                est_x[o, :] = X[best]
+                est_P[o, :, :] = P[best]
+            o += 1
+
+
+@functools.lru_cache(maxsize=256)
+def _matrices(params: TrackerParams, frame_period_s: float):
+    """F, its sparsity (columns and counts per row), Q, R and P0, cached per parameter set."""
+    d = params.state_dim
+    F = transition_matrix(params.model, frame_period_s)
+    f_nnz = np.count_nonzero(F, axis=1).astype(np.int64)
+    f_cols = np.zeros((d, max(1, int(f_nnz.max()))), dtype=np.int64)
+    for i in range(d):
+        nz = np.flatnonzero(F[i])
+        f_cols[i, : len(nz)] = nz
+    out = (
+        F,
+        f_cols,
+        f_nnz,
+        process_noise(params.model, frame_period_s, params.q_coeff),
+        # R = diag(r11², r22², r33²)
+        np.diag([params.r11**2, params.r22**2, params.r33**2]),
+        initial_covariance(params.p0),
+    )
+    return out  # shared between calls: never written (read-only flags would force a recompile)
+
+
+def track_frames(
+    z: np.ndarray,
+    frame_offsets: np.ndarray,
+    trajectory_offsets: np.ndarray,
+    trajectories: np.ndarray,
+    params: TrackerParams,
+    frame_period_s: float,
+    *,
+    check: bool = False,
+):
+    """Track the selected trajectories with the compiled kernel.
+
+    Parameters
+    ----------
+    z
+        All measurements (P, 3) ``[r, az, vr]``, sorted by frame.
+    frame_offsets
+        (F + 1,) point ranges per global frame.
+    trajectory_offsets
+        (K + 1,) frame ranges per trajectory.
+    trajectories
+        (K_sel,) indices of the trajectories to track.
+    params, frame_period_s
+        Tracker parameters and time step T (s).
+    check
+        Count, per frame, the live tracks whose state, covariance or ψ is unhealthy (non-finite,
+        ψ outside [0, 1], P not symmetric positive definite); returned as a 9th array.
+
+    Returns
+    -------
+    tuple
+        ``est_xy (F_sel, 2), has (F_sel,), est_psi (F_sel,), conf_xy (F_sel, max_tracks, 2),
+        n_conf (F_sel,), n_tracks (F_sel,), est_state (F_sel, d), est_cov (F_sel, d, d)``
+        with NaN where there is no estimate.
+    """
+    sel = np.ascontiguousarray(trajectories, dtype=np.int64)
+    t_off = np.ascontiguousarray(trajectory_offsets, dtype=np.int64)
+    lengths = t_off[sel + 1] - t_off[sel]
+    out_off = np.concatenate(([0], np.cumsum(lengths))).astype(np.int64)
+    n_out = int(out_off[-1])
+    d = params.state_dim
+    est_xy = np.full((n_out, 2), np.nan)
+    has = np.zeros(n_out, dtype=np.bool_)
+    est_psi = np.full(n_out, np.nan)
+    est_x = np.full((n_out, d), np.nan)
+    est_P = np.full((n_out, d, d), np.nan)
+    conf_xy = np.full((n_out, params.max_tracks, 2), np.nan)
+    n_conf = np.zeros(n_out, dtype=np.int64)
+    n_tr = np.zeros(n_out, dtype=np.int64)
+    n_bad = np.zeros(n_out, dtype=np.int64)
+    nonparam = params.nonparametric
+    F, f_cols, f_nnz, Q, R, P0 = _matrices(params, float(frame_period_s))
+    _track_kernel(
+        np.ascontiguousarray(z, dtype=np.float64),
+        np.ascontiguousarray(frame_offsets, dtype=np.int64),
+        t_off,
+        sel,
+        out_off,
+        F,
+        f_cols,
+        f_nnz,
+        Q,
+        R,
+        P0,
+        gate_threshold(params.p_g, 3),
+        gate_threshold(params.p_g, 2),
+        float(params.p_d),
+        float(params.p_g),
+        float(params.p_te),
+        float(params.p11),
+        float(params.p21),
+        1.0 if nonparam else float(params.clutter_density),
+        nonparam,
+        float(params.confirm_threshold),
+        float(params.delete_threshold),
+        int(params.max_tracks),
+        est_xy,
+        has,
+        est_psi,
+        est_x,
+        est_P,
+        conf_xy,
+        n_conf,
+        n_tr,
+        bool(check),
+        n_bad,
+        np.zeros((d, d)),
+    )
+    out = (est_xy, has, est_psi, conf_xy, n_conf, n_tr, est_x, est_P)
+    return (*out, n_bad) if check else out

@@ -1,0 +1,245 @@
+"""Tracker parameters (SPEC §4, §6): the paper's 14 optimised parameters plus the fixed ones.
+
+JSON keys exactly as SPEC §6; missing keys take the defaults, unknown keys are an error that
+names them. Every field is validated in ``__post_init__`` with a message naming the field.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import tempfile
+from dataclasses import dataclass, fields
+from pathlib import Path
+
+from core.errors import InputError
+
+MODELS = ("cv", "ca")
+#: State dimension per motion model: CV [x, y, vx, vy], CA [x, y, vx, vy, ax, ay].
+STATE_DIM = {"cv": 4, "ca": 6}
+NONPARAMETRIC = "nonparametric"
+
+#: Search space of the paper's eq. (15) (inclusive bounds). ``p0_ii`` is the i-th entry of p0.
+SEARCH_SPACE: dict[str, tuple[float, float]] = {
+    "q_coeff": (0.1, 30.0),
+    "r11": (0.01, 0.5),
+    "r22": (0.01, 0.2),
+    "r33": (0.1, 3.0),
+    "p0_00": (0.1, 10.0),
+    "p0_11": (0.1, 10.0),
+    "p0_22": (0.01, 10.0),
+    "p0_33": (0.01, 10.0),
+    "p0_44": (0.001, 10.0),
+    "p0_55": (0.001, 10.0),
+    "p_d": (0.8, 0.99),
+    "p_te": (0.2, 1.0),
+    "p11": (0.7, 1.0),
+    "p21": (0.0, 0.4),
+}
+
+#: Default initial standard deviations p0,ii (m, m, m/s, m/s, m/s², m/s²); see docs/tracker.md.
+DEFAULT_P0 = {"cv": (0.3, 0.3, 1.0, 1.0), "ca": (0.3, 0.3, 1.0, 1.0, 0.5, 0.5)}
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class TrackerParams:
+    """Parameters of the IPDA tracker.
+
+    Attributes
+    ----------
+    model
+        Motion model, ``"cv"`` (state ``[x, y, vx, vy]``) or ``"ca"`` (``[x, y, vx, vy, ax, ay]``).
+    q_coeff
+        Process-noise scale: ``Q = q_coeff · Q0`` with the direct discrete-time kinematic ``Q0``
+        (for CV the variance of the acceleration in m²/s⁴).
+    r11, r22, r33
+        Measurement noise standard deviations of range (m), azimuth (rad) and radial velocity
+        (m/s): ``R = diag(r11², r22², r33²)``.
+    p0
+        Initial state standard deviations ``p0,ii`` (4 for CV, 6 for CA), SI units of the state.
+    p_d
+        Detection probability P_D.
+    p_te
+        Existence probability ψ of a new (tentative) track.
+    p11, p21
+        Markov chain of existence, eq. (9): ψ⁻ = p11·ψ + p21·(1 − ψ).
+    p_g
+        Gate probability P_G (gate threshold γ = χ²₃⁻¹(P_G)). Fixed, not optimised.
+    confirm_threshold, delete_threshold
+        A tentative track is confirmed when ψ ≥ confirm_threshold (after at least one update);
+        any track is deleted when ψ < delete_threshold.
+    clutter_density
+        Clutter density ρ in measurement space (per m · rad · m/s), or ``"nonparametric"``
+        (ρ̂ = m̂ / V estimated per track and frame).
+    max_tracks
+        Track cap; beyond it the tracks with the lowest ψ are removed.
+    """
+
+    model: str = "cv"
+    q_coeff: float = 2.0
+    r11: float = 0.05
+    r22: float = 0.03
+    r33: float = 0.3
+    p0: tuple[float, ...] = DEFAULT_P0["cv"]
+    p_d: float = 0.9
+    p_te: float = 0.2
+    p11: float = 0.98
+    p21: float = 0.0
+    p_g: float = 0.99
+    confirm_threshold: float = 0.9
+    delete_threshold: float = 0.1
+    clutter_density: float | str = 0.0073
+    max_tracks: int = 20
+
+    def __post_init__(self) -> None:
+        if self.model not in MODELS:
+            raise InputError(f"model must be one of {MODELS}, got model={self.model!r}")
+        try:
+            p0 = tuple(float(v) for v in self.p0)
+        except (TypeError, ValueError):
+            raise InputError(f"p0 must be a list of numbers, got p0={self.p0!r}") from None
+        object.__setattr__(self, "p0", p0)
+        n = STATE_DIM[self.model]
+        if len(p0) != n:
+            raise InputError(
+                f"p0 must have {n} entries for model {self.model!r}, got {len(p0)}: p0={p0}"
+            )
+        for i, v in enumerate(p0):
+            if not (math.isfinite(v) and v > 0):
+                raise InputError(f"p0[{i}] must be a positive finite number, got {v}")
+        for name in ("q_coeff", "r11", "r22", "r33"):
+            v = getattr(self, name)
+            if not _is_number(v) or not (math.isfinite(v) and v > 0):
+                raise InputError(f"{name} must be a positive finite number, got {name}={v!r}")
+        unit = ("p_d", "p_te", "p11", "p21", "p_g", "confirm_threshold", "delete_threshold")
+        for name in unit:
+            v = getattr(self, name)
+            if not _is_number(v) or not (0.0 <= v <= 1.0):
+                raise InputError(f"{name} must be in [0, 1], got {name}={v!r}")
+        for name in ("p_d", "p_g"):
+            if getattr(self, name) <= 0.0:
+                raise InputError(f"{name} must be > 0, got {name}={getattr(self, name)!r}")
+        if self.p_g >= 1.0:
+            raise InputError(f"p_g must be < 1 (finite gate), got p_g={self.p_g!r}")
+        if self.delete_threshold > self.confirm_threshold:
+            raise InputError(
+                "delete_threshold must not exceed confirm_threshold, got "
+                f"delete_threshold={self.delete_threshold}, "
+                f"confirm_threshold={self.confirm_threshold}"
+            )
+        rho = self.clutter_density
+        if isinstance(rho, str):
+            if rho != NONPARAMETRIC:
+                raise InputError(
+                    f"clutter_density must be a positive number or {NONPARAMETRIC!r}, "
+                    f"got clutter_density={rho!r}"
+                )
+        elif not _is_number(rho) or not (math.isfinite(rho) and rho > 0):
+            raise InputError(
+                f"clutter_density must be a positive number or {NONPARAMETRIC!r}, "
+                f"got clutter_density={rho!r}"
+            )
+        if isinstance(self.max_tracks, bool) or not isinstance(self.max_tracks, int):
+            raise InputError(f"max_tracks must be an integer, got max_tracks={self.max_tracks!r}")
+        if self.max_tracks < 1:
+            raise InputError(f"max_tracks must be >= 1, got max_tracks={self.max_tracks}")
+
+    # ---- derived -----------------------------------------------------------------------------
+    @property
+    def state_dim(self) -> int:
+        """Number of state components (4 for CV, 6 for CA)."""
+        return STATE_DIM[self.model]
+
+    @property
+    def nonparametric(self) -> bool:
+        """True when the clutter density is estimated per track and frame."""
+        return self.clutter_density == NONPARAMETRIC
+
+    # ---- construction ------------------------------------------------------------------------
+    @classmethod
+    def default(cls, model: str = "cv") -> TrackerParams:
+        """The default parameters of a motion model (see docs/tracker.md)."""
+        if model not in MODELS:
+            raise InputError(f"model must be one of {MODELS}, got model={model!r}")
+        return cls(model=model, p0=DEFAULT_P0[model])
+
+    def to_dict(self) -> dict:
+        """JSON-ready dict with the SPEC §6 keys (``p0`` as a list)."""
+        d = {f.name: getattr(self, f.name) for f in fields(self)}
+        d["p0"] = list(self.p0)
+        return d
+
+    @classmethod
+    def from_dict(cls, data: dict, source: str | None = None) -> TrackerParams:
+        """Build from a SPEC §6 dict; missing keys take the defaults of the given model.
+
+        ``p0`` may also be given as ``p0_00 … p0_55`` (the optimiser's names).
+        """
+        if not isinstance(data, dict):
+            raise InputError("tracker parameters must be a JSON object", source)
+        data = dict(data)
+        p0_keys = sorted(k for k in data if k.startswith("p0_"))
+        known = {f.name for f in fields(cls)}
+        valid_p0 = {f"p0_{i}{i}" for i in range(6)}
+        unknown = sorted(k for k in data if k not in known and k not in valid_p0)
+        if unknown:
+            raise InputError(f"unknown tracker parameter keys {unknown}", source)
+        model = data.get("model", "cv")
+        if model not in MODELS:
+            raise InputError(f"model must be one of {MODELS}, got model={model!r}", source)
+        if p0_keys:
+            if "p0" in data:
+                raise InputError("give either p0 or p0_ii keys, not both", source)
+            n = STATE_DIM[model]
+            want = [f"p0_{i}{i}" for i in range(n)]
+            if p0_keys != want:
+                raise InputError(
+                    f"p0 keys for model {model!r} must be {want}, got {p0_keys}", source
+                )
+            data["p0"] = [data.pop(k) for k in want]
+        data.setdefault("p0", DEFAULT_P0[model])
+        if "max_tracks" in data and isinstance(data["max_tracks"], float):
+            if data["max_tracks"].is_integer():
+                data["max_tracks"] = int(data["max_tracks"])
+        try:
+            return cls(**data)
+        except InputError as exc:
+            raise InputError(exc.message, source) from None
+        except TypeError as exc:
+            raise InputError(str(exc), source) from None
+
+    @classmethod
+    def load(cls, path: str | os.PathLike) -> TrackerParams:
+        """Read a JSON parameter file; errors name the file."""
+        path = Path(path)
+        try:
+            text = path.read_text()
+        except FileNotFoundError:
+            raise InputError("file not found", str(path)) from None
+        except OSError as exc:
+            raise InputError(f"cannot read ({exc.strerror})", str(path)) from None
+        try:
+            data = json.loads(text)
+        except json.JSONDecodeError as exc:
+            raise InputError(f"invalid JSON at line {exc.lineno}: {exc.msg}", str(path)) from None
+        return cls.from_dict(data, source=str(path))
+
+    def save(self, path: str | os.PathLike) -> Path:
+        """Write atomically (temporary file in the same folder, then rename)."""
+        path = Path(path)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+        try:
+            with os.fdopen(fd, "w") as fh:
+                json.dump(self.to_dict(), fh, indent=2)
+                fh.write("\n")
+            os.replace(tmp, path)
+        except BaseException:
+            Path(tmp).unlink(missing_ok=True)
+            raise
+        return path
+
+
+def _is_number(v: object) -> bool:
+    return isinstance(v, (int, float)) and not isinstance(v, bool)

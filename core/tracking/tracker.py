@@ -1,0 +1,364 @@
+"""The IPDA multi-track tracker (SPEC §4), readable reference: it composes the role modules.
+
+Per frame: predict every track (motion model, existence eq. 9) → gate the measurements → IPDA
+update of every track with its validated measurements → initiate tentative tracks from the
+measurements outside all gates → confirm → delete → merge → cap → single-person estimate.
+
+This path is plain numpy (one track at a time) and serves the GUI (every track per frame) and the
+tests; :func:`core.tracking.fast.track_dataset` runs the same algorithm compiled for Optuna.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from core.errors import InputError
+from core.tracking import ekf, gating, initiation, ipda, management
+from core.tracking.models import process_noise, transition_matrix
+from core.tracking.params import TrackerParams
+
+__all__ = [
+    "FrameTracks",
+    "TrackerResult",
+    "run_tracker",
+    "frame_slices",
+    "TrackerConstants",
+    "gate_ellipses_xy",
+]
+
+TENTATIVE = 0
+CONFIRMED = 1
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class FrameTracks:
+    """Every live track after one frame (struct of arrays, n tracks, state dimension d).
+
+    Attributes
+    ----------
+    ids
+        Track ids (n,), increasing with birth.
+    state
+        States (n, d): [x, y, vx, vy(, ax, ay)] in m, m/s, m/s².
+    covariance
+        Covariances (n, d, d).
+    psi
+        Existence probabilities (n,).
+    confirmed
+        Status (n,) bool: True confirmed, False tentative.
+    gate_center_xy
+        Centre of each track's gate in x–y (m), (n, 2): the predicted position (for a track
+        born in this frame: its initial position).
+    gate_shape_xy
+        Gate ellipse in x–y (n, 2, 2): the points d with dᵀ G⁻¹ d ≤ 1, G = γ·J S_ra Jᵀ, where
+        S_ra is the (r, az) block of S and J = ∂(x, y)/∂(r, az) (the gate's projection on the
+        r–az plane, linearised into x–y).
+    estimate
+        Index into these arrays of the single-person estimate, or −1.
+    """
+
+    ids: np.ndarray
+    state: np.ndarray
+    covariance: np.ndarray
+    psi: np.ndarray
+    confirmed: np.ndarray
+    gate_center_xy: np.ndarray
+    gate_shape_xy: np.ndarray
+    estimate: int = -1
+
+    def __len__(self) -> int:
+        return len(self.ids)
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class TrackerResult:
+    """Tracker output over F frames.
+
+    Attributes
+    ----------
+    estimate_xy
+        Single-person estimate position (F, 2) in m, NaN where no track is confirmed.
+    has_estimate
+        (F,) bool, a confirmed track exists.
+    estimate_id
+        (F,) id of the estimate track, −1 when none.
+    estimate_psi
+        (F,) ψ of the estimate track, NaN when none.
+    estimate_state, estimate_covariance
+        (F, d) and (F, d, d) of the estimate track, NaN when none.
+    confirmed_xy
+        (F, max_tracks, 2) positions of all confirmed tracks, NaN-padded.
+    n_tracks, n_confirmed
+        (F,) live and confirmed track counts.
+    frames
+        Every track per frame (:class:`FrameTracks`), or None when ``keep_tracks=False``.
+    """
+
+    estimate_xy: np.ndarray
+    has_estimate: np.ndarray
+    estimate_id: np.ndarray
+    estimate_psi: np.ndarray
+    estimate_state: np.ndarray
+    estimate_covariance: np.ndarray
+    confirmed_xy: np.ndarray
+    n_tracks: np.ndarray
+    n_confirmed: np.ndarray
+    frames: tuple[FrameTracks, ...] | None = field(default=None, repr=False)
+
+    @property
+    def n_frames(self) -> int:
+        return len(self.has_estimate)
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class TrackerConstants:
+    """Matrices and thresholds derived once from the parameters and the frame period."""
+
+    F: np.ndarray
+    Q: np.ndarray
+    R: np.ndarray
+    P0: np.ndarray
+    gamma: float
+    gamma2: float
+    pdpg: float
+
+    @classmethod
+    def build(cls, params: TrackerParams, frame_period_s: float) -> TrackerConstants:
+        if not (np.isfinite(frame_period_s) and frame_period_s > 0):
+            raise InputError(f"frame_period_s must be positive, got {frame_period_s=}")
+        return cls(
+            F=transition_matrix(params.model, frame_period_s),
+            Q=process_noise(params.model, frame_period_s, params.q_coeff),
+            # R = diag(r11², r22², r33²)
+            R=np.diag([params.r11**2, params.r22**2, params.r33**2]),
+            P0=initiation.initial_covariance(params.p0),
+            gamma=gating.gate_threshold(params.p_g, 3),
+            gamma2=gating.gate_threshold(params.p_g, 2),
+            pdpg=params.p_d * params.p_g,
+        )
+
+
+@dataclass(slots=True)
+class _Track:  # mutable working record of the reference tracker
+    id: int
+    x: np.ndarray
+    P: np.ndarray
+    psi: float
+    confirmed: bool = False
+    updated: bool = False
+    gate_center: np.ndarray = field(default_factory=lambda: np.zeros(2))
+    gate_shape: np.ndarray = field(default_factory=lambda: np.eye(2))
+
+
+def _gate_xy(x: np.ndarray, S: np.ndarray, gamma: float) -> tuple[np.ndarray, np.ndarray]:
+    px, py, r = ekf.safe_position(x[0], x[1])
+    az = np.arctan2(px, py)
+    # J = ∂(x, y)/∂(r, az) for x = r sin az, y = r cos az
+    J = np.array([[np.sin(az), r * np.cos(az)], [np.cos(az), -r * np.sin(az)]])
+    # G = γ J S_ra Jᵀ
+    return np.array([px, py]), gamma * (J @ S[:2, :2] @ J.T)
+
+
+def frame_slices(frames) -> list[np.ndarray]:
+    """Normalise the measurement input to a list of (m_f, 3) arrays [r, az, vr]."""
+    if isinstance(frames, tuple) and len(frames) == 2 and np.ndim(frames[1]) == 1:
+        z, offsets = frames
+        z = np.asarray(z, dtype=np.float64).reshape(-1, 3)
+        offsets = np.asarray(offsets, dtype=np.int64)
+        return [z[offsets[f] : offsets[f + 1]] for f in range(len(offsets) - 1)]
+    out = []
+    for f, z in enumerate(frames):
+        z = np.asarray(z, dtype=np.float64).reshape(-1, 3)
+        if not np.all(np.isfinite(z)):
+            raise InputError(f"measurements of frame {f} contain NaN or Inf")
+        out.append(z)
+    return out
+
+
+def _step(
+    tracks: list[_Track],
+    z: np.ndarray,
+    params: TrackerParams,
+    c: TrackerConstants,
+    next_id: int,
+) -> tuple[list[_Track], int]:
+    m = len(z)
+    gated = np.zeros((len(tracks), m), dtype=bool)
+    for k, t in enumerate(tracks):
+        # prediction: state, covariance, existence (eq. 9)
+        x_pred, P_pred = ekf.predict(t.x, t.P, c.F, c.Q)
+        psi_pred = ipda.predict_existence(t.psi, params.p11, params.p21)
+        # gate
+        z_pred = ekf.measure(x_pred)
+        H = ekf.jacobian(x_pred)
+        S = gating.innovation_covariance(H, P_pred, c.R)
+        L = gating.cholesky(S)
+        nu_all = ekf.innovation(z, z_pred) if m else np.zeros((0, 3))
+        d2_all = gating.mahalanobis_squared(nu_all, L)
+        inside = d2_all <= c.gamma
+        gated[k] = inside
+        nu, d2 = nu_all[inside], d2_all[inside]
+        n_val = len(nu)
+        # clutter density: given, or non-parametric ρ̂ = m̂/V
+        log_det_S = gating.log_det_from_cholesky(L)
+        if params.nonparametric and n_val:
+            rho = ipda.nonparametric_density(
+                n_val, c.pdpg * psi_pred, gating.gate_volume(L, c.gamma)
+            )
+        elif params.nonparametric:
+            rho = 1.0  # unused: no validated measurement
+        else:
+            rho = float(params.clutter_density)
+        log_lr = ipda.log_likelihood_ratios(d2, log_det_S, params.p_g, rho)
+        assoc = ipda.associate(log_lr, c.pdpg)
+        t.psi = ipda.update_existence(psi_pred, assoc, c.pdpg, n_val)
+        t.x, t.P = ipda.pda_update(x_pred, P_pred, H, c.R, L, nu, assoc)
+        t.updated = True
+        t.gate_center, t.gate_shape = _gate_xy(x_pred, S, c.gamma)
+    # initiation from the measurements outside every gate
+    for j in np.flatnonzero(initiation.unassociated(gated)):
+        x0 = initiation.initial_state(z[j], params.state_dim)
+        t = _Track(id=next_id, x=x0, P=c.P0.copy(), psi=params.p_te)
+        next_id += 1
+        S0 = gating.innovation_covariance(ekf.jacobian(x0), t.P, c.R)
+        t.gate_center, t.gate_shape = _gate_xy(x0, S0, c.gamma)
+        tracks.append(t)
+    if not tracks:
+        return tracks, next_id
+    psi = np.array([t.psi for t in tracks])
+    ids = np.array([t.id for t in tracks])
+    conf = management.confirm(
+        np.array([t.confirmed for t in tracks]),
+        psi,
+        np.array([t.updated for t in tracks]),
+        params.confirm_threshold,
+    )
+    for t, cf in zip(tracks, conf):
+        t.confirmed = bool(cf)
+    keep = management.survivors(psi, params.delete_threshold)
+    tracks = [t for t, k in zip(tracks, keep) if k]
+    if len(tracks) > 1:
+        psi = np.array([t.psi for t in tracks])
+        ids = np.array([t.id for t in tracks])
+        pos = np.array([t.x[:2] for t in tracks])
+        pos_cov = np.array([t.P[:2, :2] for t in tracks])
+        keep = management.merge(pos, pos_cov, psi, ids, c.gamma2)
+        tracks = [t for t, k in zip(tracks, keep) if k]
+    if len(tracks) > params.max_tracks:
+        psi = np.array([t.psi for t in tracks])
+        ids = np.array([t.id for t in tracks])
+        keep = management.cap(psi, ids, params.max_tracks)
+        tracks = [t for t, k in zip(tracks, keep) if k]
+    return tracks, next_id
+
+
+def run_tracker(
+    frames: Sequence[np.ndarray] | tuple[np.ndarray, np.ndarray],
+    params: TrackerParams,
+    frame_period_s: float = 0.08,
+    *,
+    keep_tracks: bool = True,
+) -> TrackerResult:
+    """Track one trajectory (one sequence of frames) from scratch.
+
+    Parameters
+    ----------
+    frames
+        Measurements per frame: a sequence of (m_f, 3) arrays ``[r (m), az (rad), vr (m/s)]``,
+        or a pair ``(z (P, 3), frame_offsets (F + 1,))``.
+    params
+        Tracker parameters.
+    frame_period_s
+        Time step T between frames (s).
+    keep_tracks
+        Keep every track of every frame (:attr:`TrackerResult.frames`, for the GUI).
+
+    Returns
+    -------
+    TrackerResult
+    """
+    zs = frame_slices(frames)
+    c = TrackerConstants.build(params, frame_period_s)
+    n_f, d, cap = len(zs), params.state_dim, params.max_tracks
+    est_xy = np.full((n_f, 2), np.nan)
+    has = np.zeros(n_f, dtype=bool)
+    est_id = np.full(n_f, -1, dtype=np.int64)
+    est_psi = np.full(n_f, np.nan)
+    est_x = np.full((n_f, d), np.nan)
+    est_P = np.full((n_f, d, d), np.nan)
+    conf_xy = np.full((n_f, cap, 2), np.nan)
+    n_tracks = np.zeros(n_f, dtype=np.int64)
+    n_conf = np.zeros(n_f, dtype=np.int64)
+    kept: list[FrameTracks] = []
+    tracks: list[_Track] = []
+    next_id = 0
+    for f, z in enumerate(zs):
+        tracks, next_id = _step(tracks, z, params, c, next_id)
+        psi = np.array([t.psi for t in tracks])
+        ids = np.array([t.id for t in tracks], dtype=np.int64)
+        conf = np.array([t.confirmed for t in tracks], dtype=bool)
+        b = management.best_confirmed(psi, ids, conf)
+        n_tracks[f] = len(tracks)
+        n_conf[f] = int(conf.sum())
+        cx = [t.x[:2] for t in tracks if t.confirmed]
+        if cx:
+            conf_xy[f, : len(cx)] = cx
+        if b >= 0:
+            t = tracks[b]
+            has[f] = True
+            est_xy[f] = t.x[:2]
+            est_id[f] = t.id
+            est_psi[f] = t.psi
+            est_x[f] = t.x
+            est_P[f] = t.P
+        if keep_tracks:
+            n = len(tracks)
+            kept.append(
+                FrameTracks(
+                    ids=ids,
+                    state=np.array([t.x for t in tracks]).reshape(n, d),
+                    covariance=np.array([t.P for t in tracks]).reshape(n, d, d),
+                    psi=psi,
+                    confirmed=conf,
+                    gate_center_xy=np.array([t.gate_center for t in tracks]).reshape(n, 2),
+                    gate_shape_xy=np.array([t.gate_shape for t in tracks]).reshape(n, 2, 2),
+                    estimate=b,
+                )
+            )
+    return TrackerResult(
+        estimate_xy=est_xy,
+        has_estimate=has,
+        estimate_id=est_id,
+        estimate_psi=est_psi,
+        estimate_state=est_x,
+        estimate_covariance=est_P,
+        confirmed_xy=conf_xy,
+        n_tracks=n_tracks,
+        n_confirmed=n_conf,
+        frames=tuple(kept) if keep_tracks else None,
+    )
+
+
+def gate_ellipses_xy(tracks: FrameTracks, n_points: int = 48) -> np.ndarray:
+    """All gate ellipses of a frame as one NaN-separated x–y curve (for one plot item).
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape (n_tracks · (n_points + 2), 2) in m: each closed ellipse {c + d : dᵀG⁻¹d = 1}
+        (n_points + 1 vertices) followed by a NaN row.
+    """
+    n = len(tracks)
+    t = np.linspace(0.0, 2.0 * np.pi, n_points + 1)
+    circle = np.stack((np.cos(t), np.sin(t)))  # (2, n_points + 1)
+    out = np.full((n, n_points + 2, 2), np.nan)
+    for i in range(n):
+        # G = V Λ Vᵀ; boundary points c + V Λ^{1/2} u, |u| = 1
+        w, V = np.linalg.eigh(tracks.gate_shape_xy[i])
+        out[i, :-1] = (
+            tracks.gate_center_xy[i][:, None] + (V * np.sqrt(np.maximum(w, 0))) @ circle
+        ).T
+    return out.reshape(-1, 2)

@@ -1,0 +1,50 @@
+"""The report: Table I numbers are the re-tracked losses of the best trials, files are complete."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from core.evaluation import evaluate as evaluate_table
+from core.optimization import StudySettings, prepare_study, run_worker
+from core.optimization.report import PAPER_TABLE_I, write_report
+from core.tracking import TrackerParams, track_dataset
+from core.tracking.synthetic import synthetic_dataset
+
+
+def test_report_from_two_small_studies(tmp_path: Path) -> None:
+    train = synthetic_dataset(seed=1, n_per_class=1, n_frames=50)
+    other = synthetic_dataset(seed=2, n_per_class=1, n_frames=50)
+    train.save(tmp_path / "train.npz")
+    other.save(tmp_path / "other.npz")
+    url = f"memory://{tmp_path}"
+    for model in ("cv", "ca"):
+        s = StudySettings(model=model, n_trials=3, storage=url, study_name=f"{model}-main",
+                          dataset=str(tmp_path / "train.npz"))  # fmt: skip
+        prepare_study(s, dataset_path=s.dataset)
+        run_worker(url, s.name, seed=0)
+    r = write_report(url, tmp_path / "out", generalisation_dataset=str(tmp_path / "other.npz"))
+    for name in ("report.md", "report.json", "best_cv.json", "best_ca.json", "tracks.png",
+                 "loss_vs_time_cv.png", "loss_vs_time_ca.png"):  # fmt: skip
+        assert (tmp_path / "out" / name).stat().st_size > 0, name
+    assert not list((tmp_path / "out").glob(".*tmp*"))
+    for model in ("cv", "ca"):
+        params = TrackerParams.load(tmp_path / "out" / f"best_{model}.json")
+        ev = evaluate_table(train, track_dataset(train, params))
+        m = r["models"][model]
+        assert m["training"]["loss_total"] == pytest.approx(ev.loss_total, rel=1e-12)
+        # the objective's value of the best trial is the same L_t
+        assert m["best_value_in_study"] == pytest.approx(ev.loss_total, rel=1e-12)
+        gen = evaluate_table(other, track_dataset(other, params))
+        assert m["generalisation"]["loss_total"] == pytest.approx(gen.loss_total, rel=1e-12)
+    cv, ca = (r["models"][m]["training"]["loss_total"] for m in ("cv", "ca"))
+    assert r["conclusion"]["cv_over_ca"] == pytest.approx(cv / ca)
+    assert r["conclusion"]["cv_not_worse_than_ca_by_more_than_5_percent"] == (cv <= 1.05 * ca)
+    md = (tmp_path / "out" / "report.md").read_text()
+    assert f"{PAPER_TABLE_I['cv']['total']:.3f}" in md and f"{cv * 1e3:.4f}" in md
+    assert json.loads((tmp_path / "out" / "report.json").read_text())["models"].keys() == {
+        "cv",
+        "ca",
+    }

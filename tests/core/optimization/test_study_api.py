@@ -1,0 +1,118 @@
+"""Study API in one process: reproducibility, refusal of the other model, crash recovery."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import optuna
+import pytest
+
+from core.errors import InputError
+from core.optimization import (
+    StudySettings,
+    enqueue_params,
+    fail_stale_trials,
+    open_storage,
+    prepare_study,
+    run_worker,
+    study_progress,
+    tracker_params_dict,
+)
+from core.optimization.space import search_space
+from core.optimization.study import worker_seeds
+
+
+def settings(tmp_path: Path, **kw) -> StudySettings:
+    base = dict(
+        model="cv",
+        n_trials=14,
+        storage=f"memory://{tmp_path}",
+        objective="quadratic",
+        objective_options={"n_trajectories": 5},
+    )
+    return StudySettings(**{**base, **kw})
+
+
+def run(s: StudySettings, seed: int) -> list:
+    prepare_study(s)
+    run_worker(s.storage, s.name, seed=seed)
+    summaries, _ = study_progress(s.storage, s.name)
+    return summaries
+
+
+@pytest.mark.parametrize("sampler", ["tpe", "random"])
+def test_same_seed_same_trials_other_seed_other_trials(tmp_path: Path, sampler: str) -> None:
+    a = run(settings(tmp_path, study_name="a", sampler=sampler, pruner="none"), seed=5)
+    b = run(settings(tmp_path, study_name="b", sampler=sampler, pruner="none"), seed=5)
+    c = run(settings(tmp_path, study_name="c", sampler=sampler, pruner="none"), seed=6)
+    assert len(a) == 14  # beyond TPE's 10 start-up trials
+    assert [t.params for t in a] == [t.params for t in b]
+    assert [t.value for t in a] == [t.value for t in b]
+    assert [t.params for t in a] != [t.params for t in c]
+
+
+def test_tpe_finds_a_lower_loss_than_random_on_the_quadratic(tmp_path: Path) -> None:
+    best = {}
+    for sampler in ("tpe", "random"):
+        s = settings(tmp_path, study_name=sampler, sampler=sampler, pruner="none", n_trials=40)
+        _, b = run(s, seed=1), study_progress(s.storage, s.name)[1]
+        best[sampler] = b.value
+    assert best["tpe"] < best["random"]
+
+
+def test_exact_total_counts_complete_and_pruned(tmp_path: Path) -> None:
+    s = settings(tmp_path, n_trials=25, pruner="asha", objective_options={"n_trajectories": 15})
+    summaries = run(s, seed=0)
+    states = [t.state for t in summaries]
+    assert states.count("COMPLETE") + states.count("PRUNED") == 25
+    assert "PRUNED" in states and "RUNNING" not in states
+    # asking again runs nothing: the total is reached
+    assert run_worker(s.storage, s.name, seed=1) == 0
+
+
+def test_other_model_under_the_same_name_is_refused_and_study_untouched(tmp_path: Path) -> None:
+    s = settings(tmp_path, n_trials=3)
+    before = run(s, seed=0)
+    with pytest.raises(InputError, match="has model='cv', asked 'ca'"):
+        prepare_study(settings(tmp_path, model="ca", study_name=s.name, n_trials=50))
+    after, _ = study_progress(s.storage, s.name)
+    assert after == before
+    study = optuna.load_study(study_name=s.name, storage=open_storage(s.storage))
+    assert study.user_attrs["n_trials"] == 3 and study.user_attrs["model"] == "cv"
+
+
+def test_dead_workers_running_trial_fails_on_resume(tmp_path: Path) -> None:
+    s = settings(tmp_path, n_trials=4)
+    run(s, seed=0)
+    study = optuna.load_study(study_name=s.name, storage=open_storage(s.storage))
+    dead = study.ask()
+    # a worker on this host whose process no longer exists (pid 2**22 + 1 > pid_max default)
+    import socket
+
+    dead.set_user_attr("worker", f"{socket.gethostname()}:{2**22 + 1}:123")
+    alive = study.ask()
+    alive.set_user_attr("worker", f"other-host:{2**22 + 1}:123")  # remote, fresh: kept
+    assert fail_stale_trials(study) == [dead.number]
+    states = {t.number: t.state.name for t in study.get_trials()}
+    assert states[dead.number] == "FAIL" and states[alive.number] == "RUNNING"
+    assert fail_stale_trials(study, stale_after_s=0.0) == [alive.number]
+
+
+def test_enqueued_parameters_run_first(tmp_path: Path) -> None:
+    s = settings(tmp_path, n_trials=2, pruner="none")
+    prepare_study(s)
+    flat = {b.name: b.high for b in search_space("cv")}
+    enqueue_params(s.storage, s.name, tracker_params_dict(flat, "cv"))
+    run_worker(s.storage, s.name, seed=0)
+    summaries, _ = study_progress(s.storage, s.name)
+    assert summaries[0].params == flat
+    assert summaries[0].tracker_params("cv")["p0"] == [10.0, 10.0, 10.0, 10.0]
+    with pytest.raises(InputError, match="study is 'cv'"):
+        enqueue_params(s.storage, s.name, {**tracker_params_dict(flat, "cv"), "model": "ca"})
+
+
+def test_worker_seeds_differ_per_worker_and_per_resume() -> None:
+    a = worker_seeds(0, 3, 0)
+    assert len(set(a)) == 3
+    assert a == worker_seeds(0, 3, 0)
+    assert set(a).isdisjoint(worker_seeds(0, 3, 10))

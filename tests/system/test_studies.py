@@ -1,0 +1,261 @@
+"""Studies end to end through the CLI, on SQLite, the journal file and a real PostgreSQL server.
+
+The PostgreSQL server is a throwaway cluster started by the fixture (``initdb`` + ``postgres`` on a
+free localhost port, run as the ``postgres`` user when we are root). When ``CI`` is set and the
+server binaries are missing the test fails; elsewhere it is skipped with the reason.
+"""
+
+from __future__ import annotations
+
+import glob
+import os
+import pwd
+import shutil
+import signal
+import socket
+import subprocess
+import sys
+import tempfile
+import time
+from collections.abc import Iterator
+from pathlib import Path
+
+import pytest
+
+from core.optimization import study_progress
+
+ROOT = Path(__file__).resolve().parents[2]
+QUAD = ["--objective", "quadratic", "--objective-option", "n_trajectories=5", "--no-progress"]
+
+
+def cli(*args: str, timeout: float = 300) -> subprocess.CompletedProcess:
+    return subprocess.run(
+        [sys.executable, "-m", "core.cli", *args],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=timeout,
+    )
+
+
+# ---- PostgreSQL ---------------------------------------------------------------------------------
+def _pg_bin() -> Path | None:
+    found = sorted(glob.glob("/usr/lib/postgresql/*/bin/initdb"))
+    if found:
+        return Path(found[-1]).parent
+    initdb = shutil.which("initdb")
+    return Path(initdb).parent if initdb else None
+
+
+def _free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+@pytest.fixture(scope="session")
+def postgres_url() -> Iterator[str]:
+    bindir = _pg_bin()
+    if bindir is None:
+        if os.environ.get("CI"):
+            pytest.fail("CI is set but PostgreSQL server binaries (initdb) are missing")
+        pytest.skip("PostgreSQL server binaries (initdb) not installed")
+    tmp = Path(tempfile.mkdtemp(prefix="radartune-pg-"))
+    preexec = None
+    if os.geteuid() == 0:  # initdb and postgres refuse to run as root
+        pw = pwd.getpwnam("postgres")
+        os.chown(tmp, pw.pw_uid, pw.pw_gid)
+
+        def preexec() -> None:
+            os.setgid(pw.pw_gid)
+            os.setuid(pw.pw_uid)
+
+    data = tmp / "data"
+    subprocess.run(
+        [str(bindir / "initdb"), "-D", str(data), "-A", "trust", "-U", "postgres"],
+        check=True,
+        capture_output=True,
+        preexec_fn=preexec,
+        cwd=tmp,
+    )
+    port = _free_port()
+    server = subprocess.Popen(
+        [
+            str(bindir / "postgres"),
+            "-D",
+            str(data),
+            "-p",
+            str(port),
+            "-k",
+            str(tmp),
+            "-c",
+            "listen_addresses=127.0.0.1",
+            "-c",
+            "fsync=off",
+        ],
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+        preexec_fn=preexec,
+        cwd=tmp,
+    )
+    url = f"postgresql://postgres@127.0.0.1:{port}/postgres"
+    try:
+        import psycopg2
+
+        for _ in range(100):
+            try:
+                psycopg2.connect(url).close()
+                break
+            except psycopg2.OperationalError:
+                time.sleep(0.1)
+        else:
+            pytest.fail("PostgreSQL did not accept connections within 10 s")
+        yield url
+    finally:
+        server.send_signal(signal.SIGINT)  # fast shutdown
+        try:
+            server.wait(20)
+        except subprocess.TimeoutExpired:
+            server.kill()
+            server.wait()
+        shutil.rmtree(tmp, ignore_errors=True)
+
+
+@pytest.fixture(params=["sqlite", "journal", "postgresql"])
+def storage(request: pytest.FixtureRequest, tmp_path: Path) -> str:
+    if request.param == "sqlite":
+        return f"sqlite:///{tmp_path}/studies.db"
+    if request.param == "journal":
+        return f"journal:///{tmp_path}/studies.log"
+    return request.getfixturevalue("postgres_url")
+
+
+def _states(storage: str, name: str) -> dict[int, tuple[str, float | None]]:
+    summaries, _ = study_progress(storage, name)
+    return {t.number: (t.state, t.value) for t in summaries}
+
+
+def _counted(states: dict) -> int:
+    return sum(1 for s, _ in states.values() if s in ("COMPLETE", "PRUNED"))
+
+
+# ---- tests --------------------------------------------------------------------------------------
+def test_two_workers_reach_exactly_the_asked_total(storage: str, request) -> None:
+    name = f"two-{request.node.callspec.id}-{os.getpid()}"
+    # trials of 5 x 60 ms so that both workers overlap even when one starts late
+    out = cli("tune", "--model", "cv", "--trials", "10", "--jobs", "2", "--storage", storage,
+              "--study", name, *QUAD, "--objective-option", "delay_s=0.06")  # fmt: skip
+    assert out.returncode == 0, out.stderr
+    summaries, best = study_progress(storage, name)
+    states = [t.state for t in summaries]
+    assert states.count("COMPLETE") + states.count("PRUNED") == 10
+    assert "RUNNING" not in states and "WAITING" not in states
+    # both processes ran trials
+    assert len({t.worker.rsplit(":", 2)[1] for t in summaries if t.state != "FAIL"}) == 2
+    assert best is not None and best.value == min(
+        t.value for t in summaries if t.state == "COMPLETE"
+    )
+
+
+def test_sigkill_mid_study_then_resume_loses_nothing(storage: str, request) -> None:
+    name = f"kill-{request.node.callspec.id}-{os.getpid()}"
+    args = ["tune", "--model", "cv", "--trials", "10", "--jobs", "2", "--storage", storage,
+            "--study", name, "--objective", "quadratic", "--objective-option", "n_trajectories=5",
+            "--objective-option", "delay_s=0.06", "--no-progress"]  # fmt: skip
+    parent = subprocess.Popen(
+        [sys.executable, "-m", "core.cli", *args],
+        cwd=ROOT,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+        start_new_session=True,
+    )
+    deadline = time.monotonic() + 180
+    victims: set[int] = set()
+    try:
+        while time.monotonic() < deadline:
+            time.sleep(0.2)
+            try:
+                summaries, _ = study_progress(storage, name)
+            except Exception:
+                continue
+            done = [t for t in summaries if t.state in ("COMPLETE", "PRUNED")]
+            running = [t for t in summaries if t.state == "RUNNING" and t.worker]
+            if len(done) >= 3 and running:
+                victims = {int(t.worker.rsplit(":", 2)[1]) for t in running}
+                break
+        assert victims, "no running trial to kill"
+        # the whole machine dies: workers mid-trial, and the parent
+        for pid in victims:
+            os.kill(pid, signal.SIGKILL)
+        os.killpg(parent.pid, signal.SIGKILL)
+    finally:
+        parent.wait(30)
+    before = _states(storage, name)
+    assert any(s == "RUNNING" for s, _ in before.values())
+    finished_before = {n: v for n, v in before.items() if v[0] in ("COMPLETE", "PRUNED")}
+    assert 3 <= len(finished_before) < 10
+
+    out = cli(*args)  # resume
+    assert out.returncode == 0, out.stderr
+    after = _states(storage, name)
+    assert "RUNNING" not in {s for s, _ in after.values()}
+    for n, v in finished_before.items():
+        assert after[n] == v  # no completed trial lost or changed
+    for n, (s, _) in before.items():
+        if s == "RUNNING":
+            assert after[n][0] == "FAIL"
+    assert _counted(after) == 10
+
+
+# ---- bad input ----------------------------------------------------------------------------------
+def _one_line_exit_2(out: subprocess.CompletedProcess, needle: str) -> None:
+    assert out.returncode == 2, out.stderr
+    lines = out.stderr.strip().splitlines()
+    assert len(lines) == 1, out.stderr
+    assert needle in lines[0]
+
+
+def test_bad_input_is_one_line_exit_2_and_damages_nothing(tmp_path: Path) -> None:
+    url = f"sqlite:///{tmp_path}/s.db"
+    _one_line_exit_2(cli("tune", "--model", "ct", "--storage", url, *QUAD), "model must be one")
+    _one_line_exit_2(cli("tune", "--model", "cv", "--storage", "mysql://x@y/z", *QUAD), "scheme")
+    assert not (tmp_path / "s.db").exists()
+    ok = cli("tune", "--model", "cv", "--trials", "3", "--storage", url, "--study", "s", *QUAD)
+    assert ok.returncode == 0, ok.stderr
+    before = _states(url, "s")
+    _one_line_exit_2(
+        cli("tune", "--model", "ca", "--trials", "9", "--storage", url, "--study", "s", *QUAD),
+        "has model='cv', asked 'ca'",
+    )
+    assert _states(url, "s") == before
+    _one_line_exit_2(cli("worker", "--storage", url, "--study", "nope"), "no study 'nope'")
+
+
+def test_unreachable_database_is_one_line_exit_2() -> None:
+    port = _free_port()  # nothing listens there
+    out = cli("tune", "--model", "cv", "--storage", f"postgresql://u:pw@127.0.0.1:{port}/x", *QUAD)
+    _one_line_exit_2(out, "cannot open")
+    assert "pw" not in out.stderr
+
+
+def test_gui_handle_stops_workers_cleanly(tmp_path: Path) -> None:
+    from core.optimization import StudySettings, start_study
+
+    url = f"sqlite:///{tmp_path}/gui.db"
+    s = StudySettings(model="ca", n_trials=500, n_jobs=2, storage=url, objective="quadratic",
+                      objective_options={"n_trajectories": 5, "delay_s": 0.05})  # fmt: skip
+    handle = start_study(s, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    try:
+        deadline = time.monotonic() + 120
+        while time.monotonic() < deadline:
+            summaries, best = study_progress(url, s.name)
+            if best is not None:
+                break
+            time.sleep(0.2)
+        assert handle.is_running()
+    finally:
+        handle.stop(timeout=60)
+    assert not handle.is_running()
+    assert handle.returncodes() == [0, 0]  # SIGTERM: finish the trial, exit normally
+    states = [t.state for t in study_progress(url, s.name)[0]]
+    assert "RUNNING" not in states and 0 < states.count("COMPLETE") < 500
