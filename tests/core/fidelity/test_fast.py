@@ -137,6 +137,10 @@ def test_compiled_cfar_equals_library_cfar() -> None:
         ),
         ProcessingSettings(cfar_noise_model=False),
         ProcessingSettings(doppler_window="rect"),
+        ProcessingSettings(
+            range_cfar=CfarSettings(method="cago", pfa=1e-2),
+            doppler_cfar=CfarSettings(method="cago", n_train=3, n_guard=1, pfa=1e-2, cyclic=True),
+        ),
     ]
     n_det = 0
     for settings in variants:
