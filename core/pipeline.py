@@ -47,6 +47,14 @@ SIMULATORS: dict[str, str] = {
     "measurement": "core.simulation:simulate_frame_measurement",
 }
 
+#: Levels that can also simulate all frames of a scene in one call (the data-set path):
+#: name -> "module:function" with the signature of
+#: ``core.simulation.measurement.simulate_frames_measurement``. They must give the same frames
+#: as the per-frame simulator with the same per-frame generators (tested).
+BATCH_SIMULATORS: dict[str, str] = {
+    "measurement": "core.simulation.measurement:simulate_frames_measurement",
+}
+
 #: Bump when the simulation changes in a way that invalidates cached data sets.
 CACHE_VERSION = 1
 
@@ -520,6 +528,9 @@ def simulate_scene(
     t0 = time.perf_counter()
     p = the_plan or plan(scene, keep_rd_maps=keep_rd_maps, fidelity=fidelity)
     seed = scene.seed if seed is None else int(seed)
+    batch = p.fidelity in BATCH_SIMULATORS and scene.n_frames > 0
+    if batch and not p.keep_rd_maps and p.consumer != "study":
+        return _simulate_scene_batch(scene, p, seed, progress, t0)
     clouds, maps, n_clutter = [], [], []
     total = scene.n_frames
     for fr in iter_frames(scene, seed=seed, the_plan=p):
@@ -540,6 +551,40 @@ def simulate_scene(
         truth_v_mps=v,
         n_clutter=np.array(n_clutter, dtype=np.int64),
         rd_maps_db=np.stack(maps) if maps else None,
+        elapsed_s=time.perf_counter() - t0,
+    )
+
+
+def _simulate_scene_batch(
+    scene: Scene, p: Plan, seed: int, progress: ProgressCallback | None, t0: float
+) -> SceneRun:
+    """:func:`simulate_scene` through the level's batch simulator: every frame's reflectors
+    and noise generator as :func:`iter_frames` builds them, then one call for all frames."""
+    from core import simulation as sim
+
+    module, name = BATCH_SIMULATORS[p.fidelity].split(":")
+    simulate = getattr(importlib.import_module(module), name)
+    radar = scene.radar
+    settings = processing_settings(scene)
+    antenna = sim.AntennaGain.draw(radar, stage_rng(seed, "antenna"))
+    reflectors = _Reflectors.build(scene, p, seed, antenna, settings)
+    frames, n_clutter = zip(*(reflectors.frame(f) for f in range(scene.n_frames)))
+    rngs = [stage_rng(seed, "noise", f) for f in range(scene.n_frames)]
+    out = simulate(
+        radar, list(frames), rngs, antenna=antenna, settings=settings, elevation=p.elevation
+    )
+    if progress is not None:
+        progress(scene.n_frames, scene.n_frames)
+    return SceneRun(
+        scene=scene,
+        plan=p,
+        seed=seed,
+        clouds=tuple(out.clouds()),
+        truth_t_s=reflectors.truth_t_s,
+        truth_xy_m=reflectors.truth_xy_m,
+        truth_v_mps=reflectors.truth_v_mps,
+        n_clutter=np.array(n_clutter, dtype=np.int64),
+        rd_maps_db=None,
         elapsed_s=time.perf_counter() - t0,
     )
 

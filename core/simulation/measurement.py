@@ -51,13 +51,15 @@ sharing a cell, the threshold effect of the estimators at very low SNR.
 from __future__ import annotations
 
 import functools
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numba
 import numpy as np
 
 from core.config import DEFAULT_PROCESSING, SPEED_OF_LIGHT_MPS, ProcessingSettings, RadarConfig
-from core.pointcloud import SOURCE_OTHER, PointCloud
+from core.errors import InputError
+from core.pointcloud import POINT_FIELDS, SOURCE_OTHER, PointCloud
 from core.processing import estimate_angles, make_cfar
 from core.processing.angle import log_parabolic_offset
 from core.processing.spectrum import window
@@ -244,6 +246,17 @@ def chain_false_alarms(
     )
 
 
+#: No false alarms (noise-free frames).
+_NO_FALSE_ALARMS = FalseAlarms(
+    rate_per_frame=0.0,
+    doppler_index=np.zeros(0, dtype=np.int64),
+    snr_db=np.zeros(0),
+    azimuth_rad=np.zeros(0),
+    range_frac=np.zeros(0),
+    n_frames=0,
+)
+
+
 @functools.lru_cache(maxsize=16)
 def _setup(radar: RadarConfig, settings: ProcessingSettings) -> tuple[ChainTables, dict]:
     """Tables and constants of a radar and settings (one cache look-up per frame)."""
@@ -289,6 +302,7 @@ def _constants(radar: RadarConfig, settings: ProcessingSettings):
         radar.n_tx,
         radar.n_rx,
         *array_rows(radar),
+        angle_twiddles(radar, settings.angle_fft_size),
     )
     return {
         "array": array,
@@ -304,28 +318,149 @@ def _constants(radar: RadarConfig, settings: ProcessingSettings):
     }
 
 
-def _noise_estimate(
-    method: str, n_train: int, n_eff: float, L: int, rng: np.random.Generator, leak: np.ndarray
-) -> np.ndarray:
-    """CFAR noise estimates (units of the cell noise), ``(n,)``.
+@dataclass(frozen=True, slots=True, kw_only=True, eq=False)
+class FramesOutput:
+    """Result of :func:`simulate_frames_measurement`: the points of many frames, concatenated.
 
-    ``leak`` ``(n, 2)``: the reflector's own power summed over the left and right training
-    cells (units of the cell noise). The noise part of each side's sum is
-    ``(n_train / n_eff) Gamma(n_eff L)``: mean ``n_train L`` and the variance of
-    window-correlated cells (the moment match the CFAR thresholds use).
+    Attributes
+    ----------
+    point_cloud
+        Points of every frame in frame order, ``(n_points,)`` per field.
+    counts
+        ``(F,)`` int64: points per frame.
+    detections
+        ``(n_points, 2)`` int64: range bin, Doppler index (as :class:`FrameOutput`).
     """
-    z = rng.standard_gamma(float(n_eff * L), (len(leak), 2)) * (n_train / n_eff) + leak
-    if method == "ca":
-        # mu = (Z_left + Z_right) / 2n
-        return z.sum(axis=1) / (2 * n_train)
-    # CASO: min(Z1, Z2) / n;  CAGO: max(Z1, Z2) / n
-    return (z.min(axis=1) if method == "caso" else z.max(axis=1)) / n_train
+
+    point_cloud: PointCloud
+    counts: np.ndarray
+    detections: np.ndarray
+
+    def clouds(self) -> list[PointCloud]:
+        """The per-frame point clouds (views into the concatenated arrays)."""
+        edges = np.concatenate(([0], np.cumsum(self.counts)))
+        pc = self.point_cloud
+        names = (*POINT_FIELDS, "source")
+        return [
+            PointCloud(**{k: getattr(pc, k)[a:b] for k in names})
+            for a, b in zip(edges[:-1].tolist(), edges[1:].tolist())
+        ]
+
+
+def frame_seed(rng: np.random.Generator | None) -> np.ndarray:
+    """The compiled generator's 256-bit state for one frame, drawn from that frame's ``rng``.
+
+    ``(4,)`` uint64 (xoshiro256**; never all zero). ``None`` (noise-free frames) gives a fixed
+    state. The per-frame and the batch entry points seed each frame this way, so they agree.
+    """
+    if rng is None:
+        return np.array([1, 2, 3, 4], dtype=np.uint64)
+    s = rng.bit_generator.random_raw(4)
+    if not s.any():
+        s[0] = 1
+    return s
+
+
+def simulate_frames_measurement(
+    radar: RadarConfig,
+    frames: Sequence[Scatterers],
+    rngs: Sequence[np.random.Generator | None],
+    *,
+    antenna: AntennaGain,
+    settings: ProcessingSettings = DEFAULT_PROCESSING,
+    elevation: bool | None = None,
+    noise: bool = True,
+) -> FramesOutput:
+    """Many frames at the ``measurement`` level in one compiled call (the data-set path).
+
+    Frame ``f`` draws only from ``rngs[f]`` (its 256-bit state seeds the compiled generator,
+    :func:`frame_seed`), so the result equals ``simulate_frame_measurement`` of each frame with
+    the same generator, bit for bit (tested).
+
+    Parameters
+    ----------
+    frames
+        ``F`` frames' reflectors.
+    rngs
+        ``F`` generators, one per frame (the pipeline's ``stage_rng(seed, "noise", f)``).
+    elevation
+        Estimate elevation; ``None``: per frame, when the radar can and the frame is not planar.
+    """
+    if len(frames) != len(rngs):
+        raise InputError(f"rngs: {len(rngs)} generators for {len(frames)} frames")
+    n_f = len(frames)
+    states = np.stack([frame_seed(r) for r in rngs]) if n_f else np.zeros((0, 4), dtype=np.uint64)
+    counts = np.fromiter((len(s) for s in frames), dtype=np.int64, count=n_f)
+    start = np.zeros(n_f + 1, dtype=np.int64)
+    np.cumsum(counts, out=start[1:])
+    if start[-1]:
+        pos = np.concatenate([s.position_m for s in frames]).astype(np.float64, copy=False)
+        vel = np.concatenate([s.velocity_mps for s in frames]).astype(np.float64, copy=False)
+        rcs = np.concatenate([s.rcs_dbsm for s in frames]).astype(np.float64, copy=False)
+        source = np.concatenate([s.source for s in frames])
+    else:
+        pos = vel = np.zeros((0, 3))
+        rcs = np.zeros(0)
+        source = np.zeros(0, dtype=np.int32)
+    if elevation is None:
+        elev = np.array([needs_elevation(radar, s) for s in frames], dtype=np.bool_)
+    else:
+        elev = np.full(n_f, bool(elevation))
+    return _run(radar, settings, antenna, states, start, pos, vel, rcs, source, elev, noise)
+
+
+def _run(radar, settings, antenna, states, start, pos, vel, rcs, source, elev, noise):
+    """The compiled kernel over frames ``start[f]:start[f+1]`` of the concatenated reflectors."""
+    tab, const = _setup(radar, settings)
+    fa = chain_false_alarms(radar, settings) if noise else _NO_FALSE_ALARMS
+    g_db = antenna.gain_db(np.arctan2(pos[:, 0], pos[:, 1])) if len(pos) else np.zeros(0)
+    counts, f64, i64 = _measure_frames(
+        states,
+        start,
+        np.ascontiguousarray(pos),
+        np.ascontiguousarray(vel),
+        np.asarray(g_db, dtype=np.float64),
+        np.ascontiguousarray(rcs),
+        elev,
+        bool(noise),
+        *const["kernel"],
+        tab.range_gain,
+        tab.range_est,
+        tab.range_leak,
+        tab.doppler_gain,
+        tab.doppler_index,
+        tab.doppler_est,
+        tab.doppler_leak,
+        tab.cell_noise,
+        *const["array"],
+        fa.rate_per_frame,
+        fa.doppler_index,
+        fa.snr_db,
+        fa.azimuth_rad,
+        fa.range_frac,
+    )
+    ref = i64[:, 0]
+    src = np.full(len(ref), SOURCE_OTHER, dtype=np.int32)
+    real = ref >= 0
+    src[real] = source[ref[real]]
+    pc = PointCloud(
+        range_m=f64[:, 0],
+        azimuth_rad=f64[:, 1],
+        elevation_rad=f64[:, 2],
+        radial_velocity_mps=f64[:, 3],
+        snr_db=f64[:, 4],
+        x_m=f64[:, 5],
+        y_m=f64[:, 6],
+        z_m=f64[:, 7],
+        source=src,
+    )
+    return FramesOutput(point_cloud=pc, counts=counts, detections=i64[:, 1:3])
 
 
 def simulate_frame_measurement(
     radar: RadarConfig,
     scatterers: Scatterers,
-    rng: np.random.Generator,
+    rng: np.random.Generator | None,
     *,
     antenna: AntennaGain,
     settings: ProcessingSettings = DEFAULT_PROCESSING,
@@ -338,73 +473,100 @@ def simulate_frame_measurement(
     Same signature and output as :func:`core.simulation.simulate_frame`. ``rd_map_db``, when
     asked for, is a model map (mean noise floor plus the detected cells), not a spectrum.
     ``noise=False`` gives the noiseless estimates of every reflector in the range limits.
+    The random numbers come from a compiled generator seeded by four raw draws of ``rng``
+    (:func:`frame_seed`); :func:`simulate_frames_measurement` runs many frames in one call.
     """
-    tab, const = _setup(radar, settings)
-    n = len(scatterers)
     if elevation is None:
         elevation = needs_elevation(radar, scatterers)
-    fields = []
-    if n:
-        p0 = scatterers.position_m
-        g_db = antenna.gain_db(np.arctan2(p0[:, 0], p0[:, 1]))
-        det, r_bin, d_bin, u, el, snr_db, d_cell = _measure_kernel(
-            rng if noise else np.random.default_rng(0),
-            np.ascontiguousarray(p0, dtype=np.float64),
-            np.ascontiguousarray(scatterers.velocity_mps, dtype=np.float64),
-            np.asarray(g_db, dtype=np.float64),
-            np.asarray(scatterers.rcs_dbsm, dtype=np.float64),
-            *const["kernel"],
-            tab.range_gain,
-            tab.range_est,
-            tab.range_leak,
-            tab.doppler_gain,
-            tab.doppler_index,
-            tab.doppler_est,
-            tab.doppler_leak,
-            tab.u_est,
-            tab.cell_noise,
-            bool(noise),
-            *const["array"],
-            angle_twiddles(radar, settings.angle_fft_size),
-            bool(elevation),
-        )
-        el = el[det]
-        fields.append(
-            (
-                r_bin[det],
-                np.arcsin(np.clip(u[det] / np.cos(el), -1.0, 1.0)),
-                el,
-                d_bin[det],
-                snr_db[det],
-                scatterers.source[det],
-                d_cell[det],
-            )
-        )
-    if noise:
-        extra = _false_alarms(radar, settings, const, rng)
-        if extra is not None:
-            fields.append(extra)
-    if len(fields) == 1:
-        r_bin, az, el, d_bin, snr_db, source, d_cell = fields[0]
-    elif fields:
-        r_bin, az, el, d_bin, snr_db, source, d_cell = (np.concatenate(c) for c in zip(*fields))
-    else:
-        r_bin = az = el = d_bin = snr_db = np.zeros(0)
-        source, d_cell = np.zeros(0, dtype=np.int32), np.zeros(0, dtype=np.int64)
-    pc = _cloud(
+    out = _run(
         radar,
-        r_bin * radar.range_resolution_m,
-        az,
-        el,
-        d_bin * radar.velocity_resolution_mps,
-        snr_db,
-        source,
+        settings,
+        antenna,
+        frame_seed(rng if noise else None)[None, :],
+        np.array([0, len(scatterers)], dtype=np.int64),
+        np.asarray(scatterers.position_m, dtype=np.float64),
+        np.asarray(scatterers.velocity_mps, dtype=np.float64),
+        np.asarray(scatterers.rcs_dbsm, dtype=np.float64),
+        scatterers.source,
+        np.array([bool(elevation)]),
+        noise,
     )
-    cells = np.column_stack((np.rint(r_bin), d_cell)).astype(np.int64)
     rd_db = None
     if keep_rd_map:
-        rd_db = _model_map(radar, tab, cells, pc)
-    return FrameOutput(point_cloud=pc, rd_map_db=rd_db, detections=cells)
+        rd_db = _model_map(radar, _setup(radar, settings)[0], out.detections, out.point_cloud)
+    return FrameOutput(point_cloud=out.point_cloud, rd_map_db=rd_db, detections=out.detections)
+
+
+# ---- the compiled generator: xoshiro256** (Blackman & Vigna) and the draws the model needs ------
+
+
+@numba.njit(inline="always")
+def _rotl(x, k):  # pragma: no cover
+    return (x << np.uint64(k)) | (x >> np.uint64(64 - k))
+
+
+@numba.njit(cache=True, nogil=True)
+def _next_u64(s):  # pragma: no cover
+    """Next 64-bit output of xoshiro256** with state ``s`` (4,) uint64 (advanced in place)."""
+    result = _rotl(s[1] * np.uint64(5), 7) * np.uint64(9)
+    t = s[1] << np.uint64(17)
+    s[2] ^= s[0]
+    s[3] ^= s[1]
+    s[1] ^= s[2]
+    s[0] ^= s[3]
+    s[2] ^= t
+    s[3] = _rotl(s[3], 45)
+    return result
+
+
+@numba.njit(cache=True, nogil=True)
+def _uniform(s):  # pragma: no cover
+    """U[0, 1) with 53 random bits."""
+    return float(_next_u64(s) >> np.uint64(11)) * (1.0 / 9007199254740992.0)
+
+
+@numba.njit(cache=True, nogil=True)
+def _normal(s):  # pragma: no cover
+    """N(0, 1) by Box-Muller: sqrt(-2 ln u1) cos(2 pi u2), u1 in (0, 1]."""
+    u1 = 1.0 - _uniform(s)
+    return np.sqrt(-2.0 * np.log(u1)) * np.cos(2.0 * np.pi * _uniform(s))
+
+
+@numba.njit(cache=True, nogil=True)
+def _gamma(s, k):  # pragma: no cover
+    """Gamma(k, 1) by Marsaglia & Tsang (2000); k < 1 via Gamma(k + 1) U^(1/k)."""
+    if k < 1.0:
+        return _gamma(s, k + 1.0) * _uniform(s) ** (1.0 / k)
+    d = k - 1.0 / 3.0
+    c = 1.0 / np.sqrt(9.0 * d)
+    while True:
+        x = _normal(s)
+        v = 1.0 + c * x
+        if v <= 0.0:
+            continue
+        v = v * v * v
+        u = 1.0 - _uniform(s)
+        # accept when ln u < x^2/2 + d - d v + d ln v
+        if np.log(u) < 0.5 * x * x + d - d * v + d * np.log(v):
+            return d * v
+
+
+@numba.njit(cache=True, nogil=True)
+def _poisson(s, lam):  # pragma: no cover
+    """Poisson(lam) by multiplying uniforms (Knuth; the rates here are well below 1)."""
+    limit = np.exp(-lam)
+    k = 0
+    p = 1.0 - _uniform(s)
+    while p > limit:
+        k += 1
+        p *= 1.0 - _uniform(s)
+    return k
+
+
+@numba.njit(cache=True, nogil=True)
+def _randint(s, n):  # pragma: no cover
+    """Uniform integer in ``0 .. n-1`` (n >= 1; the bias of the modulo is below 2^-50)."""
+    return np.int64(_next_u64(s) % np.uint64(n))
 
 
 @numba.njit(cache=True, nogil=True)
@@ -418,10 +580,10 @@ def _lerp(table, x, x0, step):  # pragma: no cover
 
 
 @numba.njit(cache=True, nogil=True)
-def _training_sum(rng, method, n_train, n_eff, L, leak_l, leak_r):  # pragma: no cover
+def _training_sum(s, method, n_train, n_eff, L, leak_l, leak_r):  # pragma: no cover
     """CFAR noise estimate: each side ``(n / n_eff) Gamma(n_eff L)`` plus the own leakage."""
-    z1 = rng.standard_gamma(n_eff * L) * (n_train / n_eff) + leak_l
-    z2 = rng.standard_gamma(n_eff * L) * (n_train / n_eff) + leak_r
+    z1 = _gamma(s, n_eff * L) * (n_train / n_eff) + leak_l
+    z2 = _gamma(s, n_eff * L) * (n_train / n_eff) + leak_r
     if method == 0:
         # CA: (Z1 + Z2) / 2n
         return (z1 + z2) / (2 * n_train)
@@ -433,12 +595,28 @@ def _training_sum(rng, method, n_train, n_eff, L, leak_l, leak_r):  # pragma: no
 
 
 @numba.njit(cache=True, nogil=True)
-def _measure_kernel(
-    rng,
+def _grow(f64, i64, need):  # pragma: no cover
+    """The output buffers with room for at least ``need`` rows (doubling)."""
+    if need <= f64.shape[0]:
+        return f64, i64
+    cap = max(need, 2 * f64.shape[0])
+    f2 = np.empty((cap, f64.shape[1]))
+    i2 = np.empty((cap, i64.shape[1]), dtype=np.int64)
+    f2[: f64.shape[0]] = f64
+    i2[: i64.shape[0]] = i64
+    return f2, i2
+
+
+@numba.njit(cache=True, nogil=True)
+def _measure_frames(
+    states,
+    start,
     pos,
     vel,
     gain_db,
     rcs,
+    elev,
+    noise,
     t_mid,
     range_res,
     vel_res,
@@ -464,9 +642,7 @@ def _measure_kernel(
     doppler_index,
     doppler_est,
     doppler_leak,
-    u_est_tab,
     cell_noise,
-    noise,
     az_pos,
     el_pos,
     n_tx,
@@ -476,134 +652,148 @@ def _measure_kernel(
     upper,
     lower,
     tw_a,
-    elevation,
+    fa_rate,
+    fa_doppler,
+    fa_snr,
+    fa_az,
+    fa_frac,
 ):  # pragma: no cover
-    """Steps 1-3 of the module docstring for every reflector; arrays ``(N,)``."""
-    n = pos.shape[0]
-    det = np.zeros(n, dtype=np.bool_)
-    r_out = np.empty(n)
-    d_out = np.empty(n)
-    u_out = np.empty(n)
-    el_out = np.empty(n)
-    snr_out = np.empty(n)
-    cell_out = np.empty(n, dtype=np.int64)
+    """Steps 1-4 of the module docstring for every frame ``f`` (reflectors
+    ``start[f]:start[f+1]``), frame ``f`` drawing from the generator state ``states[f]``.
+
+    Returns ``counts`` ``(F,)``, ``f64`` ``(n, 8)`` (range, azimuth, elevation, radial velocity,
+    SNR, x, y, z) and ``i64`` ``(n, 3)`` (reflector index or -1 for a false alarm, range bin,
+    Doppler index).
+    """
+    n_frames = states.shape[0]
+    counts = np.zeros(n_frames, dtype=np.int64)
+    cap = start[n_frames] + 4 * n_frames + 16
+    f64 = np.empty((cap, 8))
+    i64 = np.empty((cap, 3), dtype=np.int64)
+    n_out = 0
     f_step = 1.0 / (range_gain.shape[0] - 1)
     half = n_loops / 2
     nu_step = n_loops / (doppler_gain.shape[0] - 1)
     n_v = az_pos.shape[0]
     xv = np.empty(n_v, dtype=np.complex128)
     spec = np.empty(tw_a.shape[0])
-    for i in range(n):
-        px = pos[i, 0] + vel[i, 0] * t_mid
-        py = pos[i, 1] + vel[i, 1] * t_mid
-        pz = pos[i, 2] + vel[i, 2] * t_mid
-        r = np.sqrt(px * px + py * py + pz * pz)
-        vr = (px * vel[i, 0] + py * vel[i, 1] + pz * vel[i, 2]) / r
-        el_out[i] = np.arctan2(pz, np.hypot(px, py))
-        r0 = np.sqrt(pos[i, 0] ** 2 + pos[i, 1] ** 2 + pos[i, 2] ** 2)
-        # A^2 = Pt Gt Gr lambda^2 sigma / ((4 pi)^3 R^4) * R 10^(Ge/20)   (eqs. 2-4)
-        amp2 = c_amp2 * 10.0 ** ((2.0 * gain_db[i] + rcs[i]) / 10.0) / r0**4
-        rb = r / range_res
-        k_int = np.floor(rb)
-        f = rb - k_int
-        nu_true = doppler_scale * vr / vel_res
-        nu = (nu_true + half) % n_loops - half
-        gr = _lerp(range_gain, f, 0.0, f_step)
-        r_est = k_int + _lerp(range_est, f, 0.0, f_step)
-        jd = int(np.rint((nu + half) / nu_step))
-        jr = int(np.rint(f / f_step))
-        dc = doppler_index[jd]
-        d_est = _lerp(doppler_est, nu, -half, nu_step)
-        # rho = A^2 |R|^2 |D|^2 / s2[d]  (per channel, peak cell)
-        rho = max(amp2 * gr * doppler_gain[jd] / cell_noise[dc], 1e-30)
-        # the array phase of the exact chain is that of the first chirp's direction
-        u0 = pos[i, 0] / r0
-        s0 = pos[i, 2] / r0
-        if noise:
-            # X = |sqrt(L rho) + n|^2 + Gamma(L - 1),  n ~ CN(0, 1)
-            a = np.sqrt(L * rho) + rng.standard_normal() / np.sqrt(2.0)
-            b = rng.standard_normal() / np.sqrt(2.0)
-            x = a * a + b * b + rng.standard_gamma(L - 1.0)
-            # training cells: noise plus the reflector's own leakage (units of s2)
-            leak = L * amp2 / cell_noise[dc]
-            lr = leak * doppler_gain[jd]
-            ld = leak * gr
-            mu_r = _training_sum(
-                rng, rmeth, rn, rne, L, lr * range_leak[jr, 0], lr * range_leak[jr, 1]
-            )
-            mu_d = _training_sum(
-                rng, dmeth, dn, dne, L, ld * doppler_leak[jd, 0], ld * doppler_leak[jd, 1]
-            )
-            det[i] = x > ralpha * mu_r and x > dalpha * mu_d
-            snr_out[i] = 10.0 * np.log10(x / mu_r)
-            # Cramer-Rao: var(bin) = 6 / (4 pi^2 L rho)
-            sd_bin = np.sqrt(6.0 / (4.0 * np.pi**2 * L * rho))
-            r_est += sd_bin * rng.standard_normal()
-            d_est += sd_bin * rng.standard_normal()
-        else:
-            det[i] = True
-            snr_out[i] = 10.0 * np.log10(L * rho)
-        # angles: the chain's estimator on the peak cell's channel values, units of the noise:
-        # x_v = rho^(1/2) exp(j pi (p_v u + e_v sin el)) exp(j 2 pi nu k(v) / (Nc Ntx)) + n_v
-        amp = np.sqrt(rho)
-        for v in range(n_v):
-            ph = np.pi * (az_pos[v] * u0 + el_pos[v] * s0)
-            ph += 2.0 * np.pi * nu_true * (v // n_rx) / (n_loops * n_tx)
-            xv[v] = amp * (np.cos(ph) + 1j * np.sin(ph))
+    s = np.empty(4, dtype=np.uint64)
+    for fr in range(n_frames):
+        s[:] = states[fr]
+        first = n_out
+        for i in range(start[fr], start[fr + 1]):
+            px = pos[i, 0] + vel[i, 0] * t_mid
+            py = pos[i, 1] + vel[i, 1] * t_mid
+            pz = pos[i, 2] + vel[i, 2] * t_mid
+            r = np.sqrt(px * px + py * py + pz * pz)
+            vr = (px * vel[i, 0] + py * vel[i, 1] + pz * vel[i, 2]) / r
+            r0 = np.sqrt(pos[i, 0] ** 2 + pos[i, 1] ** 2 + pos[i, 2] ** 2)
+            # A^2 = Pt Gt Gr lambda^2 sigma / ((4 pi)^3 R^4) * R 10^(Ge/20)   (eqs. 2-4)
+            amp2 = c_amp2 * 10.0 ** ((2.0 * gain_db[i] + rcs[i]) / 10.0) / r0**4
+            rb = r / range_res
+            k_int = np.floor(rb)
+            f = rb - k_int
+            nu_true = doppler_scale * vr / vel_res
+            nu = (nu_true + half) % n_loops - half
+            gr = _lerp(range_gain, f, 0.0, f_step)
+            r_est = k_int + _lerp(range_est, f, 0.0, f_step)
+            jd = int(np.rint((nu + half) / nu_step))
+            jr = int(np.rint(f / f_step))
+            dc = doppler_index[jd]
+            d_est = _lerp(doppler_est, nu, -half, nu_step)
+            # rho = A^2 |R|^2 |D|^2 / s2[d]  (per channel, peak cell)
+            rho = max(amp2 * gr * doppler_gain[jd] / cell_noise[dc], 1e-30)
+            # the array phase of the exact chain is that of the first chirp's direction
+            u0 = pos[i, 0] / r0
+            s0 = pos[i, 2] / r0
             if noise:
-                xv[v] += (rng.standard_normal() + 1j * rng.standard_normal()) / np.sqrt(2.0)
-        a_i, e_i = angles_of(
-            xv, d_est, n_tx, n_rx, n_loops, row_ch, row_pos, upper, lower, tw_a, elevation, spec
-        )
-        u_est = np.sin(a_i) * np.cos(e_i)
-        el_out[i] = e_i
-        det[i] = det[i] and bin_lo - 0.5 <= r_est <= bin_hi + 0.5
-        r_out[i] = r_est
-        d_out[i] = (d_est + half) % n_loops - half
-        u_out[i] = u_est
-        cell_out[i] = dc
-    return det, r_out, d_out, u_out, el_out, snr_out, cell_out
-
-
-def _cloud(radar, range_m, az, el, vr, snr_db, source) -> PointCloud:
-    horiz = range_m * np.cos(el)
-    range_m = np.asarray(range_m, dtype=np.float64)
-    return PointCloud(
-        range_m=range_m,
-        azimuth_rad=az,
-        elevation_rad=el,
-        radial_velocity_mps=vr,
-        snr_db=snr_db,
-        x_m=horiz * np.sin(az),
-        y_m=horiz * np.cos(az),
-        z_m=range_m * np.sin(el),
-        source=np.asarray(source, dtype=np.int32),
-    )
-
-
-def _false_alarms(radar, settings, const, rng):
-    """A Poisson number of the chain's own false alarms, resampled from the measured pool.
-
-    Returns the point fields ``(range bin, azimuth, elevation, Doppler bin, SNR, source,
-    Doppler cell)``, or None when there is none this frame.
-    """
-    fa = chain_false_alarms(radar, settings)
-    k = rng.poisson(fa.rate_per_frame) if fa.rate_per_frame > 0 and len(fa.snr_db) else 0
-    if k == 0:
-        return None
-    pick = rng.integers(0, max(len(fa.snr_db), 1), k)
-    r_bin = rng.integers(const["bin_lo"], const["bin_hi"] + 1, k) + fa.range_frac[pick]
-    # the pool's Doppler cell with a uniform sub-bin refinement in (-0.5, 0.5)
-    d_bin = fa.doppler_index[pick] - radar.n_loops // 2 + rng.uniform(-0.5, 0.5, k)
-    return (
-        r_bin,
-        fa.azimuth_rad[pick],
-        np.zeros(k),
-        d_bin,
-        fa.snr_db[pick],
-        np.full(k, SOURCE_OTHER, dtype=np.int32),
-        fa.doppler_index[pick],
-    )
+                # X = |sqrt(L rho) + n|^2 + Gamma(L - 1),  n ~ CN(0, 1)
+                a = np.sqrt(L * rho) + _normal(s) / np.sqrt(2.0)
+                b = _normal(s) / np.sqrt(2.0)
+                x = a * a + b * b + _gamma(s, L - 1.0)
+                # training cells: noise plus the reflector's own leakage (units of s2)
+                leak = L * amp2 / cell_noise[dc]
+                lr = leak * doppler_gain[jd]
+                ld = leak * gr
+                mu_r = _training_sum(
+                    s, rmeth, rn, rne, L, lr * range_leak[jr, 0], lr * range_leak[jr, 1]
+                )
+                mu_d = _training_sum(
+                    s, dmeth, dn, dne, L, ld * doppler_leak[jd, 0], ld * doppler_leak[jd, 1]
+                )
+                det = x > ralpha * mu_r and x > dalpha * mu_d
+                snr = 10.0 * np.log10(x / mu_r)
+                # Cramer-Rao: var(bin) = 6 / (4 pi^2 L rho)
+                sd_bin = np.sqrt(6.0 / (4.0 * np.pi**2 * L * rho))
+                r_est += sd_bin * _normal(s)
+                d_est += sd_bin * _normal(s)
+            else:
+                det = True
+                snr = 10.0 * np.log10(L * rho)
+            # angles: the chain's estimator on the peak cell's channel values, units of noise:
+            # x_v = rho^(1/2) exp(j pi (p_v u + e_v sin el)) exp(j 2 pi nu k(v) / (Nc Ntx)) + n_v
+            amp = np.sqrt(rho)
+            for v in range(n_v):
+                ph = np.pi * (az_pos[v] * u0 + el_pos[v] * s0)
+                ph += 2.0 * np.pi * nu_true * (v // n_rx) / (n_loops * n_tx)
+                xv[v] = amp * (np.cos(ph) + 1j * np.sin(ph))
+                if noise:
+                    xv[v] += (_normal(s) + 1j * _normal(s)) / np.sqrt(2.0)
+            a_i, e_i = angles_of(
+                xv,
+                d_est,
+                n_tx,
+                n_rx,
+                n_loops,
+                row_ch,
+                row_pos,
+                upper,
+                lower,
+                tw_a,
+                elev[fr],
+                spec,
+            )
+            if not (det and bin_lo - 0.5 <= r_est <= bin_hi + 0.5):
+                continue
+            u_est = np.sin(a_i) * np.cos(e_i)
+            az = np.arcsin(min(max(u_est / np.cos(e_i), -1.0), 1.0))
+            f64, i64 = _grow(f64, i64, n_out + 1)
+            rng_m = r_est * range_res
+            f64[n_out, 0] = rng_m
+            f64[n_out, 1] = az
+            f64[n_out, 2] = e_i
+            f64[n_out, 3] = ((d_est + half) % n_loops - half) * vel_res
+            f64[n_out, 4] = snr
+            i64[n_out, 0] = i
+            i64[n_out, 1] = int(np.rint(r_est))
+            i64[n_out, 2] = dc
+            n_out += 1
+        if noise and fa_rate > 0.0 and fa_snr.shape[0] > 0:
+            # the chain's own false alarms: Poisson count, resampled from the measured pool,
+            # range uniform over the detectable bins, Doppler refinement uniform in the cell
+            k = _poisson(s, fa_rate)
+            f64, i64 = _grow(f64, i64, n_out + k)
+            for _ in range(k):
+                pick = _randint(s, fa_snr.shape[0])
+                rb = bin_lo + _randint(s, bin_hi - bin_lo + 1) + fa_frac[pick]
+                db = fa_doppler[pick] - n_loops // 2 + (_uniform(s) - 0.5)
+                f64[n_out, 0] = rb * range_res
+                f64[n_out, 1] = fa_az[pick]
+                f64[n_out, 2] = 0.0
+                f64[n_out, 3] = db * vel_res
+                f64[n_out, 4] = fa_snr[pick]
+                i64[n_out, 0] = -1
+                i64[n_out, 1] = int(np.rint(rb))
+                i64[n_out, 2] = fa_doppler[pick]
+                n_out += 1
+        for j in range(first, n_out):
+            # x = r cos(el) sin(az), y = r cos(el) cos(az), z = r sin(el)
+            horiz = f64[j, 0] * np.cos(f64[j, 2])
+            f64[j, 5] = horiz * np.sin(f64[j, 1])
+            f64[j, 6] = horiz * np.cos(f64[j, 1])
+            f64[j, 7] = f64[j, 0] * np.sin(f64[j, 2])
+        counts[fr] = n_out - first
+    return counts, f64[:n_out], i64[:n_out]
 
 
 def _model_map(radar: RadarConfig, tab: ChainTables, cells: np.ndarray, pc: PointCloud):

@@ -6,6 +6,8 @@ import numpy as np
 import pytest
 
 from core.config import DEFAULT_PROCESSING, PAPER_RADAR
+from core.errors import InputError
+from core.pointcloud import POINT_FIELDS, SOURCE_OTHER
 from core.simulation import (
     FIDELITY_LEVELS,
     AntennaGain,
@@ -16,8 +18,15 @@ from core.simulation import (
 )
 from core.simulation.measurement import (
     _constants,
+    _gamma,
+    _normal,
+    _poisson,
+    _randint,
+    _uniform,
     chain_tables,
+    frame_seed,
     simulate_frame_measurement,
+    simulate_frames_measurement,
 )
 
 RADAR = PAPER_RADAR
@@ -139,3 +148,74 @@ def test_levels_share_the_signature_and_output(level) -> None:
     assert np.degrees(out.point_cloud.azimuth_rad[i[0]]) == pytest.approx(-10.0, abs=1.0)
     assert out.point_cloud.radial_velocity_mps[i[0]] == pytest.approx(1.0, abs=0.1)
     assert simulate_frame is FIDELITY_LEVELS["exact"]
+
+
+def scene_frames(n: int, seed: int) -> list[Scatterers]:
+    """``n`` frames: a person at 3-10 m plus 0-4 clutter reflectors of low RCS."""
+    rng = np.random.default_rng(seed)
+    out = []
+    for _ in range(n):
+        k = 1 + rng.integers(0, 5)
+        pos = np.column_stack((rng.uniform(-3, 3, k), rng.uniform(2, 10, k), np.zeros(k)))
+        out.append(
+            Scatterers(
+                position_m=pos,
+                velocity_mps=np.column_stack((rng.normal(0, 1, (k, 2)), np.zeros(k))),
+                rcs_dbsm=rng.uniform(-30, 0, k),
+                source=np.array([0] + [-1] * (k - 1), dtype=np.int32),
+            )
+        )
+    return out
+
+
+def test_batch_equals_per_frame_bit_for_bit() -> None:
+    """The batch entry point gives every frame exactly what the per-frame call gives."""
+    frames = scene_frames(40, 5)
+    frames[7] = Scatterers.empty()  # a frame without reflectors: only false alarms
+    rngs = [np.random.default_rng([9, f]) for f in range(len(frames))]
+    batch = simulate_frames_measurement(RADAR, frames, rngs, antenna=ANT)
+    rngs = [np.random.default_rng([9, f]) for f in range(len(frames))]
+    per = [simulate_frame_measurement(RADAR, sc, r, antenna=ANT) for sc, r in zip(frames, rngs)]
+    clouds = batch.clouds()
+    assert [len(c) for c in clouds] == [len(o.point_cloud) for o in per]
+    assert int(batch.counts.sum()) == len(batch.point_cloud) == len(batch.detections)
+    for c, o in zip(clouds, per):
+        for name in (*POINT_FIELDS, "source"):
+            np.testing.assert_array_equal(getattr(c, name), getattr(o.point_cloud, name))
+    np.testing.assert_array_equal(batch.detections, np.concatenate([o.detections for o in per]))
+    # the false alarms of the pool appear (label -2) and the person is seen in most frames
+    assert np.any(batch.point_cloud.source == SOURCE_OTHER)
+    assert sum(np.any(c.source == 0) for c in clouds) >= 30
+    with pytest.raises(InputError, match="rngs"):
+        simulate_frames_measurement(RADAR, frames, rngs[:3], antenna=ANT)
+
+
+def test_compiled_generator_moments() -> None:
+    """The kernel's draws have the laws they claim: U[0,1), N(0,1), Gamma(k), Poisson(lam)."""
+    n = 200_000
+    s = frame_seed(np.random.default_rng(1))
+    u = np.array([_uniform(s) for _ in range(n)])
+    z = np.array([_normal(s) for _ in range(n)])
+    # standard errors: U: 0.29/sqrt(n) = 6.5e-4; N: 2.2e-3 (mean), 3.2e-3 (var)
+    assert abs(u.mean() - 0.5) < 4e-3 and abs(u.var() - 1 / 12) < 2e-3
+    assert 0.0 <= u.min() and u.max() < 1.0
+    assert abs(z.mean()) < 0.012 and abs(z.var() - 1.0) < 0.015
+    assert abs(np.mean(z**4) - 3.0) < 0.06
+    for k in (11.0, 35.7, 0.4):
+        g = np.array([_gamma(s, k) for _ in range(n // 4)])
+        # Gamma(k): mean k, variance k, skewness 2 / sqrt(k)
+        assert abs(g.mean() / k - 1) < 5 * np.sqrt(1 / (k * len(g)))
+        assert abs(g.var() / k - 1) < 0.04
+        skew = np.mean((g - g.mean()) ** 3) / g.std() ** 3
+        assert abs(skew - 2 / np.sqrt(k)) < 0.1 * 2 / np.sqrt(k) + 0.03
+    p = np.array([_poisson(s, 0.16) for _ in range(n)])
+    assert abs(p.mean() - 0.16) < 5e-3 and abs(p.var() - 0.16) < 6e-3
+    # P(0) = exp(-0.16), P(2) = 0.16^2/2 exp(-0.16)
+    assert abs(np.mean(p == 0) - np.exp(-0.16)) < 5e-3
+    assert abs(np.mean(p == 2) - 0.0128 * np.exp(-0.16)) < 2e-3
+    ints = np.array([_randint(s, 7) for _ in range(n)])
+    np.testing.assert_allclose(np.bincount(ints, minlength=7) / n, 1 / 7, atol=4e-3)
+    # the state comes from the frame's generator: same generator, same stream
+    np.testing.assert_array_equal(
+        frame_seed(np.random.default_rng(3)), frame_seed(np.random.default_rng(3))
+    )
