@@ -26,16 +26,57 @@ from pathlib import Path
 
 import numpy as np
 
-#: trajectories per class (a-e) in the full and the quick run
-PER_CLASS = 3
+#: trajectories per class (a-e) in the full and the quick run (7: the paper's whole set of 35)
+PER_CLASS = 7
 PER_CLASS_QUICK = 1
 QUICK_FRAMES = 60
 #: noise seeds per level (the tracking loss is heavy-tailed: one frame on a clutter track moves
-#: a trajectory's loss by ~1e-3)
-N_SEEDS = 4
-N_SEEDS_QUICK = 2
-#: noise seed offset of the second exact run
+#: a trajectory's loss by ~1e-3); the cheaper levels afford more
+N_SEEDS = {"exact": 4, "fast": 8, "measurement": 32}
+N_SEEDS_QUICK = {"exact": 2, "fast": 2, "measurement": 4}
+#: noise seed offset between seeds
 OTHER_SEED = 1_000_003
+#: bootstrap resamples of the trajectories for the loss ratio's interval
+N_BOOTSTRAP = 4000
+#: the goal: tracking loss within this fraction of the exact level's
+LOSS_TOLERANCE = 0.10
+
+
+def loss_ratio_interval(
+    level: np.ndarray, exact: np.ndarray, *, n_boot: int = N_BOOTSTRAP, seed: int = 0
+) -> tuple[float, float, float]:
+    """Ratio of mean losses ``mean(level) / mean(exact)`` with a paired bootstrap interval.
+
+    Parameters
+    ----------
+    level, exact
+        ``(K,)`` per-trajectory losses (each the mean over that level's noise seeds), the same
+        trajectories in the same order: the trajectories are the independent units, resampled
+        with replacement (paired: the same resample for both levels).
+
+    Returns
+    -------
+    ratio, lo, hi
+        The ratio and its 95 % percentile interval.
+    """
+    level, exact = np.asarray(level, float), np.asarray(exact, float)
+    rng = np.random.default_rng(seed)
+    idx = rng.integers(0, len(exact), (n_boot, len(exact)))
+    # ratio* = sum_k L_level[k*] / sum_k L_exact[k*]
+    num, den = level[idx].sum(axis=1), exact[idx].sum(axis=1)
+    boot = num[den > 0] / den[den > 0]
+    lo, hi = np.percentile(boot, [2.5, 97.5]) if len(boot) else (np.nan, np.nan)
+    return float(level.sum() / exact.sum()), float(lo), float(hi)
+
+
+def verdict(lo: float, hi: float, tol: float = LOSS_TOLERANCE) -> str:
+    """``"within"`` when the interval lies inside ``[1 - tol, 1 + tol]``, ``"outside"`` when it
+    misses that band entirely, else ``"undecided"``."""
+    if 1 - tol <= lo and hi <= 1 + tol:
+        return "within"
+    if hi < 1 - tol or lo > 1 + tol:
+        return "outside"
+    return "undecided"
 
 
 def _ks(a: np.ndarray, b: np.ndarray) -> float | None:
@@ -60,6 +101,18 @@ def _frames(scene, seed):
     return frames, antenna, settings, p.elevation, refl
 
 
+def _batch_simulator(name: str):
+    """The level's all-frames entry point (``core.pipeline.BATCH_SIMULATORS``) or None."""
+    import importlib
+
+    from core import pipeline
+
+    if name not in pipeline.BATCH_SIMULATORS:
+        return None
+    module, fn = pipeline.BATCH_SIMULATORS[name].split(":")
+    return getattr(importlib.import_module(module), fn)
+
+
 def run(quick: bool = False) -> dict:
     """Run every level on the same scenes; returns JSON-ready figures (see module docstring)."""
     from core import pipeline
@@ -70,14 +123,17 @@ def run(quick: bool = False) -> dict:
     from core.tracking import TrackerParams, track_dataset
 
     per_class = PER_CLASS_QUICK if quick else PER_CLASS
-    n_seeds = N_SEEDS_QUICK if quick else N_SEEDS
+    seeds = N_SEEDS_QUICK if quick else N_SEEDS
     scenes = paper_scenes(0, 5 * per_class)
     levels = list(FIDELITY_LEVELS)
-    runs = [(name, s) for s in range(n_seeds) for name in levels]
+    n_seeds = {name: seeds.get(name, 2) for name in levels}
+    runs = [(name, s) for s in range(max(n_seeds.values())) for name in levels if s < n_seeds[name]]
     acc = {
         run: {"cpu_s": 0.0, "frames": 0, "clouds": [], "err": [], "snr": [], "hit": []}
         for run in runs
     }
+    # the per-frame entry point of levels that have a batch one (the GUI's path), seed 0
+    per_frame = {name: {"cpu_s": 0.0, "frames": 0} for name in levels if _batch_simulator(name)}
     truth = {"xy": [], "v": [], "t": [], "traj": [], "cls": []}
     setup_s = {}
     for k, scene in enumerate(scenes):
@@ -85,30 +141,44 @@ def run(quick: bool = False) -> dict:
         n_f = min(QUICK_FRAMES, len(frames)) if quick else len(frames)
         radar = scene.radar
         t_mid = 0.5 * radar.n_loops * radar.n_tx * radar.chirp_period_s
+        kw = {"antenna": antenna, "settings": settings, "elevation": elevation}
         if k == 0:
             # one-time set-up (compilation, tables, the false-alarm pool) is not frame time
             for name in levels:
                 t0 = time.process_time()
-                FIDELITY_LEVELS[name](
-                    radar, frames[0], np.random.default_rng(0), antenna=antenna,
-                    settings=settings, elevation=elevation,
-                )  # fmt: skip
+                FIDELITY_LEVELS[name](radar, frames[0], np.random.default_rng(0), **kw)
+                batch = _batch_simulator(name)
+                if batch is not None:
+                    batch(radar, frames[:2], [np.random.default_rng(0)] * 2, **kw)
                 setup_s[name] = time.process_time() - t0
         for run in runs:
             name, s = run
-            simulate = FIDELITY_LEVELS[name]
+            simulate, batch = FIDELITY_LEVELS[name], _batch_simulator(name)
             a = acc[run]
             noise_seed = scene.seed + s * OTHER_SEED
-            for f in range(n_f):
-                sc = frames[f]
-                rng = pipeline.stage_rng(noise_seed, "noise", f)
+            # the pipeline's per-frame generators, built outside the timing for every level
+            rngs = [pipeline.stage_rng(noise_seed, "noise", f) for f in range(n_f)]
+            if batch is not None:
                 t0 = time.process_time()
-                out = simulate(
-                    radar, sc, rng, antenna=antenna, settings=settings, elevation=elevation
-                )
+                clouds = batch(radar, frames[:n_f], rngs, **kw).clouds()
                 a["cpu_s"] += time.process_time() - t0
-                a["frames"] += 1
-                pc = out.point_cloud
+                if s == 0:
+                    rngs = [pipeline.stage_rng(noise_seed, "noise", f) for f in range(n_f)]
+                    t0 = time.process_time()
+                    for f in range(n_f):
+                        simulate(radar, frames[f], rngs[f], **kw)
+                    per_frame[name]["cpu_s"] += time.process_time() - t0
+                    per_frame[name]["frames"] += n_f
+            else:
+                clouds = []
+                for f in range(n_f):
+                    t0 = time.process_time()
+                    out = simulate(radar, frames[f], rngs[f], **kw)
+                    a["cpu_s"] += time.process_time() - t0
+                    clouds.append(out.point_cloud)
+            a["frames"] += n_f
+            for f, pc in enumerate(clouds):
+                sc = frames[f]
                 a["clouds"].append(pc)
                 a["hit"].append(bool(np.any(pc.source == 0)))
                 person = np.flatnonzero(sc.source == 0)
@@ -150,6 +220,13 @@ def run(quick: bool = False) -> dict:
             fidelity=run[0],
             seed=run[1],
         )
+        src = np.concatenate([c.source for c in a["clouds"]])
+        a["points"] = {
+            "clutter": int(np.sum(src == -1)),
+            "false": int(np.sum(src == -2)),
+            "person": int(np.sum(src >= 0)),
+        }
+        a["clouds"] = []  # the data set holds them now; keep memory flat over many seeds
         for model, prm in params.items():
             if not tracking:
                 track_dataset(ds, prm)  # compile the tracker outside the timing
@@ -158,6 +235,7 @@ def run(quick: bool = False) -> dict:
             dt = time.process_time() - t0
             tracking[(run, model)] = {
                 "loss_x1e3": 1e3 * ev.loss_total,
+                "trajectory_loss_x1e3": (1e3 * np.asarray(ev.loss)).tolist(),
                 "median_trajectory_loss_x1e3": 1e3 * float(np.median(ev.loss)),
                 "mse_mean_m2": float(np.nanmean(ev.mse)),
                 "n_c_mean": float(np.mean(ev.n_c)),
@@ -168,8 +246,18 @@ def run(quick: bool = False) -> dict:
             }
 
     exact = acc[("exact", 0)]
-    exact_fps = exact["frames"] / exact["cpu_s"]
-    rows = [(name, 0) for name in levels] + ([("exact", 1)] if n_seeds > 1 else [])
+    exact_fps = sum(acc[("exact", t)]["frames"] for t in range(n_seeds["exact"])) / sum(
+        acc[("exact", t)]["cpu_s"] for t in range(n_seeds["exact"])
+    )
+
+    def per_trajectory(name: str, model: str) -> np.ndarray:
+        """``(K,)`` each trajectory's loss (x1e-3), mean over the level's noise seeds."""
+        return np.mean(
+            [tracking[((name, t), model)]["trajectory_loss_x1e3"] for t in range(n_seeds[name])],
+            axis=0,
+        )
+
+    rows = [(name, 0) for name in levels] + ([("exact", 1)] if n_seeds["exact"] > 1 else [])
     result_levels = {}
     for run in rows:
         name, s = run
@@ -178,16 +266,22 @@ def run(quick: bool = False) -> dict:
         ex = np.asarray(exact["err"]).reshape(-1, 3)
         snr, ex_snr = np.asarray(a["snr"]), np.asarray(exact["snr"])
         n_frames = a["frames"]
-        src = np.concatenate([c.source for c in a["clouds"]])
-        cpu_level = [acc[(name, t)]["cpu_s"] for t in range(n_seeds)]
-        fps = sum(acc[(name, t)]["frames"] for t in range(n_seeds)) / sum(cpu_level)
+        seeds_here = range(n_seeds[name])
+        cpu_level = [acc[(name, t)]["cpu_s"] for t in seeds_here]
+        fps = sum(acc[(name, t)]["frames"] for t in seeds_here) / sum(cpu_level)
         trk = {}
         for model in params:
-            per_seed = [tracking[((name, t), model)] for t in range(n_seeds)]
+            per_seed = [tracking[((name, t), model)] for t in seeds_here]
             losses = [p["loss_x1e3"] for p in per_seed]
+            ratio, lo, hi = loss_ratio_interval(
+                per_trajectory(name, model), per_trajectory("exact", model)
+            )
             trk[model] = {
                 "loss_x1e3_per_seed": losses,
                 "loss_x1e3_mean": float(np.mean(losses)),
+                "loss_ratio_to_exact": ratio,
+                "loss_ratio_ci95": [lo, hi],
+                "verdict_within_10pct": "–" if name == "exact" else verdict(lo, hi),
                 "median_trajectory_loss_x1e3": float(
                     np.mean([p["median_trajectory_loss_x1e3"] for p in per_seed])
                 ),
@@ -200,6 +294,13 @@ def run(quick: bool = False) -> dict:
                 "trial_cpu_s": float(np.mean(cpu_level))
                 + float(np.mean([p["track_cpu_s"] for p in per_seed])),
             }
+            if name == "exact":
+                # the yardstick: each exact seed's total against the mean of the other seeds
+                tot = np.array(losses)
+                others = [(tot.sum() - v) / (len(tot) - 1) for v in tot] if len(tot) > 1 else []
+                trk[model]["exact_seed_ratio_to_others"] = [
+                    float(v / o) for v, o in zip(tot, others)
+                ]
 
         def dist(x: np.ndarray) -> dict:
             if not len(x):
@@ -218,6 +319,11 @@ def run(quick: bool = False) -> dict:
             "setup_cpu_s": setup_s[name],
             "fps": fps,
             "speedup": fps / exact_fps if s == 0 else 1.0,
+            "per_frame_call_fps": (
+                per_frame[name]["frames"] / per_frame[name]["cpu_s"]
+                if name in per_frame and s == 0
+                else None
+            ),
             "person_pd": float(np.mean(a["hit"])),
             "range_error_m": {**dist(err[:, 0]), "ks": _ks(err[:, 0], ex[:, 0])},
             "azimuth_error_deg": {
@@ -226,9 +332,10 @@ def run(quick: bool = False) -> dict:
             },
             "radial_velocity_error_mps": {**dist(err[:, 2]), "ks": _ks(err[:, 2], ex[:, 2])},
             "snr_db": {**dist(snr), "ks": _ks(snr, ex_snr)},
-            "clutter_points_per_frame": float(np.sum(src == -1) / n_frames),
-            "false_points_per_frame": float(np.sum(src == -2) / n_frames),
-            "person_points_per_frame": float(np.sum(src >= 0) / n_frames),
+            "noise_seeds": n_seeds[name],
+            "clutter_points_per_frame": a["points"]["clutter"] / n_frames,
+            "false_points_per_frame": a["points"]["false"] / n_frames,
+            "person_points_per_frame": a["points"]["person"] / n_frames,
             "tracking": trk,
         }
     out = {
@@ -236,11 +343,16 @@ def run(quick: bool = False) -> dict:
         f"({per_class} per class a-e)" + (f", first {QUICK_FRAMES} frames each" if quick else ""),
         "frames_per_level": exact["frames"],
         "noise_seeds": n_seeds,
+        "bootstrap": f"{N_BOOTSTRAP} paired resamples of the {len(scenes)} trajectories",
         "tracker_parameters": "TrackerParams.default('cv') / ('ca') (no tuned parameters "
         "were committed on branch tune when this ran)",
-        "timing": "process CPU time of the simulator call only, levels interleaved per "
-        "trajectory, after a warm-up call (set-up time listed separately); exact* = exact "
-        "with the second noise seed, the yardstick for the distances",
+        "timing": "process CPU time of the simulator call only (for a level with a batch entry "
+        "point, core.pipeline.BATCH_SIMULATORS: the one call for all frames of a trajectory, "
+        "as the data-set path runs it; its per-frame call, the GUI's path, is listed too), "
+        "levels interleaved per trajectory, after a warm-up call (set-up time listed "
+        "separately); the pipeline's per-frame generators and reflectors are built outside "
+        "the timing for every level; exact* = exact with the second noise seed, the "
+        "yardstick for the distances",
         "levels": result_levels,
     }
     target = Path("bench/results") if quick else Path("docs/fidelity")
@@ -258,12 +370,13 @@ def _fmt(v, spec: str = ".3g") -> str:
 def _table(result: dict) -> str:
     lv = result["levels"]
     head = (
-        "| level | frames/s | speed-up | Pd person | range err mean/sd (mm) | KS | "
-        "az err mean/sd (°) | KS | vr err mean/sd (m/s) | KS | SNR mean (dB) | KS | "
-        "clutter pts/frame | false pts/frame | loss CV ×1e-3 (seeds) | loss CA ×1e-3 (seeds) | "
+        "| level | seeds | frames/s | speed-up | per-frame call frames/s | Pd person | "
+        "range err mean/sd (mm) | KS | az err mean/sd (°) | KS | vr err mean/sd (m/s) | KS | "
+        "SNR mean (dB) | KS | clutter pts/frame | false pts/frame | "
+        "loss CV ×1e-3 mean (seed min–max) | loss CA ×1e-3 mean (seed min–max) | "
         "median traj. loss CV / CA ×1e-3 | RMSE CV / CA (m) | trial CPU (s) |"
     )
-    rows = [head, "|" + "---|" * 19]
+    rows = [head, "|" + "---|" * 21]
     for name, r in lv.items():
         re, ae, ve, sn = (
             r["range_error_m"],
@@ -274,8 +387,11 @@ def _table(result: dict) -> str:
         mean_mm = None if re["mean"] is None else 1e3 * re["mean"]
         sd_mm = None if re["sd"] is None else 1e3 * re["sd"]
         mm = f"{_fmt(mean_mm, '.2f')}/{_fmt(sd_mm, '.2f')}"
+        pf = r.get("per_frame_call_fps")
         rows.append(
-            f"| {name} | {r['fps']:.0f} | {r['speedup']:.1f} | {r['person_pd']:.3f} | {mm} | "
+            f"| {name} | {r['noise_seeds'] if name != 'exact*' else 1} | {r['fps']:.0f} | "
+            f"{r['speedup']:.1f} | {'–' if pf is None else format(pf, '.0f')} | "
+            f"{r['person_pd']:.3f} | {mm} | "
             f"{_fmt(re['ks'], '.3f')} | {_fmt(ae['mean'], '.3f')}/{_fmt(ae['sd'], '.3f')} | "
             f"{_fmt(ae['ks'], '.3f')} | {_fmt(ve['mean'], '.4f')}/{_fmt(ve['sd'], '.4f')} | "
             f"{_fmt(ve['ks'], '.3f')} | {_fmt(sn['mean'], '.2f')} | {_fmt(sn['ks'], '.3f')} | "
@@ -293,9 +409,40 @@ def _table(result: dict) -> str:
     return "\n".join(rows)
 
 
+def _loss_table(result: dict) -> str:
+    """The 10 % criterion: loss ratio to exact with its paired bootstrap interval."""
+    lv = result["levels"]
+    rows = [
+        "| level | model | loss ×1e-3 | ratio to exact | 95 % interval (bootstrap over "
+        "trajectories) | within 10 %? |",
+        "|---|---|---|---|---|---|",
+    ]
+    for name, r in lv.items():
+        if name in ("exact", "exact*"):
+            continue
+        for model in ("cv", "ca"):
+            t = r["tracking"][model]
+            lo, hi = t["loss_ratio_ci95"]
+            rows.append(
+                f"| {name} | {model.upper()} | {t['loss_x1e3_mean']:.3f} | "
+                f"{t['loss_ratio_to_exact']:.2f} | {lo:.2f}–{hi:.2f} | "
+                f"{t['verdict_within_10pct']} |"
+            )
+    ex = lv["exact"]["tracking"]
+    yard = []
+    for model in ("cv", "ca"):
+        v = ex[model].get("exact_seed_ratio_to_others") or []
+        if v:
+            yard.append(
+                f"{model.upper()}: one exact seed against the mean of the others "
+                + ", ".join(f"{x:.2f}" for x in v)
+            )
+    return "\n".join(rows) + ("\n\nYardstick — " + "; ".join(yard) if yard else "")
+
+
 def _losses(t: dict) -> str:
-    seeds = ", ".join(f"{v:.3f}" for v in t["loss_x1e3_per_seed"])
-    return f"{t['loss_x1e3_mean']:.3f} ({seeds})"
+    v = t["loss_x1e3_per_seed"]
+    return f"{t['loss_x1e3_mean']:.3f} ({min(v):.3f}–{max(v):.3f})"
 
 
 def _write_table(result: dict, path: Path) -> None:
@@ -303,15 +450,19 @@ def _write_table(result: dict, path: Path) -> None:
         "# Fidelity levels: error against run time\n\n"
         f"Command: `radartune bench fidelity` (writes this file, the plot and "
         f"`bench/results/fidelity.json`).\n\n"
-        f"- Scenes: {result['scenes']}; {result['frames_per_level']} frames per level.\n"
+        f"- Scenes: {result['scenes']}; {result['frames_per_level']} frames per level and seed.\n"
+        f"- Noise seeds: {result['noise_seeds']}.\n"
         f"- Tracker: {result['tracker_parameters']}.\n"
         f"- Timing: {result['timing']}.\n"
-        "- KS: two-sample Kolmogorov-Smirnov distance of the person's point errors to `exact`; "
-        "`exact*` is the yardstick (same scenes, other noise).\n"
-        "- Loss: eq. (14) on the level's own data set (×1e-3), mean over the noise seeds (each "
-        "seed in brackets); trial CPU = simulation of the data set + one tracking run.\n\n"
-        + _table(result)
-        + "\n"
+        "- KS: two-sample Kolmogorov-Smirnov distance of the person's point errors to `exact` "
+        "(first seed of each level); `exact*` is the yardstick (same scenes, other noise).\n"
+        "- Loss: eq. (14) on the level's own data set (×1e-3), mean over the noise seeds "
+        "(smallest and largest seed in brackets); trial CPU = simulation of the data set + one "
+        "tracking run.\n"
+        f"- Loss ratio: mean loss of the level over that of `exact`, each trajectory's loss "
+        f"averaged over the level's seeds; interval: {result['bootstrap']}. Verdict "
+        "`within` when the whole interval lies in 0.9–1.1, `outside` when it misses that "
+        "band, else `undecided`.\n\n" + _table(result) + "\n\n" + _loss_table(result) + "\n"
     )
     tmp = path.with_suffix(path.suffix + ".tmp")
     tmp.write_text(text)
@@ -355,15 +506,24 @@ def _plot(result: dict, path: Path) -> None:
     names = [n for n in names if n != "exact*"]
     for model, mk in (("cv", "o"), ("ca", "s")):
         xs = np.array([lv[n]["tracking"][model]["trial_cpu_s"] for n in names])
-        ys = np.array([lv[n]["tracking"][model]["loss_x1e3_mean"] for n in names])
-        lo = ys - [min(lv[n]["tracking"][model]["loss_x1e3_per_seed"]) for n in names]
-        hi = [max(lv[n]["tracking"][model]["loss_x1e3_per_seed"]) for n in names] - ys
-        ax2.errorbar(xs, ys, yerr=[lo, hi], fmt=mk, capsize=3, label=model.upper(), alpha=0.8)
+        ex = lv["exact"]["tracking"][model]["loss_x1e3_mean"]
+        ys = np.array([lv[n]["tracking"][model]["loss_ratio_to_exact"] for n in names])
+        ci = np.array(
+            [lv[n]["tracking"][model]["loss_ratio_ci95"] if n != "exact" else [1, 1] for n in names]
+        )
+        # exact: its own seed-to-seed spread (one seed against the mean of the others)
+        spread = lv["exact"]["tracking"][model].get("exact_seed_ratio_to_others") or [1.0]
+        ci[0] = [min(spread), max(spread)]
+        ax2.errorbar(
+            xs, ys, yerr=[ys - ci[:, 0], ci[:, 1] - ys], fmt=mk, capsize=3,
+            label=f"{model.upper()} (exact: {ex:.3f}e-3)", alpha=0.8,
+        )  # fmt: skip
         if model == "cv":
             for n, x, y in zip(names, xs, ys):
                 ax2.annotate(n, (x, y), textcoords="offset points", xytext=(6, 6), fontsize=8)
+    ax2.axhspan(1 - LOSS_TOLERANCE, 1 + LOSS_TOLERANCE, color="g", alpha=0.12, label="±10 %")
     ax2.set_xlabel("CPU time per trial: simulate the data set + track it (s)")
-    ax2.set_ylabel("tracking loss L_t (×1e-3), mean and range over seeds")
+    ax2.set_ylabel("tracking loss / exact's (95 % bootstrap interval;\nexact: seed spread)")
     ax2.set_title("tracking loss against run time")
     ax2.legend(fontsize=8)
     fig.tight_layout()
