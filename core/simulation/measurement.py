@@ -51,6 +51,8 @@ sharing a cell, the threshold effect of the estimators at very low SNR.
 from __future__ import annotations
 
 import functools
+import hashlib
+import os
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -222,7 +224,58 @@ class FalseAlarms:
 def chain_false_alarms(
     radar: RadarConfig, settings: ProcessingSettings, n_frames: int = FALSE_ALARM_FRAMES
 ) -> FalseAlarms:
-    """Run ``n_frames`` noise-only frames through the exact chain (seeded) and pool the points."""
+    """Run ``n_frames`` noise-only frames through the exact chain (seeded) and pool the points.
+
+    The pool is cached on disk (``<cache>/false_alarms/<key>.npz``, the data-set cache folder
+    of :func:`core.pipeline.default_cache_dir`; key: radar, settings, ``n_frames`` and the
+    simulation's source fingerprint), so a worker process loads it instead of spending ~1 s
+    of exact frames; a missing or unreadable file is simply recomputed.
+    """
+    path = _false_alarm_cache_path(radar, settings, n_frames)
+    try:
+        with np.load(path) as z:
+            return FalseAlarms(
+                rate_per_frame=float(z["rate_per_frame"]),
+                doppler_index=z["doppler_index"].astype(np.int64),
+                snr_db=z["snr_db"].astype(np.float64),
+                azimuth_rad=z["azimuth_rad"].astype(np.float64),
+                range_frac=z["range_frac"].astype(np.float64),
+                n_frames=int(z["n_frames"]),
+            )
+    except (OSError, KeyError, ValueError):
+        pass
+    fa = _measure_false_alarms(radar, settings, n_frames)
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        tmp = path.with_name(f"{path.stem}.{os.getpid()}.tmp.npz")
+        np.savez(
+            tmp,
+            rate_per_frame=fa.rate_per_frame,
+            doppler_index=fa.doppler_index,
+            snr_db=fa.snr_db,
+            azimuth_rad=fa.azimuth_rad,
+            range_frac=fa.range_frac,
+            n_frames=fa.n_frames,
+        )
+        tmp.replace(path)  # atomic: a reader never sees half a file
+    except OSError:
+        pass  # a read-only cache only costs the recomputation
+    return fa
+
+
+def _false_alarm_cache_path(radar: RadarConfig, settings: ProcessingSettings, n_frames: int):
+    from core.pipeline import code_fingerprint, default_cache_dir
+
+    key = hashlib.sha256(
+        f"{radar!r}\n{settings!r}\n{n_frames}\n{code_fingerprint()}".encode()
+    ).hexdigest()[:32]
+    return default_cache_dir() / "false_alarms" / f"{key}.npz"
+
+
+def _measure_false_alarms(
+    radar: RadarConfig, settings: ProcessingSettings, n_frames: int
+) -> FalseAlarms:
+    """The pool itself: ``n_frames`` seeded noise-only frames of the exact chain."""
     from core.simulation.frame import simulate_frame
 
     rng = np.random.default_rng(20_261_121)

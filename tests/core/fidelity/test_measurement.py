@@ -19,10 +19,12 @@ from core.simulation import (
 from core.simulation.measurement import (
     _constants,
     _gamma,
+    _measure_false_alarms,
     _normal,
     _poisson,
     _randint,
     _uniform,
+    chain_false_alarms,
     chain_tables,
     frame_seed,
     simulate_frame_measurement,
@@ -219,3 +221,20 @@ def test_compiled_generator_moments() -> None:
     np.testing.assert_array_equal(
         frame_seed(np.random.default_rng(3)), frame_seed(np.random.default_rng(3))
     )
+
+
+def test_false_alarm_pool_cached_on_disk(tmp_path, monkeypatch) -> None:
+    """The pool is written once, read back equal, and a corrupt file is recomputed."""
+    monkeypatch.setenv("RADARTUNE_CACHE", str(tmp_path))
+    fresh = _measure_false_alarms(RADAR, DEFAULT_PROCESSING, 20)
+    first = chain_false_alarms.__wrapped__(RADAR, DEFAULT_PROCESSING, 20)
+    files = list((tmp_path / "false_alarms").glob("*.npz"))
+    assert len(files) == 1 and not list((tmp_path / "false_alarms").glob("*.tmp*"))
+    loaded = chain_false_alarms.__wrapped__(RADAR, DEFAULT_PROCESSING, 20)
+    for fa in (first, loaded):
+        assert fa.rate_per_frame == fresh.rate_per_frame and fa.n_frames == 20
+        for name in ("doppler_index", "snr_db", "azimuth_rad", "range_frac"):
+            np.testing.assert_array_equal(getattr(fa, name), getattr(fresh, name))
+    files[0].write_bytes(b"not a npz")
+    again = chain_false_alarms.__wrapped__(RADAR, DEFAULT_PROCESSING, 20)
+    np.testing.assert_array_equal(again.snr_db, fresh.snr_db)

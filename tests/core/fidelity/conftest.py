@@ -1,0 +1,11 @@
+"""The fidelity tests keep their on-disk caches (false-alarm pool) out of the user's cache."""
+
+import pytest
+
+
+@pytest.fixture(autouse=True, scope="session")
+def _private_cache(tmp_path_factory):
+    mp = pytest.MonkeyPatch()
+    mp.setenv("RADARTUNE_CACHE", str(tmp_path_factory.mktemp("radartune-cache")))
+    yield
+    mp.undo()
