@@ -55,6 +55,7 @@ import hashlib
 import os
 from collections.abc import Sequence
 from dataclasses import dataclass
+from pathlib import Path
 
 import numba
 import numpy as np
@@ -226,10 +227,10 @@ def chain_false_alarms(
 ) -> FalseAlarms:
     """Run ``n_frames`` noise-only frames through the exact chain (seeded) and pool the points.
 
-    The pool is cached on disk (``<cache>/false_alarms/<key>.npz``, the data-set cache folder
-    of :func:`core.pipeline.default_cache_dir`; key: radar, settings, ``n_frames`` and the
-    simulation's source fingerprint), so a worker process loads it instead of spending ~1 s
-    of exact frames; a missing or unreadable file is simply recomputed.
+    The pool is cached on disk (``<cache>/false_alarms/<key>.npz`` in the data-set cache
+    folder; key: radar, settings, ``n_frames`` and the chain's source fingerprint), so a
+    worker process loads it instead of spending ~1 s of exact frames; a missing or unreadable
+    file is simply recomputed.
     """
     path = _false_alarm_cache_path(radar, settings, n_frames)
     try:
@@ -263,13 +264,30 @@ def chain_false_alarms(
     return fa
 
 
-def _false_alarm_cache_path(radar: RadarConfig, settings: ProcessingSettings, n_frames: int):
-    from core.pipeline import code_fingerprint, default_cache_dir
+@functools.cache
+def _chain_fingerprint() -> str:
+    """Hash of the sources the exact chain's false alarms depend on (config, simulation,
+    processing), so a changed chain never serves a stale pool."""
+    root = Path(__file__).resolve().parent.parent
+    files = [root / "config.py", root / "pointcloud.py"]
+    for pkg in ("simulation", "processing"):
+        files += sorted((root / pkg).rglob("*.py"))
+    h = hashlib.sha256()
+    for f in files:
+        if f.is_file():
+            h.update(f.relative_to(root).as_posix().encode() + b"\0" + f.read_bytes() + b"\0")
+    return h.hexdigest()[:16]
 
+
+def _false_alarm_cache_path(radar: RadarConfig, settings: ProcessingSettings, n_frames: int):
+    """``<cache>/false_alarms/<key>.npz``; ``<cache>``: ``$RADARTUNE_CACHE`` or
+    ``~/.cache/radartune`` (the data-set cache's folder, see ``core.pipeline``)."""
+    env = os.environ.get("RADARTUNE_CACHE")
+    root = Path(env) if env else Path.home() / ".cache" / "radartune"
     key = hashlib.sha256(
-        f"{radar!r}\n{settings!r}\n{n_frames}\n{code_fingerprint()}".encode()
+        f"{radar!r}\n{settings!r}\n{n_frames}\n{_chain_fingerprint()}".encode()
     ).hexdigest()[:32]
-    return default_cache_dir() / "false_alarms" / f"{key}.npz"
+    return root / "false_alarms" / f"{key}.npz"
 
 
 def _measure_false_alarms(
