@@ -501,6 +501,8 @@ def _plot(result: dict, path: Path) -> None:
     ax1.set_xlabel("frames per second (simulator CPU time)")
     ax1.set_ylabel("KS distance of the person's point errors to exact")
     ax1.set_ylim(0, 1.35 * top)
+    fps = [lv[n]["fps"] for n in names]
+    ax1.set_xlim(min(fps) / 1.8, max(fps) * 1.8)  # room for the labels
     ax1.set_title("point errors against run time")
     ax1.legend(fontsize=8, loc="lower right")
     names = [n for n in names if n != "exact*"]
