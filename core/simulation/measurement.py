@@ -43,6 +43,12 @@ in four steps.
    Clutter reflectors (a Poisson number per frame, drawn by the scene) are reflectors like the
    people and go through steps 1-3.
 
+Speed: all four steps run in one compiled kernel over any number of frames
+(:func:`simulate_frames_measurement`, the data-set path; :func:`simulate_frame_measurement` is
+the same kernel with one frame). The kernel draws from its own xoshiro256** generator, seeded
+per frame with four raw draws of that frame's ``rng`` (:func:`frame_seed`), so both entry
+points give the same frames bit for bit (``docs/decisions/fidelity-04``).
+
 Not modelled (measured against ``exact`` in ``docs/fidelity.md``): the extra detections next to
 very strong or fast reflectors (window sidelobes, clutter-removal residuals), two reflectors
 sharing a cell, the threshold effect of the estimators at very low SNR.
