@@ -820,14 +820,23 @@ def run_tracker_compiled(
     from core.tracking.tracker import FrameTracks, TrackerConstants, TrackerResult, frame_slices
 
     TrackerConstants.build(params, frame_period_s)  # validates the frame period
-    zs = frame_slices(frames)
-    counts = np.array([len(z) for z in zs], dtype=np.int64)
-    z = np.concatenate(zs) if zs else np.zeros((0, 3))
+    if isinstance(frames, tuple) and len(frames) == 2 and np.ndim(frames[1]) == 1:
+        z = np.asarray(frames[0], dtype=np.float64).reshape(-1, 3)
+        f_off = np.asarray(frames[1], dtype=np.int64)
+        if len(f_off) == 0 or f_off[0] != 0 or f_off[-1] != len(z) or np.any(np.diff(f_off) < 0):
+            raise InputError(
+                f"frame_offsets must rise from 0 to the {len(z)} measurements, "
+                f"got {f_off[:3].tolist()}…{f_off[-2:].tolist()}"
+            )
+    else:
+        zs = frame_slices(frames)
+        counts = np.array([len(zf) for zf in zs], dtype=np.int64)
+        z = np.concatenate(zs) if zs else np.zeros((0, 3))
+        f_off = np.concatenate(([0], np.cumsum(counts))).astype(np.int64)
     if not np.all(np.isfinite(z)):
         bad = int(np.flatnonzero(~np.all(np.isfinite(z), axis=1))[0])
         raise InputError(f"measurement {bad} contains NaN or Inf")
-    n_f = len(zs)
-    f_off = np.concatenate(([0], np.cumsum(counts))).astype(np.int64)
+    n_f = len(f_off) - 1
     t_off = np.array([0, n_f], dtype=np.int64)
     out = track_frames(
         z, f_off, t_off, np.zeros(1, dtype=np.int64), params, frame_period_s, record=True

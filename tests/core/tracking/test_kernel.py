@@ -172,3 +172,18 @@ def test_unknown_engine_is_an_input_error():
 def test_nan_measurement_is_an_input_error():
     with pytest.raises(InputError, match="NaN"):
         run_tracker([np.array([[np.nan, 0.0, 0.0]])], TrackerParams(), 0.08, engine="numba")
+
+
+def test_compiled_run_accepts_both_input_forms_and_rejects_bad_offsets(dataset):
+    p = CASES["cv-default"]
+    z, offsets = _trajectory(dataset, 0)
+    pair = run_tracker((z, offsets), p, 0.08, engine="numba")
+    listed = run_tracker(
+        [z[a:b] for a, b in zip(offsets[:-1], offsets[1:])], p, 0.08, engine="numba"
+    )
+    np.testing.assert_array_equal(pair.estimate_xy, listed.estimate_xy)
+    np.testing.assert_array_equal(pair.estimate_id, listed.estimate_id)
+    with pytest.raises(InputError, match="frame_offsets"):
+        run_tracker((z, offsets[:-1]), p, 0.08, engine="numba")  # misses the last points
+    with pytest.raises(InputError, match="frame_period_s"):
+        run_tracker((z, offsets), p, 0.0, engine="numba")
