@@ -43,6 +43,8 @@ PERSON_RCS_STD_DB = 4.0
 #: ``core.simulation.simulate_frame``. Adding a level is one line.
 SIMULATORS: dict[str, str] = {
     "exact": "core.simulation:simulate_frame",
+    "fast": "core.simulation:simulate_frame_fast",
+    "measurement": "core.simulation:simulate_frame_measurement",
 }
 
 #: Bump when the simulation changes in a way that invalidates cached data sets.

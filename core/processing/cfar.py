@@ -26,6 +26,7 @@ import functools
 from dataclasses import dataclass
 from typing import Protocol
 
+import numba
 import numpy as np
 from scipy.integrate import quad
 from scipy.optimize import brentq
@@ -301,18 +302,135 @@ class Detections:
 
 def _local_maxima(rd: np.ndarray, r: np.ndarray, d: np.ndarray) -> np.ndarray:
     """True where ``rd[r, d]`` >= its 8 neighbours (range edges open, Doppler cyclic)."""
+    return _local_maxima_kernel(np.asarray(rd), np.asarray(r), np.asarray(d))
+
+
+@numba.njit(cache=True, nogil=True)
+def _local_maxima_kernel(rd, r, d):  # pragma: no cover
     n_r, n_d = rd.shape
-    keep = np.ones(len(r), dtype=bool)
-    for dr in (-1, 0, 1):
-        rr = r + dr
-        inside = (rr >= 0) & (rr < n_r)
-        rr = np.clip(rr, 0, n_r - 1)
-        for dd in (-1, 0, 1):
-            if dr == 0 and dd == 0:
+    keep = np.ones(len(r), dtype=np.bool_)
+    for t in range(len(r)):
+        centre = rd[r[t], d[t]]
+        for dr in (-1, 0, 1):
+            rr = r[t] + dr
+            if rr < 0 or rr >= n_r:
                 continue
-            neighbour = rd[rr, (d + dd) % n_d]
-            keep &= ~inside | (rd[r, d] >= neighbour)
+            for dd in (-1, 0, 1):
+                if (dr != 0 or dd != 0) and rd[rr, (d[t] + dd) % n_d] > centre:
+                    keep[t] = False
     return keep
+
+
+@functools.lru_cache(maxsize=64)
+def _cfar_plan(radar: RadarConfig, settings: ProcessingSettings, n_r: int, n_d: int, L: int):
+    """What two_stage_cfar needs besides the map (range limits, whitening, thresholds)."""
+    k = np.arange(n_r) * radar.range_resolution_m
+    inside = np.flatnonzero((k >= settings.min_range_m) & (k <= settings.max_range_m))
+    if inside.size == 0:
+        return None
+    lo, hi = int(inside[0]), int(inside[-1])
+    rc, dc = settings.range_cfar, settings.doppler_cfar
+    ne_r = ne_d = None
+    profile = None
+    dead = np.zeros(n_d, dtype=np.bool_)
+    if settings.cfar_noise_model:
+        ne_r = _effective(settings.range_window, radar.n_samples, rc.n_train)
+        ne_d = _effective(settings.doppler_window, n_d, dc.n_train)
+        if settings.static_clutter_removal:
+            g = clutter_removal_noise_profile(settings.doppler_window, n_d)
+            dead = g < 0.01
+            profile = np.where(dead, 1.0, g)
+            profile.flags.writeable = False
+    dead.flags.writeable = False
+    # the range stage needs training cells beyond the limits: run it on a margin around them
+    margin = rc.n_train + rc.n_guard
+    a, b = max(0, lo - margin), min(n_r, hi + 1 + margin)
+    args = (*_kernel_args(make_cfar(rc, L, ne_r)), *_kernel_args(make_cfar(dc, L, ne_d)))
+    return lo, hi, a, b, profile, dead, args
+
+
+_METHOD_CODE = {"ca": 0, "caso": 1, "cago": 2}
+
+
+def _kernel_args(c: _SidedCfar) -> tuple:
+    return (c.n_train, c.n_guard, c.cyclic, _METHOD_CODE[c.method], c.alpha(), c.alpha_one_side())
+
+
+@numba.njit(cache=True, nogil=True)
+def _cfar_line(p, n, g, cyclic, method, a_both, a_one, mask, noise):  # pragma: no cover
+    """One line of a sided CFAR; the same arithmetic as ``_SidedCfar.detect``."""
+    size = p.shape[0]
+    pad = n + g if cyclic else 0
+    cs = np.empty(size + 2 * pad + 1)
+    cs[0] = 0.0
+    for i in range(size + 2 * pad):
+        cs[i + 1] = cs[i] + p[(i - pad) % size]
+    for i in range(size):
+        c = i + pad
+        ok_l = cyclic or i - g - n >= 0
+        ok_r = cyclic or i + g + n <= size - 1
+        left = cs[c - g] - cs[c - g - n] if ok_l else 0.0
+        right = cs[c + g + 1 + n] - cs[c + g + 1] if ok_r else 0.0
+        if ok_l and ok_r:
+            if method == 0:
+                mu = (left + right) / (2 * n)
+            elif method == 1:
+                mu = min(left, right) / n
+            else:
+                mu = max(left, right) / n
+            alpha = a_both
+        elif ok_l:
+            mu = left / n
+            alpha = a_one
+        elif ok_r:
+            mu = right / n
+            alpha = a_one
+        else:
+            mu = np.nan
+            alpha = a_one
+        noise[i] = mu
+        mask[i] = p[i] > alpha * mu
+
+
+@numba.njit(cache=True, nogil=True)
+def _two_stage_kernel(
+    sub, lo, hi, dead, n_r, g_r, cyc_r, m_r, ab_r, ao_r, n_d, g_d, cyc_d, m_d_code, ab_d, ao_d
+):  # pragma: no cover
+    """Range stage on every column, Doppler stage on the rows with a range detection in
+    ``lo..hi``; returns the rows, columns and range-stage noise of cells passing both."""
+    n_rows, n_cols = sub.shape
+    mask_r = np.zeros((n_rows, n_cols), dtype=np.bool_)
+    noise_r = np.empty((n_rows, n_cols))
+    line = np.empty(n_rows)
+    m_line = np.empty(n_rows, dtype=np.bool_)
+    z_line = np.empty(n_rows)
+    for j in range(n_cols):
+        if dead[j]:
+            continue
+        for i in range(n_rows):
+            line[i] = sub[i, j]
+        _cfar_line(line, n_r, g_r, cyc_r, m_r, ab_r, ao_r, m_line, z_line)
+        for i in range(n_rows):
+            mask_r[i, j] = m_line[i]
+            noise_r[i, j] = z_line[i]
+    out_r = []
+    out_d = []
+    out_z = []
+    m_d = np.empty(n_cols, dtype=np.bool_)
+    z_d = np.empty(n_cols)
+    for i in range(lo, hi + 1):
+        hit = False
+        for j in range(n_cols):
+            hit = hit or mask_r[i, j]
+        if not hit:
+            continue
+        _cfar_line(sub[i], n_d, g_d, cyc_d, m_d_code, ab_d, ao_d, m_d, z_d)
+        for j in range(n_cols):
+            if mask_r[i, j] and m_d[j]:
+                out_r.append(i)
+                out_d.append(j)
+                out_z.append(noise_r[i, j])
+    return np.array(out_r, dtype=np.int64), np.array(out_d, dtype=np.int64), np.array(out_z)
 
 
 def two_stage_cfar(
@@ -345,47 +463,24 @@ def two_stage_cfar(
     rd = np.asarray(rd_map)
     L = radar.n_virtual if n_channels is None else n_channels
     n_r, n_d = rd.shape
-    k = np.arange(n_r) * radar.range_resolution_m
-    in_range = (k >= settings.min_range_m) & (k <= settings.max_range_m)
-    lo, hi = np.flatnonzero(in_range)[[0, -1]] if in_range.any() else (0, -1)
-    if hi < lo:
+    plan = _cfar_plan(radar, settings, n_r, n_d, L)
+    if plan is None:
         return _empty_detections()
-    rc, dc = settings.range_cfar, settings.doppler_cfar
-    ne_r = ne_d = None
-    profile = None
-    if settings.cfar_noise_model:
-        ne_r = _effective(settings.range_window, radar.n_samples, rc.n_train)
-        ne_d = _effective(settings.doppler_window, n_d, dc.n_train)
-        if settings.static_clutter_removal:
-            profile = clutter_removal_noise_profile(settings.doppler_window, n_d)
-    # the range stage needs training cells beyond the limits: run it on a margin around them
-    margin = rc.n_train + rc.n_guard
-    a, b = max(0, lo - margin), min(n_r, hi + 1 + margin)
+    lo, hi, a, b, profile, dead, kernel_args = plan
     if profile is None:
-        sub = rd[a:b]
+        sub = np.asarray(rd[a:b], dtype=np.float64)
     else:
         # whiten: equal noise in every Doppler bin; bins the removal empties (rectangular
         # window: zero Doppler) carry nothing and are never detected
-        dead = profile < 0.01
-        profile = np.where(dead, 1.0, profile)
-        sub = np.where(dead, 0.0, rd[a:b] / profile)
-    mask_r, noise_r = make_cfar(rc, L, ne_r).detect(sub, axis=0)
-    if profile is not None:
-        mask_r[:, dead] = False
-    mask_r[: lo - a] = False
-    mask_r[hi + 1 - a :] = False
-    rows = np.flatnonzero(mask_r.any(axis=1))
-    if rows.size == 0:
-        return _empty_detections()
-    # Doppler stage only on the rows the range stage passed
-    mask_d, _ = make_cfar(dc, L, ne_d).detect(sub[rows], axis=1)
-    mask = mask_r[rows] & mask_d
-    ri, d = np.nonzero(mask)
-    r = rows[ri] + a
+        sub = rd[a:b] / profile
+        if dead.any():
+            sub[:, dead] = 0.0
+    # both stages in one compiled pass (same arithmetic as CaCfar/CasoCfar/CagoCfar.detect)
+    rr, d, noise = _two_stage_kernel(np.ascontiguousarray(sub), lo - a, hi - a, dead, *kernel_args)
+    r = rr + a
     if settings.peak_grouping and r.size:
         keep = _local_maxima(rd, r, d)
-        r, d, ri = r[keep], d[keep], ri[keep]
-    noise = noise_r[rows[ri], d]
+        r, d, noise = r[keep], d[keep], noise[keep]
     if profile is not None:
         noise = noise * profile[d]  # back to the map's units at the cell under test
     return Detections(

@@ -218,3 +218,55 @@ def test_range_limits_exclude_near_cells() -> None:
     rd[100, 10] = 1e4
     det = two_stage_cfar(rd, RADAR, ProcessingSettings())
     assert det.range_bin.tolist() == [100]
+
+
+def reference_two_stage(rd, settings, ne_r, ne_d, profile):
+    """Both stages composed from the numpy strategies (CaCfar/CasoCfar/CagoCfar.detect)."""
+    k = np.arange(rd.shape[0]) * RADAR.range_resolution_m
+    inside = np.flatnonzero((k >= settings.min_range_m) & (k <= settings.max_range_m))
+    lo, hi = inside[0], inside[-1]
+    margin = settings.range_cfar.n_train + settings.range_cfar.n_guard
+    a, b = max(0, lo - margin), min(rd.shape[0], hi + 1 + margin)
+    sub = rd[a:b] if profile is None else rd[a:b] / profile
+    mask_r, noise_r = make_cfar(settings.range_cfar, L, ne_r).detect(sub, axis=0)
+    mask_d, _ = make_cfar(settings.doppler_cfar, L, ne_d).detect(sub, axis=1)
+    mask = mask_r & mask_d
+    mask[: lo - a] = False
+    mask[hi + 1 - a :] = False
+    r, d = np.nonzero(mask)
+    return r + a, d, noise_r[r, d]
+
+
+@pytest.mark.parametrize(
+    "settings",
+    [
+        ProcessingSettings(peak_grouping=False, static_clutter_removal=False),
+        ProcessingSettings(
+            peak_grouping=False,
+            static_clutter_removal=False,
+            cfar_noise_model=False,
+            range_cfar=CfarSettings(method="cago", n_train=6, n_guard=2, pfa=1e-2),
+            doppler_cfar=CfarSettings(method="caso", n_train=3, n_guard=1, pfa=0.05),
+        ),
+        ProcessingSettings(
+            peak_grouping=False,
+            static_clutter_removal=False,
+            range_cfar=CfarSettings(method="ca", n_train=4, n_guard=1, pfa=1e-2, cyclic=True),
+            doppler_cfar=CfarSettings(method="ca", n_train=2, n_guard=1, pfa=0.05, cyclic=False),
+        ),
+    ],
+)
+def test_compiled_two_stage_equals_composed_strategies(settings) -> None:
+    rng = np.random.default_rng(21)
+    rd = rng.gamma(L, 1.0, size=(256, 32))
+    rd[rng.integers(0, 256, 40), rng.integers(0, 32, 40)] *= 8.0
+    ne_r = ne_d = None
+    if settings.cfar_noise_model:
+        ne_r = effective_cells(settings.range_window, 256, settings.range_cfar.n_train)
+        ne_d = effective_cells(settings.doppler_window, 32, settings.doppler_cfar.n_train)
+    det = two_stage_cfar(rd, RADAR, settings)
+    r, d, noise = reference_two_stage(rd, settings, ne_r, ne_d, None)
+    assert len(r) > 20
+    np.testing.assert_array_equal(det.range_bin, r)
+    np.testing.assert_array_equal(det.doppler_index, d)
+    np.testing.assert_array_equal(det.noise_power, noise)
