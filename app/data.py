@@ -130,9 +130,6 @@ class TrackingResult:
     trail_id: np.ndarray
     params_key: str = ""
     elapsed_s: float = 0.0
-    #: False for the fast first stage (compiled kernel: estimate, confirmed positions, metrics;
-    #: no track ids, ψ or gates), True once the readable tracker delivered every track.
-    detail: bool = True
 
     @property
     def n_frames(self) -> int:

@@ -260,15 +260,17 @@ def _ospa_per_frame(frames: Sequence[FrameData], confirmed_xy: Sequence[np.ndarr
     return out
 
 
-def track_fast(
+def track(
     frames: Sequence[FrameData], params, frame_period_s: float, *, key: str = ""
 ) -> TrackingResult:
-    """First stage of a re-track: the compiled kernel (the same algorithm as the study's).
+    """Re-track the cached point clouds with the compiled kernel, recording every track of every
+    frame (ids, ψ, status, gates), and prepare everything the overlay draws, in one step.
 
-    Gives the estimate, the confirmed track positions and all metrics in milliseconds; track
-    ids, ψ of every track and gates follow from :func:`track` (``detail=True``).
+    ``run_tracker(..., engine="numba")``: the readable tracker's result (equal to round-off) in
+    milliseconds. The loss follows eqs. (12)–(13) against person 0 (the paper's single-person
+    scenes).
     """
-    from core.tracking.kernel import track_frames
+    from core.tracking import run_tracker
 
     t0 = time.perf_counter()
     counts = np.array([len(f.cloud) for f in frames], dtype=np.int64)
@@ -278,63 +280,7 @@ def track_fast(
         else np.zeros((0, 3))
     )
     f_off = np.concatenate(([0], np.cumsum(counts))).astype(np.int64)
-    t_off = np.array([0, len(frames)], dtype=np.int64)
-    out = track_frames(z, f_off, t_off, np.array([0]), params, frame_period_s)
-    est_xy, has, est_psi, conf_xy, n_conf = out[0], out[1], out[2], out[3], out[4]
-    tfs, conf_list = [], []
-    for k in range(len(frames)):
-        xy = np.asarray(conf_xy[k, : n_conf[k]], dtype=float).reshape(-1, 2)
-        conf_list.append(xy)
-        n = len(xy)
-        tfs.append(
-            TrackFrame(
-                track_id=np.full(n, -1, dtype=np.int64),
-                xy_m=xy,
-                gate_center_xy_m=xy,
-                gate_shape_xy_m2=np.zeros((n, 2, 2)),
-                psi=np.full(n, np.nan),
-                confirmed=np.ones(n, dtype=bool),
-            )
-        )
-    has = np.asarray(has, dtype=bool)
-    est = np.where(has[:, None], est_xy, np.nan)
-    truth0 = _truth0(frames)
-    loss, rmse = running_loss(est, has, truth0)
-    t_idx = np.flatnonzero(has)
-    t_s = np.arange(len(frames)) * frame_period_s
-    return TrackingResult(
-        frames=tuple(tfs),
-        estimate_xy_m=est,
-        truth_xy_m=truth0,
-        running_loss=loss,
-        running_rmse_m=rmse,
-        ospa_m=_ospa_per_frame(frames, conf_list),
-        psi_t_s=np.zeros(0),
-        psi_value=np.zeros(0),
-        psi_confirmed_t_s=t_s,
-        psi_confirmed_value=np.where(has, est_psi, np.nan),
-        trail_t_index=t_idx,
-        trail_xy_m=est[t_idx],
-        trail_id=np.full(len(t_idx), -1, dtype=np.int64),
-        params_key=key,
-        elapsed_s=time.perf_counter() - t0,
-        detail=False,
-    )
-
-
-def track(
-    frames: Sequence[FrameData], params, frame_period_s: float, *, key: str = ""
-) -> TrackingResult:
-    """Run the readable tracker on the cached point clouds, keeping every track of every
-    frame, and prepare everything the overlay draws.
-
-    The loss follows eqs. (12)–(13) against person 0 (the paper's single-person scenes).
-    """
-    from core.tracking import run_tracker
-
-    t0 = time.perf_counter()
-    z = [f.cloud.measurements() for f in frames]
-    res = run_tracker(z, params, frame_period_s, keep_tracks=True)
+    res = run_tracker((z, f_off), params, frame_period_s, keep_tracks=True, engine="numba")
     tfs, conf_list = [], []
     ids_l, t_l, xy_l, psi_l, conf_l = [], [], [], [], []
     for k, ft in enumerate(res.frames):
@@ -387,7 +333,6 @@ def track(
         trail_id=ids,
         params_key=key,
         elapsed_s=time.perf_counter() - t0,
-        detail=True,
     )
 
 
@@ -591,7 +536,6 @@ class Engine:
     make_params = staticmethod(make_params)
     simulate = staticmethod(simulate)
     track = staticmethod(track)
-    track_fast = staticmethod(track_fast)
     read_ti_cfg = staticmethod(read_ti_cfg)
     scene_dataset = staticmethod(scene_dataset)
     start_study = staticmethod(start_study)

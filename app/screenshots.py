@@ -57,7 +57,7 @@ def main(argv: list[str] | None = None) -> int:
     if not _wait(qa, lambda: w.cache.complete, 300):
         print("simulation did not finish", file=sys.stderr)
         return 1
-    _wait(qa, lambda: w.tracking_model.result is not None and w.tracking_model.result.detail, 120)
+    _wait(qa, lambda: w.tracking_model.result is not None, 120)
     _wait(qa, lambda: w.tracker.idle, 60)
     shots: list[str] = []
 

@@ -143,8 +143,8 @@ class _Signals(QtCore.QObject):
 
 
 class _TrackJob(QtCore.QRunnable):
-    """Two stages: the compiled kernel (estimate, confirmed tracks, metrics; milliseconds),
-    then the readable tracker with every track (ids, ψ, gates), skipped when superseded."""
+    """One re-track: the compiled kernel recording every track (ids, ψ, status, gates) plus the
+    metrics, delivered as one :class:`TrackingResult`; skipped when superseded before it runs."""
 
     def __init__(self, engine, frames, params, frame_period_s, key, ticket, signals, latest):
         super().__init__()
@@ -157,11 +157,9 @@ class _TrackJob(QtCore.QRunnable):
     def run(self) -> None:  # pool thread
         engine, frames, params, frame_period_s, key = self._args
         try:
-            fast = engine.track_fast(frames, params, frame_period_s, key=key)
-            self._signals.result.emit(self._ticket, fast)
             if self._latest() == self._ticket:
-                full = engine.track(frames, params, frame_period_s, key=key)
-                self._signals.result.emit(self._ticket, full)
+                result = engine.track(frames, params, frame_period_s, key=key)
+                self._signals.result.emit(self._ticket, result)
         except Exception as exc:
             traceback.print_exc()
             self._signals.failed.emit(self._ticket, describe_error(exc))
@@ -177,7 +175,7 @@ class TrackingController(QtCore.QObject):
     """
 
     failed = QtCore.Signal(str)
-    finished = QtCore.Signal(float, float)  # elapsed s of the fast stage, of the detailed stage
+    finished = QtCore.Signal(float)  # elapsed s of the re-track (tracker + overlay preparation)
 
     def __init__(
         self,
@@ -208,8 +206,7 @@ class TrackingController(QtCore.QObject):
         self._ticket = 0
         self._busy = False
         self._pending = False
-        self.last_fast_s = float("nan")
-        self.last_detail_s = float("nan")
+        self.last_elapsed_s = float("nan")
         self.n_runs = 0
         params.changed.connect(self.request)
 
@@ -244,15 +241,11 @@ class TrackingController(QtCore.QObject):
         self._pool.start(job)
 
     def _on_result(self, ticket: int, result: TrackingResult) -> None:
-        if result.detail:
-            self.last_detail_s = result.elapsed_s
-        else:
-            self.last_fast_s = result.elapsed_s
+        self.last_elapsed_s = result.elapsed_s
         if ticket == self._ticket:
             self._tracking.set_result(result)
-            if result.detail:
-                self.n_runs += 1
-                self.finished.emit(self.last_fast_s, self.last_detail_s)
+            self.n_runs += 1
+            self.finished.emit(result.elapsed_s)
 
     def _on_failed(self, ticket: int, message: str) -> None:
         if ticket == self._ticket:

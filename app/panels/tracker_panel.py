@@ -242,9 +242,9 @@ class TrackerPanel(QtWidgets.QWidget):
         for w in widgets:
             w.blockSignals(False)
 
-    def show_timing(self, fast_s: float, detail_s: float, n_frames: int) -> None:
+    def show_timing(self, elapsed_s: float, n_frames: int) -> None:
         self.timing.setText(
-            f"re-track of {n_frames} frames: estimate and metrics {fast_s * 1e3:.0f} ms, "
-            f"every track with ψ and gates {detail_s * 1e3:.0f} ms"
+            f"re-track of {n_frames} frames (every track with ψ and gates, metrics): "
+            f"{elapsed_s * 1e3:.0f} ms"
         )
         self.timing.setWordWrap(True)

@@ -299,7 +299,7 @@ class TopView(pg.PlotWidget):
             self.addItem(label)
             self._labels.append(label)
         for k, label in enumerate(self._labels):
-            if k < n and tf.track_id[k] >= 0:
+            if k < n:
                 label.setText(f"{tf.track_id[k]} ψ={tf.psi[k]:.2f}")
                 label.setPos(float(tf.xy_m[k, 0]) + 0.1, float(tf.xy_m[k, 1]) + 0.1)
                 label.show()

@@ -174,6 +174,43 @@ def _best_of(fn, repeats: int) -> tuple[float, float]:
     return best, best_cpu
 
 
+def _gui_retrack(ds, params, period: float, quick: bool) -> dict:
+    """The GUI's re-track of its longest trajectory: every track recorded by the kernel
+    (``run_tracker(engine="numba")``) against the readable ``run_tracker``, and whether every
+    track of every frame agrees to 1e-10."""
+    from core.tracking import run_tracker
+
+    t_off, f_off = ds.trajectory_offsets, ds.frame_offsets
+    k = int(np.argmax(np.diff(t_off)))
+    a, b = int(t_off[k]), int(t_off[k + 1])
+    frames = (ds.measurements()[f_off[a] : f_off[b]], f_off[a : b + 1] - f_off[a])
+    fast = run_tracker(frames, params, period, engine="numba")
+    t_fast, c_fast = _best_of(
+        lambda: run_tracker(frames, params, period, engine="numba"), 3 if quick else 20
+    )
+    t0, c0 = time.perf_counter(), time.process_time()
+    ref = run_tracker(frames, params, period)
+    t_ref, c_ref = time.perf_counter() - t0, time.process_time() - c0
+    same = all(
+        np.array_equal(x.ids, y.ids)
+        and np.array_equal(x.confirmed, y.confirmed)
+        and np.allclose(x.state, y.state, rtol=1e-10, atol=1e-10)
+        and np.allclose(x.covariance, y.covariance, rtol=1e-10, atol=1e-10)
+        and np.allclose(x.psi, y.psi, rtol=0, atol=1e-10)
+        and np.allclose(x.gate_shape_xy, y.gate_shape_xy, rtol=1e-10, atol=1e-8)
+        for x, y in zip(fast.frames, ref.frames)
+    )
+    return {
+        "gui_frames": b - a,
+        "gui_record_ms": 1e3 * t_fast,
+        "gui_record_cpu_ms": 1e3 * c_fast,
+        "gui_reference_ms": 1e3 * t_ref,
+        "gui_reference_cpu_ms": 1e3 * c_ref,
+        "gui_speedup_cpu": c_ref / max(c_fast, 1e-9),
+        "gui_same_every_track": bool(same),
+    }
+
+
 def run(quick: bool = False) -> dict:
     from core.evaluation import evaluate
     from core.tracking import TrackerParams, track_dataset
@@ -213,6 +250,7 @@ def run(quick: bool = False) -> dict:
             and np.allclose(fast.estimate_xy, ref.estimate_xy, atol=1e-10, equal_nan=True)
         )
         loss = evaluate(ds, fast).loss_total
+        gui = _gui_retrack(ds, p, period, quick)
         out["models"][model] = {
             "kernel_first_call_s": first,
             "kernel_ms_per_pass": 1e3 * t_fast,
@@ -232,6 +270,7 @@ def run(quick: bool = False) -> dict:
             "same_result_reference": same_ref,
             "loss_total_x1e3": 1e3 * loss,
             "mean_live_tracks": float(fast.n_tracks.mean()),
+            **gui,
         }
     return out
 
@@ -258,5 +297,13 @@ def summary(result: dict) -> str:
             f"{model:>5} {r['reference_ms_per_pass']:7.0f} ms "
             f"({r['reference_cpu_ms_per_pass']:6.0f})  kernel "
             f"{r['speedup_vs_reference']:4.0f}x faster, same: {r['same_result_reference']}"
+        )
+    lines.append("GUI re-track of one trajectory, every track recorded (run_tracker engine=numba):")
+    for model, r in result["models"].items():
+        lines.append(
+            f"{model:>5} {r['gui_frames']} frames: {r['gui_record_ms']:6.2f} ms "
+            f"({r['gui_record_cpu_ms']:6.2f}) vs readable {r['gui_reference_ms']:6.0f} ms "
+            f"({r['gui_reference_cpu_ms']:6.0f}), {r['gui_speedup_cpu']:4.0f}x (CPU), "
+            f"every track same: {r['gui_same_every_track']}"
         )
     return "\n".join(lines)

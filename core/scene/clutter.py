@@ -14,6 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from core.config import RadarConfig
+from core.errors import InputError
 from core.scene.aoi import AOI
 
 CLUTTER_SNR_DB = (15.0, 30.0)
@@ -48,6 +49,31 @@ class ClutterDraw:
         return self.position_m / r[:, None] * self.radial_velocity_mps[:, None]
 
 
+def min_loops_for_clutter() -> int:
+    """Smallest ``n_loops`` for which clutter can be drawn.
+
+    ``v_max = n_loops/2 · Δv`` (Δv = λ/(2 N_tx N_c T_c), v_max = λ/(4 N_tx T_c)), and clutter
+    needs ``2 Δv <= |v| < v_max``: a non-empty range only for ``n_loops > 4``.
+    """
+    return int(2 * MIN_CLUTTER_SPEED_BINS) + 1
+
+
+def check_clutter_radar(radar: RadarConfig, density_per_m2: float) -> None:
+    """Raise :class:`InputError` naming ``n_loops`` when clutter cannot move fast enough.
+
+    Clutter (density > 0) must move at ``|v| >= 2`` velocity bins inside ``±v_max`` to survive
+    static clutter removal, which needs ``n_loops >= 5`` (see :func:`min_loops_for_clutter`).
+    """
+    if density_per_m2 > 0 and radar.n_loops < min_loops_for_clutter():
+        raise InputError(
+            f"radar n_loops={radar.n_loops} is too small for clutter "
+            f"(clutter_density_per_m2={density_per_m2}): clutter moves at >= "
+            f"{MIN_CLUTTER_SPEED_BINS:g} velocity bins within ±v_max = n_loops/2 bins, which "
+            f"needs n_loops >= {min_loops_for_clutter()}; raise n_loops or set "
+            "clutter_density_per_m2 to 0"
+        )
+
+
 def expected_clutter_count(aoi: AOI, density_per_m2: float) -> float:
     """Mean number of clutter reflectors per frame, ``λ · area(AOI)``."""
     return density_per_m2 * aoi.area_m2
@@ -68,9 +94,17 @@ def draw_clutter(
         Gives ``v_max`` and the velocity bin ``Δv``.
     rng
         The only source of randomness.
+
+    Raises
+    ------
+    InputError
+        When ``density_per_m2 > 0`` and ``radar.n_loops < 5`` (no speed range for clutter).
     """
+    check_clutter_radar(radar, density_per_m2)
     n = int(rng.poisson(expected_clutter_count(aoi, density_per_m2)))
     pos = aoi.sample_uniform(n, rng)
+    if n == 0:  # nothing to draw (and no speed range needed, e.g. density 0 with few loops)
+        return ClutterDraw(position_m=pos, radial_velocity_mps=np.zeros(0), snr_db=np.zeros(0))
     v_max = radar.max_velocity_mps
     v_min = MIN_CLUTTER_SPEED_BINS * radar.velocity_resolution_mps
     # |v| uniform in [v_min, v_max), sign uniform: uniform over ±v_max without the centre

@@ -16,6 +16,7 @@ import numpy as np
 from core.config import PAPER_RADAR, RadarConfig
 from core.errors import InputError
 from core.scene.aoi import AOI
+from core.scene.clutter import check_clutter_radar
 from core.scene.trajectory import (
     TRAJECTORY_CLASSES,
     Trajectory,
@@ -113,6 +114,7 @@ class Scene:
             raise InputError(
                 f"clutter_density_per_m2 must be in [0, 1] m^-2, got clutter_density_per_m2={d!r}"
             )
+        check_clutter_radar(self.radar, d)
 
     # ---- derived -----------------------------------------------------------------------------
     @property

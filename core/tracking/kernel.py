@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import functools
 import math
+from dataclasses import dataclass, replace
 
 import numpy as np
 from numba import njit
@@ -22,9 +23,65 @@ from core.tracking.ipda import LOG_2PI
 from core.tracking.models import process_noise, transition_matrix
 from core.tracking.params import TrackerParams
 
-__all__ = ["track_frames"]
+__all__ = ["TrackRecord", "run_tracker_compiled", "track_frames"]
 
 MIN_RANGE_M = 1e-2  # same as core.tracking.ekf.MIN_RANGE_M
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class TrackRecord:
+    """Every live track of every output frame, as the kernel recorded it (F frames, cap slots).
+
+    Slot ``t < n_tracks[f]`` of frame f holds the t-th live track in the tracker's order (the
+    order of :class:`core.tracking.tracker.FrameTracks`); the other slots are unspecified.
+
+    Attributes
+    ----------
+    n_tracks
+        (F,) live tracks per frame.
+    ids
+        (F, cap) int64 track ids (per trajectory, increasing with birth).
+    state, covariance
+        (F, cap, d) and (F, cap, d, d): [x, y, vx, vy(, ax, ay)] in m, m/s, m/s².
+    psi
+        (F, cap) existence probability ψ.
+    confirmed
+        (F, cap) bool status: True confirmed, False tentative.
+    birth_frame
+        (F, cap) int64 frame (index within the trajectory) in which the track was born.
+    gate_center_xy, gate_shape_xy
+        (F, cap, 2) and (F, cap, 2, 2): the gate in x–y (see ``FrameTracks``), from the
+        predicted covariance of the frame (for a newborn track: P₀).
+    estimate
+        (F,) slot of the single-person estimate, −1 when no track is confirmed.
+    """
+
+    n_tracks: np.ndarray
+    ids: np.ndarray
+    state: np.ndarray
+    covariance: np.ndarray
+    psi: np.ndarray
+    confirmed: np.ndarray
+    birth_frame: np.ndarray
+    gate_center_xy: np.ndarray
+    gate_shape_xy: np.ndarray
+    estimate: np.ndarray
+
+    @classmethod
+    def allocate(cls, n_frames: int, cap: int, d: int) -> TrackRecord:
+        """Preallocated arrays for ``n_frames`` frames of ``cap`` tracks (0, 0: recording off)."""
+        return cls(
+            n_tracks=np.zeros(n_frames, dtype=np.int64),
+            ids=np.full((n_frames, cap), -1, dtype=np.int64),
+            state=np.full((n_frames, cap, d), np.nan),
+            covariance=np.full((n_frames, cap, d, d), np.nan),
+            psi=np.full((n_frames, cap), np.nan),
+            confirmed=np.zeros((n_frames, cap), dtype=np.bool_),
+            birth_frame=np.full((n_frames, cap), -1, dtype=np.int64),
+            gate_center_xy=np.full((n_frames, cap, 2), np.nan),
+            gate_shape_xy=np.full((n_frames, cap, 2, 2), np.nan),
+            estimate=np.full(n_frames, -1, dtype=np.int64),
+        )
 
 
 @njit(cache=True)
@@ -260,6 +317,45 @@ def _compact(keep, nt, X, P, psi, conf, ids):
 
 
 @njit(cache=True)
+def _compact_rec(keep, nt, birth, gc, gs):
+    """Compact the per-slot recording arrays (birth frame, gate) like :func:`_compact`."""
+    j = 0
+    for i in range(nt):
+        if keep[i]:
+            if j != i:
+                birth[j] = birth[i]
+                gc[j] = gc[i]
+                gs[j] = gs[i]
+            j += 1
+
+
+@njit(cache=True)
+def _gate_xy(x, S, gamma, gc, gs):
+    """Gate of a track in x–y: centre (2,) and G = γ J S_ra Jᵀ (2, 2) into gc, gs."""
+    px, py, r = _safe_xy(x[0], x[1])
+    az = math.atan2(px, py)
+    sa = math.sin(az)
+    ca = math.cos(az)
+    # J = ∂(x, y)/∂(r, az) for x = r sin az, y = r cos az
+    j00 = sa
+    j01 = r * ca
+    j10 = ca
+    j11 = -r * sa
+    # M = J S_ra
+    m00 = j00 * S[0, 0] + j01 * S[1, 0]
+    m01 = j00 * S[0, 1] + j01 * S[1, 1]
+    m10 = j10 * S[0, 0] + j11 * S[1, 0]
+    m11 = j10 * S[0, 1] + j11 * S[1, 1]
+    gc[0] = px
+    gc[1] = py
+    # G = γ M Jᵀ
+    gs[0, 0] = gamma * (m00 * j00 + m01 * j01)
+    gs[0, 1] = gamma * (m00 * j10 + m01 * j11)
+    gs[1, 0] = gamma * (m10 * j00 + m11 * j01)
+    gs[1, 1] = gamma * (m10 * j10 + m11 * j11)
+
+
+@njit(cache=True)
 def _rank(nt, psi, ids, order):
     for i in range(nt):
         order[i] = i
@@ -308,6 +404,16 @@ def _track_kernel(
     check,
     n_bad,
     chol,
+    record,
+    rec_ids,
+    rec_x,
+    rec_P,
+    rec_psi,
+    rec_conf,
+    rec_birth,
+    rec_gc,
+    rec_gs,
+    rec_best,
 ):
     n = F.shape[0]
     pdpg = p_d * p_g
@@ -327,6 +433,11 @@ def _track_kernel(
     ids = np.zeros(cap, dtype=np.int64)
     keep = np.zeros(cap, dtype=np.bool_)
     order = np.zeros(cap, dtype=np.int64)
+    # recording slots (birth frame, gate), allocated only when recording
+    n_rec = cap if record else 0
+    birth = np.zeros(n_rec, dtype=np.int64)
+    gc = np.zeros((n_rec, 2))
+    gs = np.zeros((n_rec, 2, 2))
     gated_any = np.zeros(max_m + 1, dtype=np.bool_)
     d2 = np.zeros(max_m + 1)
     nu = np.zeros((max_m + 1, 3))
@@ -367,6 +478,8 @@ def _track_kernel(
                 pp = min(1.0, max(0.0, pp))
                 _measure(xp, zp, H)
                 _innov_cov(H, Pp, R, S, HP)
+                if record:
+                    _gate_xy(xp, S, gamma, gc[t], gs[t])
                 _chol3(S, L)
                 mval = 0
                 for j in range(m):
@@ -447,6 +560,12 @@ def _track_kernel(
                     psi[nt] = p_te
                     conf[nt] = False
                     ids[nt] = next_id
+                    if record:
+                        birth[nt] = f - fa
+                        # gate of a newborn track: S₀ = H(x₀) P₀ H(x₀)ᵀ + R around x₀
+                        _measure(X[nt], zp, H)
+                        _innov_cov(H, P0, R, S, HP)
+                        _gate_xy(X[nt], S, gamma, gc[nt], gs[nt])
                     next_id += 1
                     nt += 1
             # confirmation (tracks updated this frame only), deletion
@@ -454,6 +573,8 @@ def _track_kernel(
                 if t < n_old and psi[t] >= confirm_th:
                     conf[t] = True
                 keep[t] = psi[t] >= delete_th
+            if record:
+                _compact_rec(keep, nt, birth, gc, gs)
             nt = _compact(keep, nt, X, P, psi, conf, ids)
             # merging: greedy in ψ order, within the 2-D gate of the combined position covariance
             if nt > 1:
@@ -479,6 +600,8 @@ def _track_kernel(
                         )
                         if dd <= gamma2:
                             keep[b] = False
+                if record:
+                    _compact_rec(keep, nt, birth, gc, gs)
                 nt = _compact(keep, nt, X, P, psi, conf, ids)
             # cap: the lowest ψ go (ties: the youngest)
             if nt > max_tracks:
@@ -487,6 +610,8 @@ def _track_kernel(
                     keep[t] = False
                 for ia in range(max_tracks):
                     keep[order[ia]] = True
+                if record:
+                    _compact_rec(keep, nt, birth, gc, gs)
                 nt = _compact(keep, nt, X, P, psi, conf, ids)
             # outputs: the estimate is the confirmed track with the highest ψ (ties: older)
             best = -1
@@ -511,6 +636,18 @@ def _track_kernel(
                 est_psi[o] = psi[best]
                 est_x[o, :] = X[best]
                 est_P[o, :, :] = P[best]
+            if record:
+                # every live track of this frame (nt <= max_tracks after the cap)
+                rec_best[o] = best
+                for t in range(nt):
+                    rec_ids[o, t] = ids[t]
+                    rec_x[o, t, :] = X[t]
+                    rec_P[o, t, :, :] = P[t]
+                    rec_psi[o, t] = psi[t]
+                    rec_conf[o, t] = conf[t]
+                    rec_birth[o, t] = birth[t]
+                    rec_gc[o, t, :] = gc[t]
+                    rec_gs[o, t, :, :] = gs[t]
             o += 1
 
 
@@ -545,6 +682,7 @@ def track_frames(
     frame_period_s: float,
     *,
     check: bool = False,
+    record: bool = False,
 ):
     """Track the selected trajectories with the compiled kernel.
 
@@ -563,13 +701,18 @@ def track_frames(
     check
         Count, per frame, the live tracks whose state, covariance or ψ is unhealthy (non-finite,
         ψ outside [0, 1], P not symmetric positive definite); returned as a 9th array.
+    record
+        Record every live track of every frame (id, state, covariance, ψ, status, birth frame,
+        gate) into preallocated (F_sel, max_tracks, ...) arrays; returned last as a
+        :class:`TrackRecord`. Off, the kernel allocates nothing for it.
 
     Returns
     -------
     tuple
         ``est_xy (F_sel, 2), has (F_sel,), est_psi (F_sel,), conf_xy (F_sel, max_tracks, 2),
         n_conf (F_sel,), n_tracks (F_sel,), est_state (F_sel, d), est_cov (F_sel, d, d)``
-        with NaN where there is no estimate.
+        with NaN where there is no estimate, then ``n_bad`` if ``check`` and the
+        :class:`TrackRecord` if ``record``.
     """
     sel = np.ascontiguousarray(trajectories, dtype=np.int64)
     t_off = np.ascontiguousarray(trajectory_offsets, dtype=np.int64)
@@ -588,6 +731,7 @@ def track_frames(
     n_bad = np.zeros(n_out, dtype=np.int64)
     nonparam = params.nonparametric
     F, f_cols, f_nnz, Q, R, P0 = _matrices(params, float(frame_period_s))
+    rec = TrackRecord.allocate(n_out if record else 0, params.max_tracks if record else 0, d)
     _track_kernel(
         np.ascontiguousarray(z, dtype=np.float64),
         np.ascontiguousarray(frame_offsets, dtype=np.int64),
@@ -623,6 +767,109 @@ def track_frames(
         bool(check),
         n_bad,
         np.zeros((d, d)),
+        bool(record),
+        rec.ids,
+        rec.state,
+        rec.covariance,
+        rec.psi,
+        rec.confirmed,
+        rec.birth_frame,
+        rec.gate_center_xy,
+        rec.gate_shape_xy,
+        rec.estimate,
     )
     out = (est_xy, has, est_psi, conf_xy, n_conf, n_tr, est_x, est_P)
-    return (*out, n_bad) if check else out
+    if check:
+        out = (*out, n_bad)
+    if record:
+        out = (*out, replace(rec, n_tracks=n_tr))
+    return out
+
+
+def run_tracker_compiled(
+    frames,
+    params: TrackerParams,
+    frame_period_s: float = 0.08,
+    *,
+    keep_tracks: bool = True,
+):
+    """:func:`core.tracking.tracker.run_tracker` on the compiled kernel (every track recorded).
+
+    Same input and the same :class:`~core.tracking.tracker.TrackerResult` (estimates, ids, ψ,
+    status, states, covariances, birth frames and gates of every track per frame) as the
+    readable tracker, equal to round-off; tracks one 250-frame scene in milliseconds.
+
+    Parameters
+    ----------
+    frames
+        Measurements per frame: a sequence of (m_f, 3) arrays ``[r (m), az (rad), vr (m/s)]``,
+        or a pair ``(z (P, 3), frame_offsets (F + 1,))``.
+    params
+        Tracker parameters.
+    frame_period_s
+        Time step T between frames (s).
+    keep_tracks
+        Return every track of every frame (:attr:`TrackerResult.frames`; recorded either way,
+        for the estimate's id).
+
+    Returns
+    -------
+    TrackerResult
+    """
+    from core.errors import InputError
+    from core.tracking.tracker import FrameTracks, TrackerConstants, TrackerResult, frame_slices
+
+    TrackerConstants.build(params, frame_period_s)  # validates the frame period
+    if isinstance(frames, tuple) and len(frames) == 2 and np.ndim(frames[1]) == 1:
+        z = np.asarray(frames[0], dtype=np.float64).reshape(-1, 3)
+        f_off = np.asarray(frames[1], dtype=np.int64)
+        if len(f_off) == 0 or f_off[0] != 0 or f_off[-1] != len(z) or np.any(np.diff(f_off) < 0):
+            raise InputError(
+                f"frame_offsets must rise from 0 to the {len(z)} measurements, "
+                f"got {f_off[:3].tolist()}…{f_off[-2:].tolist()}"
+            )
+    else:
+        zs = frame_slices(frames)
+        counts = np.array([len(zf) for zf in zs], dtype=np.int64)
+        z = np.concatenate(zs) if zs else np.zeros((0, 3))
+        f_off = np.concatenate(([0], np.cumsum(counts))).astype(np.int64)
+    if not np.all(np.isfinite(z)):
+        bad = int(np.flatnonzero(~np.all(np.isfinite(z), axis=1))[0])
+        raise InputError(f"measurement {bad} contains NaN or Inf")
+    n_f = len(f_off) - 1
+    t_off = np.array([0, n_f], dtype=np.int64)
+    out = track_frames(
+        z, f_off, t_off, np.zeros(1, dtype=np.int64), params, frame_period_s, record=True
+    )
+    est_xy, has, est_psi, conf_xy, n_conf, n_tr, est_x, est_P, rec = out
+    est_id = np.full(n_f, -1, dtype=np.int64)
+    rows = np.flatnonzero(rec.estimate >= 0)
+    est_id[rows] = rec.ids[rows, rec.estimate[rows]]
+    kept = None
+    if keep_tracks:
+        kept = tuple(
+            FrameTracks(
+                ids=rec.ids[f, :n],
+                state=rec.state[f, :n],
+                covariance=rec.covariance[f, :n],
+                psi=rec.psi[f, :n],
+                confirmed=rec.confirmed[f, :n],
+                gate_center_xy=rec.gate_center_xy[f, :n],
+                gate_shape_xy=rec.gate_shape_xy[f, :n],
+                birth_frame=rec.birth_frame[f, :n],
+                estimate=int(rec.estimate[f]),
+            )
+            for f, n in enumerate(rec.n_tracks.tolist())
+        )
+    return TrackerResult(
+        estimate_xy=est_xy,
+        has_estimate=has,
+        estimate_id=est_id,
+        estimate_psi=est_psi,
+        estimate_state=est_x,
+        estimate_covariance=est_P,
+        confirmed_xy=conf_xy,
+        n_tracks=n_tr,
+        n_confirmed=n_conf,
+        frames=kept,
+    )

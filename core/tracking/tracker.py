@@ -56,6 +56,8 @@ class FrameTracks:
         Gate ellipse in x–y (n, 2, 2): the points d with dᵀ G⁻¹ d ≤ 1, G = γ·J S_ra Jᵀ, where
         S_ra is the (r, az) block of S and J = ∂(x, y)/∂(r, az) (the gate's projection on the
         r–az plane, linearised into x–y).
+    birth_frame
+        Frame (index within the run) in which each track was born (n,), int64.
     estimate
         Index into these arrays of the single-person estimate, or −1.
     """
@@ -67,6 +69,7 @@ class FrameTracks:
     confirmed: np.ndarray
     gate_center_xy: np.ndarray
     gate_shape_xy: np.ndarray
+    birth_frame: np.ndarray
     estimate: int = -1
 
     def __len__(self) -> int:
@@ -147,6 +150,7 @@ class _Track:  # mutable working record of the reference tracker
     x: np.ndarray
     P: np.ndarray
     psi: float
+    birth: int = 0
     confirmed: bool = False
     updated: bool = False
     gate_center: np.ndarray = field(default_factory=lambda: np.zeros(2))
@@ -184,6 +188,7 @@ def _step(
     params: TrackerParams,
     c: TrackerConstants,
     next_id: int,
+    frame: int = 0,
 ) -> tuple[list[_Track], int]:
     m = len(z)
     gated = np.zeros((len(tracks), m), dtype=bool)
@@ -221,7 +226,7 @@ def _step(
     # initiation from the measurements outside every gate
     for j in np.flatnonzero(initiation.unassociated(gated)):
         x0 = initiation.initial_state(z[j], params.state_dim)
-        t = _Track(id=next_id, x=x0, P=c.P0.copy(), psi=params.p_te)
+        t = _Track(id=next_id, x=x0, P=c.P0.copy(), psi=params.p_te, birth=frame)
         next_id += 1
         S0 = gating.innovation_covariance(ekf.jacobian(x0), t.P, c.R)
         t.gate_center, t.gate_shape = _gate_xy(x0, S0, c.gamma)
@@ -261,6 +266,7 @@ def run_tracker(
     frame_period_s: float = 0.08,
     *,
     keep_tracks: bool = True,
+    engine: str = "numpy",
 ) -> TrackerResult:
     """Track one trajectory (one sequence of frames) from scratch.
 
@@ -275,11 +281,21 @@ def run_tracker(
         Time step T between frames (s).
     keep_tracks
         Keep every track of every frame (:attr:`TrackerResult.frames`, for the GUI).
+    engine
+        ``"numpy"`` (this readable implementation, default) or ``"numba"`` (the compiled kernel
+        recording every track, :func:`core.tracking.kernel.run_tracker_compiled`; the same
+        result to round-off, ~100× faster).
 
     Returns
     -------
     TrackerResult
     """
+    if engine == "numba":
+        from core.tracking.kernel import run_tracker_compiled
+
+        return run_tracker_compiled(frames, params, frame_period_s, keep_tracks=keep_tracks)
+    if engine != "numpy":
+        raise InputError(f"engine must be 'numpy' or 'numba', got engine={engine!r}")
     zs = frame_slices(frames)
     c = TrackerConstants.build(params, frame_period_s)
     n_f, d, cap = len(zs), params.state_dim, params.max_tracks
@@ -296,7 +312,7 @@ def run_tracker(
     tracks: list[_Track] = []
     next_id = 0
     for f, z in enumerate(zs):
-        tracks, next_id = _step(tracks, z, params, c, next_id)
+        tracks, next_id = _step(tracks, z, params, c, next_id, f)
         psi = np.array([t.psi for t in tracks])
         ids = np.array([t.id for t in tracks], dtype=np.int64)
         conf = np.array([t.confirmed for t in tracks], dtype=bool)
@@ -325,6 +341,7 @@ def run_tracker(
                     confirmed=conf,
                     gate_center_xy=np.array([t.gate_center for t in tracks]).reshape(n, 2),
                     gate_shape_xy=np.array([t.gate_shape for t in tracks]).reshape(n, 2, 2),
+                    birth_frame=np.array([t.birth for t in tracks], dtype=np.int64),
                     estimate=b,
                 )
             )

@@ -52,3 +52,55 @@ def test_clutter_velocity_and_snr() -> None:
 def test_no_clutter_when_density_is_zero() -> None:
     rng = np.random.default_rng(0)
     assert all(len(draw_clutter(AOI(), 0.0, PAPER_RADAR, rng)) == 0 for _ in range(50))
+
+
+@pytest.mark.parametrize("n_loops", [1, 2, 3, 4])
+def test_too_few_loops_for_clutter_is_an_input_error_naming_n_loops(n_loops) -> None:
+    # v_max = n_loops/2 velocity bins: |v| >= 2 bins inside ±v_max needs n_loops >= 5
+    from dataclasses import replace
+
+    from core.errors import InputError
+    from core.scene import Scene
+
+    radar = replace(PAPER_RADAR, n_loops=n_loops)
+    assert radar.max_velocity_mps / radar.velocity_resolution_mps == pytest.approx(n_loops / 2)
+    with pytest.raises(InputError, match=f"n_loops={n_loops} .*needs n_loops >= 5"):
+        Scene(radar=radar, clutter_density_per_m2=0.02)
+    with pytest.raises(InputError, match="n_loops"):
+        draw_clutter(AOI(), 0.02, radar, np.random.default_rng(0))
+    # without clutter the scene is valid and no clutter is drawn
+    assert Scene(radar=radar, clutter_density_per_m2=0.0).radar.n_loops == n_loops
+    assert len(draw_clutter(AOI(), 0.0, radar, np.random.default_rng(0))) == 0
+
+
+def test_scene_file_with_too_few_loops_names_the_file_and_field(tmp_path) -> None:
+    import json
+
+    from core.errors import InputError
+    from core.scene import Scene
+
+    doc = {
+        "schema_version": 1,
+        "radar": {"n_loops": 2},
+        "clutter_density_per_m2": 0.02,
+        "persons": [{"trajectory": {"class": "a", "seed": 1}}],
+    }
+    path = tmp_path / "scene.json"
+    path.write_text(json.dumps(doc))
+    with pytest.raises(InputError, match="n_loops=2") as err:
+        Scene.from_json(path)
+    assert str(path) in str(err.value)
+
+
+def test_five_loops_is_the_smallest_radar_that_draws_clutter() -> None:
+    from dataclasses import replace
+
+    radar = replace(PAPER_RADAR, n_loops=5)
+    rng = np.random.default_rng(1)
+    vr = np.concatenate(
+        [draw_clutter(AOI(), 0.05, radar, rng).radial_velocity_mps for _ in range(200)]
+    )
+    dv = radar.velocity_resolution_mps
+    assert vr.size > 500
+    # 2 Δv <= |v| < v_max = 2.5 Δv
+    assert np.all(np.abs(vr) >= 2 * dv) and np.all(np.abs(vr) < radar.max_velocity_mps)
