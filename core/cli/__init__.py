@@ -61,6 +61,10 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         print(f"radartune {args.command}: interrupted", file=sys.stderr)
         return 130
+    except BrokenPipeError:
+        # the reader went away (`radartune radar --json | head`): not an error of ours
+        sys.stdout = None
+        return 0
     return int(code or 0)
 
 
