@@ -163,8 +163,8 @@ def plot_loss_vs_time(studies: Sequence[StudyRecord], model: str, path: Path) ->
         return False
     fig, ax = plt.subplots(figsize=(7, 4.2))
     styles = {"tpe": "-", "random": "--"}
-    colors = {"asha": "tab:blue", "wilcoxon": "tab:green", "none": "tab:orange"}
-    for s in mine:
+    colors = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    for i, s in enumerate(mine):
         secs, best = s.best_against_time()
         if len(secs) == 0:
             continue
@@ -173,7 +173,7 @@ def plot_loss_vs_time(studies: Sequence[StudyRecord], model: str, path: Path) ->
             best * 1e3,
             where="post",
             ls=styles.get(s.sampler, ":"),
-            color=colors.get(s.pruner, "k"),
+            color=colors[i % len(colors)],
             label=f"{s.sampler.upper()} + {s.pruner} ({s.counted()} trials, {s.name})",
         )
     ax.set_yscale("log")
