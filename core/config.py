@@ -257,6 +257,9 @@ class ProcessingSettings:
         Subtract the mean over loops per range bin and virtual channel.
     range_cfar, doppler_cfar
         The two CFAR stages; a cell is detected only if it passes both.
+    cfar_noise_model
+        Let the CFAR thresholds account for window-correlated cells and the noise notch that
+        static clutter removal leaves around zero Doppler (otherwise: independent cells).
     peak_grouping
         Keep only detections that are local maxima of the range-Doppler map (3 x 3, Doppler
         cyclic).
@@ -271,6 +274,7 @@ class ProcessingSettings:
     static_clutter_removal: bool = True
     range_cfar: CfarSettings = RANGE_CFAR
     doppler_cfar: CfarSettings = DOPPLER_CFAR
+    cfar_noise_model: bool = True
     peak_grouping: bool = True
     min_range_m: float = 0.3
     max_range_m: float = 10.0

@@ -17,6 +17,7 @@ import functools
 import hashlib
 import importlib
 import json
+import multiprocessing
 import os
 import time
 from collections.abc import Callable, Iterator, Sequence
@@ -42,6 +43,8 @@ PERSON_RCS_STD_DB = 4.0
 #: ``core.simulation.simulate_frame``. Adding a level is one line.
 SIMULATORS: dict[str, str] = {
     "exact": "core.simulation:simulate_frame",
+    "fast": "core.simulation:simulate_frame_fast",
+    "measurement": "core.simulation:simulate_frame_measurement",
 }
 
 #: Bump when the simulation changes in a way that invalidates cached data sets.
@@ -236,6 +239,9 @@ def plan(
             "point clouds are simulated here",
         ),
     )  # fmt: skip
+    unknown = sorted(set(force) - {s.name for s in stages})
+    if unknown:
+        raise InputError(f"force: unknown stage(s) {unknown}")
     return Plan(stages=stages, fidelity=fidelity, consumer=consumer)
 
 
@@ -315,6 +321,126 @@ def processing_settings(scene: Scene) -> ProcessingSettings:
     return dataclasses.replace(DEFAULT_PROCESSING, max_range_m=scene.aoi.max_range_m)
 
 
+@dataclass(frozen=True, slots=True, kw_only=True)
+class _Reflectors:
+    """Builds the scatterers of any frame of a scene (stages truth … scatterers of the plan)."""
+
+    scene: Scene
+    seed: int
+    antenna: Any
+    settings: ProcessingSettings
+    truth_t_s: np.ndarray  # (F,)
+    truth_xy_m: np.ndarray  # (F, n_persons, 2)
+    truth_v_mps: np.ndarray  # (F, n_persons, 2)
+    fixed_rcs: np.ndarray  # (n_persons,), NaN where drawn
+    extended: np.ndarray  # (n_persons,) bool: body model applies
+    headings: dict[int, np.ndarray]
+    run_rcs: bool
+    run_clutter: bool
+    run_static: bool
+
+    @classmethod
+    def build(cls, scene: Scene, p: Plan, seed: int, antenna, settings) -> _Reflectors:
+        t_s, xy, v = scene.truth()
+        extended = np.array([q.model == "extended" for q in scene.persons], dtype=bool)
+        if not p.runs("body_model"):
+            extended[:] = False
+        return cls(
+            scene=scene,
+            seed=seed,
+            antenna=antenna,
+            settings=settings,
+            truth_t_s=t_s,
+            truth_xy_m=xy,
+            truth_v_mps=v,
+            fixed_rcs=np.array(
+                [np.nan if q.rcs_dbsm is None else q.rcs_dbsm for q in scene.persons]
+            ),
+            extended=extended,
+            headings={
+                i: walking_headings(q.trajectory.velocity_mps)
+                for i, q in enumerate(scene.persons)
+                if extended[i]
+            },
+            run_rcs=p.runs("person_rcs"),
+            run_clutter=p.runs("clutter"),
+            run_static=p.runs("static_reflectors"),
+        )
+
+    def frame(self, f: int) -> tuple[Any, int]:
+        """Scatterers of frame ``f`` and the number of clutter reflectors among them."""
+        from core import simulation as sim
+
+        scene, radar = self.scene, self.scene.radar
+        xy, v = self.truth_xy_m[f], self.truth_v_mps[f]
+        rcs = self.fixed_rcs.copy()
+        if self.run_rcs:
+            # σ_dBsm ~ N(−8, 16), eq. (5), drawn afresh every frame
+            drawn = stage_rng(self.seed, "person_rcs", f).normal(
+                PERSON_RCS_MEAN_DBSM, PERSON_RCS_STD_DB, scene.n_persons
+            )
+            rcs = np.where(np.isnan(self.fixed_rcs), drawn, self.fixed_rcs)
+        active = ~np.isnan(xy[:, 0])
+        # persons: one point scatterer at the trajectory position, z = 0
+        point = active & ~self.extended
+        pos = [np.column_stack((xy[point], np.zeros(point.sum())))]
+        vel = [np.column_stack((v[point], np.zeros(point.sum())))]
+        rcs_list = [rcs[point]]
+        src = [np.flatnonzero(point).astype(np.int32)]
+        for i in np.flatnonzero(active & self.extended):
+            bp, bv, frac = body_scatterers(xy[i], v[i], self.headings[i][f], self.truth_t_s[f])
+            pos.append(np.column_stack((bp, np.zeros(len(bp)))))
+            vel.append(np.column_stack((bv, np.zeros(len(bv)))))
+            # σ_part = σ · share (linear power)
+            rcs_list.append(rcs[i] + 10 * np.log10(frac))
+            src.append(np.full(len(bp), i, dtype=np.int32))
+        n_clutter = 0
+        if self.run_clutter:
+            c = draw_clutter(
+                scene.aoi, scene.clutter_density_per_m2, radar, stage_rng(self.seed, "clutter", f)
+            )
+            n_clutter = len(c)
+            if n_clutter:
+                r = np.hypot(c.position_m[:, 0], c.position_m[:, 1])
+                az = np.arctan2(c.position_m[:, 0], c.position_m[:, 1])
+                pos.append(np.column_stack((c.position_m, np.zeros(n_clutter))))
+                vel.append(np.column_stack((c.velocity_mps, np.zeros(n_clutter))))
+                rcs_list.append(
+                    sim.rcs_for_snr_db(radar, r, az, c.snr_db, self.antenna, self.settings)
+                )
+                src.append(np.full(n_clutter, -1, dtype=np.int32))
+        static = scene.static_reflectors
+        if self.run_static and static:
+            pos.append(np.array([[q.x_m, q.y_m, q.z_m] for q in static]))
+            vel.append(np.zeros((len(static), 3)))
+            rcs_list.append(np.array([q.rcs_dbsm for q in static], dtype=np.float64))
+            src.append(np.full(len(static), -1, dtype=np.int32))
+        scatterers = sim.Scatterers(
+            position_m=np.concatenate(pos).astype(np.float64),
+            velocity_mps=np.concatenate(vel).astype(np.float64),
+            rcs_dbsm=np.concatenate(rcs_list).astype(np.float64),
+            source=np.concatenate(src).astype(np.int32),
+        )
+        return scatterers, n_clutter
+
+
+def frame_scatterers(scene: Scene, frame: int, *, seed: int | None = None, the_plan=None):
+    """The reflectors of one frame (persons, clutter, static reflectors) as the chain sees them.
+
+    Returns
+    -------
+    core.simulation.Scatterers
+        ``source``: person index, or −1 for clutter and static reflectors.
+    """
+    from core import simulation as sim
+
+    p = the_plan or plan(scene)
+    seed = scene.seed if seed is None else int(seed)
+    antenna = sim.AntennaGain.draw(scene.radar, stage_rng(seed, "antenna"))
+    settings = processing_settings(scene)
+    return _Reflectors.build(scene, p, seed, antenna, settings).frame(frame)[0]
+
+
 def iter_frames(
     scene: Scene,
     *,
@@ -350,73 +476,10 @@ def iter_frames(
     settings = processing_settings(scene)
     simulate = simulator(p.fidelity)
     antenna = sim.AntennaGain.draw(radar, stage_rng(seed, "antenna"))
-    t_s, xy, v = scene.truth()
-    n_persons = scene.n_persons
-    fixed_rcs = np.array([np.nan if q.rcs_dbsm is None else q.rcs_dbsm for q in scene.persons])
-    static = scene.static_reflectors
-    static_pos = np.array([[r.x_m, r.y_m, r.z_m] for r in static]).reshape(-1, 3)
-    static_rcs = np.array([r.rcs_dbsm for r in static], dtype=np.float64)
-    run_rcs, run_clutter, run_static, run_body = (
-        p.runs("person_rcs"),
-        p.runs("clutter"),
-        p.runs("static_reflectors"),
-        p.runs("body_model"),
-    )
-    extended = np.array([q.model == "extended" for q in scene.persons], dtype=bool)
-    if not run_body:
-        extended[:] = False
-    headings = {
-        i: walking_headings(q.trajectory.velocity_mps)
-        for i, q in enumerate(scene.persons)
-        if extended[i]
-    }
+    reflectors = _Reflectors.build(scene, p, seed, antenna, settings)
+    t_s, xy, v = reflectors.truth_t_s, reflectors.truth_xy_m, reflectors.truth_v_mps
     for f in frames if frames is not None else range(scene.n_frames):
-        # persons: one point scatterer at the trajectory position, z = 0
-        rcs = fixed_rcs.copy()
-        if run_rcs:
-            # σ_dBsm ~ N(−8, 16), eq. (5), drawn afresh every frame
-            drawn = stage_rng(seed, "person_rcs", f).normal(
-                PERSON_RCS_MEAN_DBSM, PERSON_RCS_STD_DB, n_persons
-            )
-            rcs = np.where(np.isnan(fixed_rcs), drawn, fixed_rcs)
-        active = ~np.isnan(xy[f, :, 0])
-        point = active & ~extended
-        pos = [np.column_stack((xy[f, point], np.zeros(point.sum())))]
-        vel = [np.column_stack((v[f, point], np.zeros(point.sum())))]
-        rcs_list = [rcs[point]]
-        src = [np.flatnonzero(point).astype(np.int32)]
-        if run_body:
-            for i in np.flatnonzero(active & extended):
-                bp, bv, frac = body_scatterers(xy[f, i], v[f, i], headings[i][f], t_s[f])
-                pos.append(np.column_stack((bp, np.zeros(len(bp)))))
-                vel.append(np.column_stack((bv, np.zeros(len(bv)))))
-                # σ_part = σ · share (linear power)
-                rcs_list.append(rcs[i] + 10 * np.log10(frac))
-                src.append(np.full(len(bp), i, dtype=np.int32))
-        n_clutter = 0
-        if run_clutter:
-            c = draw_clutter(
-                scene.aoi, scene.clutter_density_per_m2, radar, stage_rng(seed, "clutter", f)
-            )
-            n_clutter = len(c)
-            if n_clutter:
-                r = np.hypot(c.position_m[:, 0], c.position_m[:, 1])
-                az = np.arctan2(c.position_m[:, 0], c.position_m[:, 1])
-                pos.append(np.column_stack((c.position_m, np.zeros(n_clutter))))
-                vel.append(np.column_stack((c.velocity_mps, np.zeros(n_clutter))))
-                rcs_list.append(sim.rcs_for_snr_db(radar, r, az, c.snr_db, antenna, settings))
-                src.append(np.full(n_clutter, -1, dtype=np.int32))
-        if run_static and len(static):
-            pos.append(static_pos)
-            vel.append(np.zeros_like(static_pos))
-            rcs_list.append(static_rcs)
-            src.append(np.full(len(static), -1, dtype=np.int32))
-        scatterers = sim.Scatterers(
-            position_m=np.concatenate(pos).astype(np.float64),
-            velocity_mps=np.concatenate(vel).astype(np.float64),
-            rcs_dbsm=np.concatenate(rcs_list).astype(np.float64),
-            source=np.concatenate(src).astype(np.int32),
-        )
+        scatterers, n_clutter = reflectors.frame(f)
         out = simulate(
             radar,
             scatterers,
@@ -619,7 +682,10 @@ def build_dataset(
         seeds = trajectory_seeds(seed, len(scenes))
     elif len(seeds) != len(scenes):
         raise InputError(f"seeds: {len(seeds)} given for {len(scenes)} scenes")
-    tasks = [(s.to_json(), sd, fidelity) for s, sd in zip(scenes, seeds)]
+    # self-contained scenes (radar as fields): workers may not see a .cfg relative to a file
+    tasks = [
+        (json.dumps(s.to_dict(resolve_radar=True)), sd, fidelity) for s, sd in zip(scenes, seeds)
+    ]
     jobs = (os.cpu_count() or 1) if jobs is None else max(1, int(jobs))
     results: list[dict[str, Any]] = []
     if jobs == 1 or len(tasks) == 1:
@@ -628,7 +694,11 @@ def build_dataset(
             if progress is not None:
                 progress(i + 1, len(tasks))
     else:
-        with ProcessPoolExecutor(max_workers=min(jobs, len(tasks))) as pool:
+        # workers fork from a single-threaded server that has imported the chain once: safe when
+        # the caller has threads (GUI, FFT pools: forking a threaded process can deadlock) and
+        # cheaper than "spawn", which imports the chain in every worker
+        ctx = _worker_context()
+        with ProcessPoolExecutor(max_workers=min(jobs, len(tasks)), mp_context=ctx) as pool:
             for i, r in enumerate(pool.map(_simulate_task, tasks)):
                 results.append(r)
                 if progress is not None:
@@ -637,6 +707,14 @@ def build_dataset(
     if cache_file is not None:
         ds.save(cache_file)
     return ds
+
+
+def _worker_context() -> multiprocessing.context.BaseContext:
+    if "forkserver" in multiprocessing.get_all_start_methods():
+        ctx = multiprocessing.get_context("forkserver")
+        ctx.set_forkserver_preload(["core.pipeline", "core.simulation"])
+        return ctx
+    return multiprocessing.get_context("spawn")
 
 
 def _assemble(
@@ -705,32 +783,23 @@ def paper_dataset(
 # ---- clutter density for the tracker ----------------------------------------------------------
 
 
-def expected_false_alarms_per_frame(radar: RadarConfig, settings: ProcessingSettings) -> float:
-    """Expected CFAR false alarms per frame from receiver noise alone.
-
-    A noise cell is declared only when it passes both CFAR stages, so per cell
-    ``P_fa ≈ P_fa,range · P_fa,Doppler``; the cells are the range bins inside the processing
-    range limits times all Doppler bins. Peak grouping can only lower this, so it is an upper
-    estimate (about 5.5e-4 per frame for the paper radar: negligible next to clutter).
-    """
-    dr = radar.range_resolution_m
-    n_range = int(np.floor(settings.max_range_m / dr)) - int(np.ceil(settings.min_range_m / dr))
-    n_range = max(0, n_range + 1)
-    # P_fa per cell = P_fa,range * P_fa,Doppler
-    pfa = settings.range_cfar.pfa * settings.doppler_cfar.pfa
-    return n_range * radar.n_loops * pfa
-
-
 def scene_clutter_density(scene: Scene, settings: ProcessingSettings | None = None) -> float:
     """Clutter density ρ for the tracker, per m · rad · m/s.
 
-    ``ρ = (λ·area(AOI) + false alarms per frame) / (Δr · Δaz · 2 v_max)``: the expected false
-    points per frame (clutter reflectors plus the chain's own CFAR false alarms) spread over
-    the measurement-space volume of the AOI. About 0.0073 for the paper's scene.
+    ``ρ = (λ·area(AOI) + N_fa) / ((r_max − r_min) · 2 az_max · 2 v_max)``: the expected false
+    points per frame — clutter reflectors plus the chain's own noise detections ``N_fa``
+    (:func:`core.processing.expected_false_alarms_per_frame`: the two CFAR stages test the same
+    cell, so their joint false-alarm probability is far above ``Pfa_r · Pfa_d``; about 0.20 per
+    frame for the paper chain) — spread over the measurement-space volume of the AOI.
+    Paper scene: (2.089 + 0.200) / 288.1 = 0.00795. SPEC §4's "about 0.0073" is the clutter
+    term alone (2.089 / 288.1 = 0.00725); see docs/decisions/scene-05.
     """
+    from core.processing import expected_false_alarms_per_frame
+
     aoi = scene.aoi
-    n_false = expected_clutter_count(aoi, scene.clutter_density_per_m2)
     settings = settings or processing_settings(scene)
+    # N = λ·A + N_fa
+    n_false = expected_clutter_count(aoi, scene.clutter_density_per_m2)
     n_false += expected_false_alarms_per_frame(scene.radar, settings)
     # V = (r_max − r_min) · 2 az_max · 2 v_max
     volume = (

@@ -9,12 +9,14 @@ from core.processing.cfar import (
     CasoCfar,
     Cfar,
     Detections,
+    expected_false_alarms_per_frame,
     make_cfar,
     pfa_ca,
     pfa_cago,
     pfa_caso,
     threshold_factor,
     two_stage_cfar,
+    two_stage_pfa,
 )
 from core.processing.points import build_point_cloud, label_sources, refine_bins
 from core.processing.spectrum import (
@@ -32,6 +34,7 @@ __all__ = [
     "CasoCfar",
     "Cfar",
     "Detections",
+    "expected_false_alarms_per_frame",
     "build_point_cloud",
     "doppler_fft",
     "estimate_angles",
@@ -47,6 +50,7 @@ __all__ = [
     "tdm_compensate",
     "threshold_factor",
     "two_stage_cfar",
+    "two_stage_pfa",
     "window",
     "window_loss_db",
 ]

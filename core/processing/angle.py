@@ -16,9 +16,18 @@ azimuth position differ by ``pi sin(el)`` in phase: ``sin(el) = arg(sum x_e conj
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 
 from core.config import RadarConfig
+
+_TINY = float(np.finfo(np.float64).tiny)
+
+
+def _frozen(a: np.ndarray) -> np.ndarray:
+    a.flags.writeable = False
+    return a
 
 
 def _parabolic_offset(a: np.ndarray, b: np.ndarray, c: np.ndarray) -> np.ndarray:
@@ -32,7 +41,7 @@ def _parabolic_offset(a: np.ndarray, b: np.ndarray, c: np.ndarray) -> np.ndarray
 
 def log_parabolic_offset(left: np.ndarray, peak: np.ndarray, right: np.ndarray) -> np.ndarray:
     """Sub-bin offset of a spectral peak from the log powers of the peak and its neighbours."""
-    tiny = np.finfo(np.float64).tiny
+    tiny = _TINY
     la, lb, lc = (
         np.log(np.maximum(np.asarray(v, dtype=np.float64), tiny)) for v in (left, peak, right)
     )
@@ -45,8 +54,13 @@ def azimuth_row(radar: RadarConfig) -> tuple[np.ndarray, np.ndarray]:
     The row is the set of channels at the lowest elevation position; where two channels share
     an azimuth position the first is used.
     """
-    el = np.asarray(radar.elevation_positions)
-    az = np.asarray(radar.azimuth_positions)
+    return _azimuth_row(radar.azimuth_positions, radar.elevation_positions)
+
+
+@functools.lru_cache(maxsize=32)
+def _azimuth_row(az_pos: tuple, el_pos: tuple) -> tuple[np.ndarray, np.ndarray]:
+    el = np.asarray(el_pos)
+    az = np.asarray(az_pos)
     base = el.min()
     channels, positions, seen = [], [], set()
     for v in np.flatnonzero(el == base):
@@ -55,13 +69,18 @@ def azimuth_row(radar: RadarConfig) -> tuple[np.ndarray, np.ndarray]:
             channels.append(v)
             positions.append(int(az[v]))
     pos = np.asarray(positions)
-    return np.asarray(channels), pos - pos.min()
+    return _frozen(np.asarray(channels)), _frozen(pos - pos.min())
 
 
 def elevation_pairs(radar: RadarConfig) -> tuple[np.ndarray, np.ndarray]:
     """Pairs ``(elevated channel, row channel)`` at the same azimuth position, one above."""
-    el = np.asarray(radar.elevation_positions)
-    az = np.asarray(radar.azimuth_positions)
+    return _elevation_pairs(radar.azimuth_positions, radar.elevation_positions)
+
+
+@functools.lru_cache(maxsize=32)
+def _elevation_pairs(az_pos: tuple, el_pos: tuple) -> tuple[np.ndarray, np.ndarray]:
+    el = np.asarray(el_pos)
+    az = np.asarray(az_pos)
     base = el.min()
     upper, lower = [], []
     for v in np.flatnonzero(el == base + 1):
@@ -69,7 +88,7 @@ def elevation_pairs(radar: RadarConfig) -> tuple[np.ndarray, np.ndarray]:
         if match.size:
             upper.append(v)
             lower.append(match[0])
-    return np.asarray(upper, dtype=np.int64), np.asarray(lower, dtype=np.int64)
+    return _frozen(np.asarray(upper, dtype=np.int64)), _frozen(np.asarray(lower, dtype=np.int64))
 
 
 def tdm_compensate(channels: np.ndarray, doppler_bin: np.ndarray, radar: RadarConfig) -> np.ndarray:
@@ -127,15 +146,16 @@ def estimate_angles(
     row = np.zeros((n_det, fft_size), dtype=np.complex128)
     row[:, row_pos] = x[:, row_ch]
     # X_k = sum_p x_p exp(-j 2 pi k p / N): peaks at k = N u / 2
-    spec = np.fft.fftshift(np.fft.fft(row, axis=1), axes=1)
+    spec = np.fft.fft(row, axis=1)  # index k <-> k (k < N/2) or k - N
     power = spec.real**2 + spec.imag**2
     k = np.argmax(power, axis=1)
     i = np.arange(n_det)
     delta = log_parabolic_offset(
         power[i, (k - 1) % fft_size], power[i, k], power[i, (k + 1) % fft_size]
     )
-    # u = sin(az) cos(el) = 2 (k - N/2 + delta) / N
-    u = 2.0 * (k - fft_size // 2 + delta) / fft_size
+    k_signed = np.where(k >= fft_size // 2, k - fft_size, k)
+    # u = sin(az) cos(el) = 2 (k + delta) / N, k centred
+    u = 2.0 * (k_signed + delta) / fft_size
     el = np.zeros(n_det)
     if elevation:
         upper, lower = elevation_pairs(radar)

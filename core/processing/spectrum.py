@@ -58,6 +58,50 @@ def window_loss_db(name: str, n: int) -> float:
     return float(10 * np.log10(w.sum() ** 2 / (n * np.sum(w**2))))
 
 
+def cell_power_correlation(name: str, n_fft: int, lag: int) -> float:
+    """Correlation of the powers of two FFT cells ``lag`` bins apart, white noise input.
+
+    ``|rho(k)|^2`` with ``rho(k) = sum w^2 exp(-j 2 pi k n / N) / sum w^2`` (periodic Hann:
+    ``4/9`` for neighbours, ``1/36`` two bins apart, 0 beyond).
+    """
+    w2 = window(name, n_fft).astype(np.float64) ** 2
+    n = np.arange(n_fft)
+    rho = np.sum(w2 * np.exp(-2j * np.pi * lag * n / n_fft)) / w2.sum()
+    return float(abs(rho) ** 2)
+
+
+def effective_cells(name: str, n_fft: int, n_cells: int) -> float:
+    """Effective number of independent cells in a run of ``n_cells`` adjacent FFT cells.
+
+    ``N_eff = N^2 / sum_ij |rho(i - j)|^2``: the number of independent cells whose sum has the
+    same mean-to-variance ratio (rectangular window: ``N``; periodic Hann, 8 cells: 4.40).
+    """
+    r = [cell_power_correlation(name, n_fft, k) for k in range(n_cells)]
+    # sum_ij |rho(i-j)|^2 = N + 2 sum_k (N - k) |rho(k)|^2
+    total = n_cells + 2 * sum((n_cells - k) * r[k] for k in range(1, n_cells))
+    return n_cells**2 / total
+
+
+def clutter_removal_noise_profile(name: str, n: int) -> np.ndarray:
+    """Relative noise power per Doppler bin after mean removal and the Doppler window.
+
+    ``g_k = 1 - |W_k|^2 / (N sum w^2)`` with ``W_k`` the window's DFT; zero velocity centred
+    (index ``j`` is bin ``j - N/2``). Periodic Hann: 1/3 at zero Doppler, 5/6 next to it, 1
+    elsewhere; rectangular: 0 at zero Doppler. Returns a read-only float64 array ``(n,)``.
+    """
+    return _noise_profile(name, int(n))
+
+
+@functools.lru_cache(maxsize=64)
+def _noise_profile(name: str, n: int) -> np.ndarray:
+    w = window(name, n).astype(np.float64)
+    W = np.fft.fftshift(np.fft.fft(w))
+    # E|Y_k|^2 / E|Y_k|^2 (no removal) = 1 - |W_k|^2 / (N sum w^2)
+    g = 1.0 - np.abs(W) ** 2 / (n * np.sum(w**2))
+    g.flags.writeable = False
+    return g
+
+
 def range_fft(cube: np.ndarray, window_name: str = "hann", *, workers: int | None = None):
     """Range FFT along ADC samples.
 
@@ -75,9 +119,11 @@ def range_fft(cube: np.ndarray, window_name: str = "hann", *, workers: int | Non
         ``k * range_resolution_m`` (complex sampling: all bins are positive ranges).
     """
     x = np.asarray(cube)
-    if window_name != "rect":
-        x = x * window(window_name, x.shape[-1])
-    return scipy.fft.fft(x.astype(np.complex64, copy=False), axis=-1, workers=workers)
+    if window_name == "rect":
+        return scipy.fft.fft(x.astype(np.complex64, copy=False), axis=-1, workers=workers)
+    # the windowed copy is ours: transform it in place
+    y = (x * window(window_name, x.shape[-1])).astype(np.complex64, copy=False)
+    return scipy.fft.fft(y, axis=-1, workers=workers, overwrite_x=True)
 
 
 def remove_static_clutter(range_cube: np.ndarray) -> np.ndarray:
@@ -89,31 +135,62 @@ def remove_static_clutter(range_cube: np.ndarray) -> np.ndarray:
     return x - x.mean(axis=1, keepdims=True, dtype=np.complex64)
 
 
-def doppler_fft(range_cube: np.ndarray, window_name: str = "hann", *, workers: int | None = None):
+@functools.lru_cache(maxsize=64)
+def _doppler_taps(window_name: str, n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Window with the fftshift folded in, and the non-zero bins of its DFT (index, value)."""
+    w = window(window_name, n).astype(np.float64)
+    if n % 2 == 0:
+        # fftshift folded into the window: X[k - N/2] <-> x[m] * (-1)^m
+        w = w * np.where(np.arange(n) % 2 == 0, 1.0, -1.0)
+    W = np.fft.fft(w)
+    if n % 2 == 1:
+        W = np.fft.fftshift(W)
+    idx = np.flatnonzero(np.abs(W) > 1e-9 * np.abs(W).max())
+    return w.astype(np.float32), idx, W[idx].astype(np.complex64)
+
+
+def doppler_fft(
+    range_cube: np.ndarray,
+    window_name: str = "hann",
+    *,
+    remove_static: bool = False,
+    workers: int | None = None,
+) -> np.ndarray:
     """Doppler FFT along loops, zero velocity centred.
 
     Parameters
     ----------
     range_cube
         ``[virtual channel, loop, range bin]``, complex.
+    window_name
+        Window along loops.
+    remove_static
+        Static clutter removal folded into the FFT (same result as
+        :func:`remove_static_clutter` first, one pass less): the FFT is linear, so
+        ``FFT(w (x - mean x)) = FFT(w x) - mean(x) W``, and the window's DFT ``W`` is non-zero
+        on a few bins only (periodic Hann: 3).
 
     Returns
     -------
     numpy.ndarray
         Doppler cube ``[virtual channel, range bin, Doppler bin]``, complex64; index ``j`` is
         Doppler bin ``j - n_loops // 2`` (velocity ``(j - n_loops // 2) * velocity_resolution``).
+        A transposed view of a ``[v, Doppler, range]`` array (the FFT runs along loops without
+        a transposing copy); ``numpy.ascontiguousarray`` gives a contiguous copy if needed.
     """
     x = np.asarray(range_cube)
     n = x.shape[1]
-    w = window(window_name, n)
-    if n % 2 == 0:
-        # fftshift folded into the window: X[k - N/2] <-> x[m] * (-1)^m
-        w = w * np.where(np.arange(n) % 2 == 0, 1.0, -1.0).astype(np.float32)
-    y = x.transpose(0, 2, 1) * w  # one pass: transpose to [v, range, loop] and window
-    out = scipy.fft.fft(y.astype(np.complex64, copy=False), axis=-1, workers=workers)
+    w, idx, taps = _doppler_taps(window_name, n)
+    y = (x * w[:, None]).astype(np.complex64, copy=False)
+    # FFT along loops in place; the result is returned as a [v, range, Doppler] view
+    out = scipy.fft.fft(y, axis=1, workers=workers, overwrite_x=True)
     if n % 2 == 1:
-        out = np.fft.fftshift(out, axes=-1)
-    return out
+        out = np.fft.fftshift(out, axes=1)
+    if remove_static:
+        mu = x.mean(axis=1, dtype=np.complex64)  # [v, range]
+        # Y_j = X_j - mean * W_j on the bins where the window's DFT is non-zero
+        out[:, idx, :] -= mu[:, None, :] * taps[:, None]
+    return out.transpose(0, 2, 1)
 
 
 def range_doppler_map(doppler_cube: np.ndarray) -> np.ndarray:

@@ -42,6 +42,7 @@ REFLECTOR_KEYS = ("x_m", "y_m", "z_m", "rcs_dbsm")
 RCS_RANGE_DBSM = (-60.0, 60.0)
 WAYPOINT_SPEED_RANGE_MPS = (0.05, 3.0)
 MAX_PROFILE_FRAMES = 100_000
+MIN_SCATTERER_RANGE_M = 0.1
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -156,10 +157,18 @@ class Scene:
         return np.arange(f) * self.radar.frame_period_s, xy, v
 
     # ---- JSON --------------------------------------------------------------------------------
-    def to_dict(self) -> dict:
+    def to_dict(self, *, resolve_radar: bool = False) -> dict:
+        """The scene as JSON-ready data; ``resolve_radar`` writes the radar as its fields
+        (self-contained: no ``.cfg`` path relative to a scene file)."""
+        if resolve_radar:
+            radar: Any = self.radar.to_dict()
+        elif isinstance(self.radar_spec, str):
+            radar = self.radar_spec
+        else:
+            radar = dict(self.radar_spec)
         return {
             "schema_version": SCHEMA_VERSION,
-            "radar": self.radar_spec if isinstance(self.radar_spec, str) else dict(self.radar_spec),
+            "radar": radar,
             "seed": self.seed,
             "clutter_density_per_m2": self.clutter_density_per_m2,
             "aoi": self.aoi.to_dict(),
@@ -176,9 +185,7 @@ class Scene:
 
     def canonical_json(self) -> str:
         """Compact, key-sorted JSON including the resolved radar (for hashing)."""
-        d = self.to_dict()
-        d["radar"] = self.radar.to_dict()
-        return json.dumps(d, sort_keys=True, separators=(",", ":"))
+        return json.dumps(self.to_dict(resolve_radar=True), sort_keys=True, separators=(",", ":"))
 
     @classmethod
     def from_json(cls, path: str | os.PathLike) -> Scene:
@@ -244,6 +251,14 @@ def _check_keys(obj: Any, allowed: tuple[str, ...], where: str) -> dict:
     if unknown:
         raise InputError(f"{where}: unknown key(s) {unknown}; expected some of {list(allowed)}")
     return obj
+
+
+def _all_numbers(d: dict) -> bool:
+    return all(
+        isinstance(v, int | float) and not isinstance(v, bool) and math.isfinite(v)
+        for k, v in d.items()
+        if k in ("x_m", "y_m", "z_m")
+    )
 
 
 def _number(value: Any, where: str, lo: float | None = None, hi: float | None = None) -> float:
@@ -401,6 +416,12 @@ def _parse_scene(data: Any, base_dir: Path) -> Scene:
         for k in ("x_m", "y_m"):
             if k not in r:
                 raise InputError(f"{where}: missing key {k!r}")
+        r_m = math.hypot(r["x_m"], r["y_m"], r.get("z_m", 0.0)) if _all_numbers(r) else None
+        if r_m is not None and not MIN_SCATTERER_RANGE_M <= r_m <= radar.max_range_m:
+            raise InputError(
+                f"{where}: range {r_m:.3g} m must be in [{MIN_SCATTERER_RANGE_M}, "
+                f"{radar.max_range_m:.3f}] m (the radar's maximum range)"
+            )
         reflectors.append(
             StaticReflector(
                 x_m=_number(r["x_m"], f"{where}.x_m"),
@@ -421,6 +442,12 @@ def _parse_scene(data: Any, base_dir: Path) -> Scene:
         traj = _parse_trajectory(
             p["trajectory"], f"{where}.trajectory", seed, i, aoi, radar.frame_period_s
         )
+        r_min = float(np.hypot(*traj.position_m.T).min())
+        if r_min < MIN_SCATTERER_RANGE_M:
+            raise InputError(
+                f"{where}.trajectory passes within {r_min:.3g} m of the radar "
+                f"(at least {MIN_SCATTERER_RANGE_M} m)"
+            )
         rcs = p.get("rcs_dbsm")
         if rcs is not None:
             rcs = _number(rcs, f"{where}.rcs_dbsm", *RCS_RANGE_DBSM)

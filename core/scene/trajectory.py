@@ -30,7 +30,7 @@ SPEED_RANGE_MPS = (0.5, 1.8)  # walking speeds drawn by the generators
 _MAX_ATTEMPTS = 500
 
 
-@dataclass(frozen=True, slots=True, kw_only=True)
+@dataclass(frozen=True, slots=True, kw_only=True, eq=False)
 class Trajectory:
     """A person's ground truth over ``F`` frames, eq. (6).
 
@@ -65,6 +65,19 @@ class Trajectory:
                 raise InputError(f"trajectory {name} contains non-finite values")
         if f < 1:
             raise InputError("a trajectory needs at least one frame")
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, Trajectory):
+            return NotImplemented
+        return (
+            self.frame_period_s == other.frame_period_s
+            and self.trajectory_class == other.trajectory_class
+            and np.array_equal(self.position_m, other.position_m)
+            and np.array_equal(self.velocity_mps, other.velocity_mps)
+            and np.array_equal(self.acceleration_mps2, other.acceleration_mps2)
+        )
+
+    __hash__ = None  # type: ignore[assignment]
 
     @property
     def n_frames(self) -> int:

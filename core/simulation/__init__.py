@@ -8,6 +8,7 @@ from core.simulation.baseband import (
     synthesize_noise,
     synthesize_signal,
 )
+from core.simulation.fast import simulate_frame_fast
 from core.simulation.frame import FrameOutput, needs_elevation, simulate_frame
 from core.simulation.link import (
     draw_person_rcs_dbsm,
@@ -19,9 +20,19 @@ from core.simulation.link import (
     receiver_voltage_scale,
     signal_amplitude_v,
 )
+from core.simulation.measurement import simulate_frame_measurement
 from core.simulation.scatterers import Scatterers
 
+# fidelity levels (docs/fidelity.md): every simulator has the signature of simulate_frame
+#: Frame simulators by fidelity level, cheapest last; ``exact`` is the reference.
+FIDELITY_LEVELS = {
+    "exact": simulate_frame,
+    "fast": simulate_frame_fast,
+    "measurement": simulate_frame_measurement,
+}
+
 __all__ = [
+    "FIDELITY_LEVELS",
     "AntennaGain",
     "FrameOutput",
     "Scatterers",
@@ -36,6 +47,8 @@ __all__ = [
     "receiver_voltage_scale",
     "signal_amplitude_v",
     "simulate_frame",
+    "simulate_frame_fast",
+    "simulate_frame_measurement",
     "steering_vectors",
     "synthesize_baseband",
     "synthesize_noise",

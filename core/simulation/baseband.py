@@ -54,18 +54,24 @@ def steering_vectors(radar: RadarConfig, scatterers: Scatterers) -> np.ndarray:
     return np.exp(1j * np.pi * u)
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, fastmath=True)
 def _synthesize_kernel(
     out, amp, ranges, steer, phase_per_m, beat_per_m, n_tx, n_rx
 ):  # pragma: no cover
+    """out[k Nrx + r, m, n] += A_i a_i[v] exp(j (phi0 + n dphi)) for every scatterer and chirp.
+
+    The start phase and the per-sample step come from the chirp's range in float64 (reduced
+    modulo 2 pi); the tone is generated in complex128 by the recurrence and added in complex64.
+    """
     n_s, n_chirps = ranges.shape
     n_samples = out.shape[2]
-    row = np.empty(n_samples, dtype=np.complex128)
+    row = np.empty(n_samples, dtype=np.complex64)
     for i in range(n_s):
         for c in range(n_chirps):
             m = c // n_tx
             k = c - m * n_tx
             r = ranges[i, c]
+            # phi0 = 4 pi R / lambda;  dphi = 2 pi f_b / Fs with f_b = 2 S R / c
             ph0 = (phase_per_m * r) % TWO_PI
             dph = (beat_per_m * r) % TWO_PI
             z = amp[i] * (np.cos(ph0) + 1j * np.sin(ph0))
@@ -75,9 +81,10 @@ def _synthesize_kernel(
                 z = z * step
             for rx in range(n_rx):
                 v = k * n_rx + rx
-                a = steer[i, v]
+                a = np.complex64(steer[i, v])
+                o = out[v, m]
                 for n in range(n_samples):
-                    out[v, m, n] += a * row[n]
+                    o[n] += a * row[n]
 
 
 def signal_parameters(radar: RadarConfig, scatterers: Scatterers, antenna: AntennaGain):
@@ -92,11 +99,30 @@ def signal_parameters(radar: RadarConfig, scatterers: Scatterers, antenna: Anten
     )
 
 
+def visible(radar: RadarConfig, scatterers: Scatterers) -> np.ndarray:
+    """``(N,)`` bool: in front of the antennas (|az| < 90 deg, the domain of eq. 1) and closer
+    than the maximum range (the IF filter; beyond it complex sampling would alias the range)."""
+    return (np.abs(scatterers.azimuth_rad) < np.pi / 2) & (scatterers.range_m < radar.max_range_m)
+
+
 def synthesize_signal(radar: RadarConfig, scatterers: Scatterers, antenna: AntennaGain):
-    """Noise-free baseband cube ``[virtual channel, loop, ADC sample]``, complex64, volts."""
+    """Noise-free baseband cube ``[virtual channel, loop, ADC sample]``, complex64, volts.
+
+    Only :func:`visible` scatterers contribute.
+    """
     out = np.zeros((radar.n_virtual, radar.n_loops, radar.n_samples), dtype=np.complex64)
     if len(scatterers) == 0:
         return out
+    keep = visible(radar, scatterers)
+    if not keep.all():
+        scatterers = Scatterers(
+            position_m=scatterers.position_m[keep],
+            velocity_mps=scatterers.velocity_mps[keep],
+            rcs_dbsm=scatterers.rcs_dbsm[keep],
+            source=scatterers.source[keep],
+        )
+        if len(scatterers) == 0:
+            return out
     amp, ranges, steer = signal_parameters(radar, scatterers, antenna)
     # phase 4 pi R / lambda;  beat phase per sample 2 pi (2 S R / c) / Fs
     phase_per_m = 4 * np.pi / radar.wavelength_m

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
@@ -14,7 +15,6 @@ from core.processing import (
     label_sources,
     range_doppler_map,
     range_fft,
-    remove_static_clutter,
     two_stage_cfar,
 )
 from core.simulation.antenna import AntennaGain
@@ -40,6 +40,14 @@ class FrameOutput:
     point_cloud: PointCloud
     rd_map_db: np.ndarray | None
     detections: np.ndarray
+
+
+def processed_range_bins(radar: RadarConfig, settings: ProcessingSettings) -> int:
+    """Range bins ``0 .. n-1`` that the detector needs: up to ``max_range_m`` plus the range
+    CFAR's guard and training cells (the map beyond is never looked at)."""
+    last = int(np.floor(settings.max_range_m / radar.range_resolution_m))
+    margin = settings.range_cfar.n_train + settings.range_cfar.n_guard
+    return int(min(radar.n_samples, last + 1 + margin))
 
 
 def needs_elevation(radar: RadarConfig, scatterers: Scatterers) -> bool:
@@ -77,14 +85,45 @@ def simulate_frame(
     if noise:
         cube += synthesize_noise(radar, rng)
     rc = range_fft(cube, settings.range_window)
-    if settings.static_clutter_removal:
-        rc = remove_static_clutter(rc)
-    dc = doppler_fft(rc, settings.doppler_window)
+    if not keep_rd_map:
+        # only the range bins the CFAR looks at (limits plus its training window)
+        rc = rc[:, :, : processed_range_bins(radar, settings)]
+    dc = doppler_fft(rc, settings.doppler_window, remove_static=settings.static_clutter_removal)
     rd = range_doppler_map(dc)
-    det = two_stage_cfar(rd, radar, settings)
     if elevation is None:
         elevation = needs_elevation(radar, scatterers)
-    pc = build_point_cloud(dc, rd, det, radar, settings, elevation=elevation)
+    return frame_from_spectrum(
+        dc, rd, radar, scatterers, settings=settings, keep_rd_map=keep_rd_map, elevation=elevation
+    )
+
+
+def frame_from_spectrum(
+    doppler_cube: np.ndarray,
+    rd_map: np.ndarray,
+    radar: RadarConfig,
+    scatterers: Scatterers,
+    *,
+    settings: ProcessingSettings = DEFAULT_PROCESSING,
+    keep_rd_map: bool = False,
+    elevation: bool = False,
+) -> FrameOutput:
+    """The detection half of the chain: CFAR, angles, point cloud and ground-truth labels.
+
+    For frame simulators that produce the spectrum another way (cheaper fidelity levels).
+
+    Parameters
+    ----------
+    doppler_cube
+        ``[virtual channel, range bin, Doppler bin]`` complex, zero velocity centred; range bins
+        ``0 .. n-1`` (may stop at :func:`processed_range_bins`).
+    rd_map
+        ``[range bin, Doppler bin]`` non-coherent power sum of ``doppler_cube``.
+    scatterers
+        The frame's reflectors, for the ``source`` labels (truth at the middle of the chirps).
+    """
+    rd = rd_map
+    det = two_stage_cfar(rd, radar, settings)
+    pc = build_point_cloud(doppler_cube, rd, det, radar, settings, elevation=elevation)
     if len(pc) and len(scatterers):
         # truth at the middle of the frame's chirps
         t_mid = 0.5 * radar.n_loops * radar.n_tx * radar.chirp_period_s
@@ -92,17 +131,7 @@ def simulate_frame(
         r_mid = np.linalg.norm(pos, axis=1)
         vr = np.einsum("ij,ij->i", pos, scatterers.velocity_mps) / r_mid
         src = label_sources(pc.range_m, pc.radial_velocity_mps, r_mid, vr, scatterers.source, radar)
-        pc = PointCloud(
-            range_m=pc.range_m,
-            azimuth_rad=pc.azimuth_rad,
-            elevation_rad=pc.elevation_rad,
-            radial_velocity_mps=pc.radial_velocity_mps,
-            snr_db=pc.snr_db,
-            x_m=pc.x_m,
-            y_m=pc.y_m,
-            z_m=pc.z_m,
-            source=src,
-        )
+        pc = dataclasses.replace(pc, source=src)
     rd_db = None
     if keep_rd_map:
         rd_db = (10 * np.log10(np.maximum(rd, np.finfo(np.float32).tiny))).astype(np.float32)

@@ -43,6 +43,9 @@ class Scatterers:
                 raise InputError(
                     f"{name} must have shape {shape}, got {np.shape(getattr(self, name))}"
                 )
+        for name in ("position_m", "velocity_mps", "rcs_dbsm"):
+            if not np.all(np.isfinite(getattr(self, name))):
+                raise InputError(f"{name} must be finite, got {getattr(self, name)!r}")
         if n[0] and np.any(np.linalg.norm(self.position_m, axis=1) <= 0):
             raise InputError("position_m: a scatterer sits at the radar (range 0)")
 

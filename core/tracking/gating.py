@@ -7,6 +7,7 @@
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -22,6 +23,7 @@ __all__ = [
 ]
 
 
+@functools.lru_cache(maxsize=64)
 def gate_threshold(p_g: float, dof: int = 3) -> float:
     """γ = χ²⁻¹_dof(P_G), the gate threshold on the squared Mahalanobis distance."""
     return float(chi2.ppf(p_g, dof))

@@ -10,6 +10,7 @@ trajectory of a data set. ``tests/core/tracking/test_kernel.py`` checks that bot
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -46,32 +47,34 @@ def _safe_xy(x, y):
 
 
 @njit(cache=True)
-def _predict(x, P, F, Q, xo, Po, tmp):
+def _predict(x, P, F, f_cols, f_nnz, Q, xo, Po, tmp):
+    """x⁻ = F x, P⁻ = F P Fᵀ + Q using the sparsity of F (row i: columns f_cols[i, :f_nnz[i]])."""
     n = x.shape[0]
     # x⁻ = F x
     for i in range(n):
         s = 0.0
-        for k in range(n):
+        for q in range(f_nnz[i]):
+            k = f_cols[i, q]
             s += F[i, k] * x[k]
         xo[i] = s
-    # P⁻ = F P Fᵀ + Q
+    # tmp = F P
     for i in range(n):
         for j in range(n):
             s = 0.0
-            for k in range(n):
+            for q in range(f_nnz[i]):
+                k = f_cols[i, q]
                 s += F[i, k] * P[k, j]
             tmp[i, j] = s
+    # P⁻ = (F P) Fᵀ + Q, upper triangle mirrored (symmetric by construction)
     for i in range(n):
-        for j in range(n):
+        for j in range(i, n):
             s = 0.0
-            for k in range(n):
+            for q in range(f_nnz[j]):
+                k = f_cols[j, q]
                 s += tmp[i, k] * F[j, k]
-            Po[i, j] = s + Q[i, j]
-    for i in range(n):
-        for j in range(i + 1, n):
-            v = 0.5 * (Po[i, j] + Po[j, i])
-            Po[i, j] = v
-            Po[j, i] = v
+            s += Q[i, j]
+            Po[i, j] = s
+            Po[j, i] = s
 
 
 @njit(cache=True)
@@ -99,25 +102,22 @@ def _measure(x, zp, H):
 @njit(cache=True)
 def _innov_cov(H, P, R, S, HP):
     n = P.shape[0]
-    # HP = H P⁻
+    # HP = H P⁻ (H is zero beyond the first 4 columns)
     for i in range(3):
         for j in range(n):
             s = 0.0
-            for k in range(n):
+            for k in range(4):
                 s += H[i, k] * P[k, j]
             HP[i, j] = s
-    # S = H P⁻ Hᵀ + R
+    # S = H P⁻ Hᵀ + R, upper triangle mirrored
     for i in range(3):
-        for j in range(3):
+        for j in range(i, 3):
             s = 0.0
-            for k in range(n):
+            for k in range(4):
                 s += HP[i, k] * H[j, k]
-            S[i, j] = s + R[i, j]
-    for i in range(3):
-        for j in range(i + 1, 3):
-            v = 0.5 * (S[i, j] + S[j, i])
-            S[i, j] = v
-            S[j, i] = v
+            s += R[i, j]
+            S[i, j] = s
+            S[j, i] = s
 
 
 @njit(cache=True)
@@ -155,7 +155,7 @@ def _back3(L, b, w):
 
 
 @njit(cache=True)
-def _pda_update(x, P, xp, Pp, H, HP, R, L, nu, beta, beta0, mval, K, A, tmp, tmp2, w, v):
+def _pda_update(x, P, xp, Pp, H, HP, R, L, nu, beta, beta0, mval, K, B, C, KT, T2, w, v):
     """PDA update with the spread of means and the Joseph form into x, P."""
     n = xp.shape[0]
     # K = P⁻ Hᵀ S⁻¹: row i of K solves S kᵢ = (H P⁻)[:, i]
@@ -177,21 +177,15 @@ def _pda_update(x, P, xp, Pp, H, HP, R, L, nu, beta, beta0, mval, K, A, tmp, tmp
     # x = x⁻ + K ν̄
     for i in range(n):
         x[i] = xp[i] + K[i, 0] * nb0 + K[i, 1] * nb1 + K[i, 2] * nb2
-    # A = I − K H
+    # B = (I − K H) P⁻ = P⁻ − K (H P⁻)
     for i in range(n):
         for j in range(n):
-            s = 1.0 if i == j else 0.0
-            for r in range(3):
-                s -= K[i, r] * H[r, j]
-            A[i, j] = s
-    # tmp = A P⁻
+            B[i, j] = Pp[i, j] - (K[i, 0] * HP[0, j] + K[i, 1] * HP[1, j] + K[i, 2] * HP[2, j])
+    # C = B Hᵀ, so that (I − K H) P⁻ (I − K H)ᵀ = B − C Kᵀ
     for i in range(n):
-        for j in range(n):
-            s = 0.0
-            for k in range(n):
-                s += A[i, k] * Pp[k, j]
-            tmp[i, j] = s
-    # tmp2 = (1 − β₀) R + spread, spread = Σβᵢ(νᵢ − ν̄)(νᵢ − ν̄)ᵀ + β₀ ν̄ν̄ᵀ (= Σβνν' − ν̄ν̄')
+        for r in range(3):
+            C[i, r] = B[i, 0] * H[r, 0] + B[i, 1] * H[r, 1] + B[i, 2] * H[r, 2] + B[i, 3] * H[r, 3]
+    # T2 = (1 − β₀) R + spread, spread = Σβᵢ(νᵢ − ν̄)(νᵢ − ν̄)ᵀ + β₀ ν̄ν̄ᵀ (= Σβνν' − ν̄ν̄')
     c = 1.0 - beta0
     nbar = (nb0, nb1, nb2)
     for a in range(3):
@@ -199,23 +193,18 @@ def _pda_update(x, P, xp, Pp, H, HP, R, L, nu, beta, beta0, mval, K, A, tmp, tmp
             s = beta0 * nbar[a] * nbar[b]
             for j in range(mval):
                 s += beta[j] * (nu[j, a] - nbar[a]) * (nu[j, b] - nbar[b])
-            tmp2[a, b] = c * R[a, b] + s
-    # P = β₀ P⁻ + (1 − β₀) [A P⁻ Aᵀ + K R Kᵀ] + K spread Kᵀ   (Joseph form inside)
+            T2[a, b] = c * R[a, b] + s
+    # KT = K T2
     for i in range(n):
-        for j in range(n):
-            s = 0.0
-            for k in range(n):
-                s += tmp[i, k] * A[j, k]
-            t = 0.0
-            for a in range(3):
-                u = 0.0
-                for b in range(3):
-                    u += tmp2[a, b] * K[j, b]
-                t += K[i, a] * u
-            P[i, j] = beta0 * Pp[i, j] + c * s + t
+        for b in range(3):
+            KT[i, b] = K[i, 0] * T2[0, b] + K[i, 1] * T2[1, b] + K[i, 2] * T2[2, b]
+    # P = β₀ P⁻ + (1 − β₀) [(I − KH) P⁻ (I − KH)ᵀ] + K [(1 − β₀) R + spread] Kᵀ
+    #   = β₀ P⁻ + (1 − β₀) P_c + K (Σβνν' − ν̄ν̄') Kᵀ, P_c in the Joseph form
     for i in range(n):
-        for j in range(i + 1, n):
-            val = 0.5 * (P[i, j] + P[j, i])
+        for j in range(i, n):
+            joseph = B[i, j] - (C[i, 0] * K[j, 0] + C[i, 1] * K[j, 1] + C[i, 2] * K[j, 2])
+            kt = KT[i, 0] * K[j, 0] + KT[i, 1] * K[j, 1] + KT[i, 2] * K[j, 2]
+            val = beta0 * Pp[i, j] + c * joseph + kt
             P[i, j] = val
             P[j, i] = val
 
@@ -291,6 +280,8 @@ def _track_kernel(
     sel,
     out_offsets,
     F,
+    f_cols,
+    f_nnz,
     Q,
     R,
     P0,
@@ -346,6 +337,8 @@ def _track_kernel(
     tmp = np.zeros((n, n))
     A = np.zeros((n, n))
     K = np.zeros((n, 3))
+    C3 = np.zeros((n, 3))
+    KT = np.zeros((n, 3))
     H = np.zeros((3, n))
     HP = np.zeros((3, n))
     S = np.zeros((3, 3))
@@ -368,7 +361,7 @@ def _track_kernel(
                 gated_any[j] = False
             n_old = nt
             for t in range(n_old):
-                _predict(X[t], P[t], F, Q, xp, Pp, tmp)
+                _predict(X[t], P[t], F, f_cols, f_nnz, Q, xp, Pp, tmp)
                 # ψ⁻ = p11 ψ + p21 (1 − ψ)
                 pp = p11 * psi[t] + p21 * (1.0 - psi[t])
                 pp = min(1.0, max(0.0, pp))
@@ -435,7 +428,7 @@ def _track_kernel(
                     ps = omd * pp / ((1.0 - pp) + omd * pp)
                     psi[t] = min(1.0, max(0.0, ps))
                 _pda_update(
-                    X[t], P[t], xp, Pp, H, HP, R, L, nu, beta, b0, mval, K, A, tmp, tmp2, w, v
+                    X[t], P[t], xp, Pp, H, HP, R, L, nu, beta, b0, mval, K, A, C3, KT, tmp2, w, v
                 )
             # initiation: measurements outside every gate start tentative tracks
             for j in range(m):
@@ -521,6 +514,28 @@ def _track_kernel(
             o += 1
 
 
+@functools.lru_cache(maxsize=256)
+def _matrices(params: TrackerParams, frame_period_s: float):
+    """F, its sparsity (columns and counts per row), Q, R and P0, cached per parameter set."""
+    d = params.state_dim
+    F = transition_matrix(params.model, frame_period_s)
+    f_nnz = np.count_nonzero(F, axis=1).astype(np.int64)
+    f_cols = np.zeros((d, max(1, int(f_nnz.max()))), dtype=np.int64)
+    for i in range(d):
+        nz = np.flatnonzero(F[i])
+        f_cols[i, : len(nz)] = nz
+    out = (
+        F,
+        f_cols,
+        f_nnz,
+        process_noise(params.model, frame_period_s, params.q_coeff),
+        # R = diag(r11², r22², r33²)
+        np.diag([params.r11**2, params.r22**2, params.r33**2]),
+        initial_covariance(params.p0),
+    )
+    return out  # shared between calls: never written (read-only flags would force a recompile)
+
+
 def track_frames(
     z: np.ndarray,
     frame_offsets: np.ndarray,
@@ -572,16 +587,19 @@ def track_frames(
     n_tr = np.zeros(n_out, dtype=np.int64)
     n_bad = np.zeros(n_out, dtype=np.int64)
     nonparam = params.nonparametric
+    F, f_cols, f_nnz, Q, R, P0 = _matrices(params, float(frame_period_s))
     _track_kernel(
         np.ascontiguousarray(z, dtype=np.float64),
         np.ascontiguousarray(frame_offsets, dtype=np.int64),
         t_off,
         sel,
         out_off,
-        transition_matrix(params.model, frame_period_s),
-        process_noise(params.model, frame_period_s, params.q_coeff),
-        np.diag([params.r11**2, params.r22**2, params.r33**2]),
-        initial_covariance(params.p0),
+        F,
+        f_cols,
+        f_nnz,
+        Q,
+        R,
+        P0,
         gate_threshold(params.p_g, 3),
         gate_threshold(params.p_g, 2),
         float(params.p_d),

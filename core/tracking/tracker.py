@@ -20,7 +20,14 @@ from core.tracking import ekf, gating, initiation, ipda, management
 from core.tracking.models import process_noise, transition_matrix
 from core.tracking.params import TrackerParams
 
-__all__ = ["FrameTracks", "TrackerResult", "run_tracker", "frame_slices", "TrackerConstants"]
+__all__ = [
+    "FrameTracks",
+    "TrackerResult",
+    "run_tracker",
+    "frame_slices",
+    "TrackerConstants",
+    "gate_ellipses_xy",
+]
 
 TENTATIVE = 0
 CONFIRMED = 1
@@ -333,3 +340,25 @@ def run_tracker(
         n_confirmed=n_conf,
         frames=tuple(kept) if keep_tracks else None,
     )
+
+
+def gate_ellipses_xy(tracks: FrameTracks, n_points: int = 48) -> np.ndarray:
+    """All gate ellipses of a frame as one NaN-separated x–y curve (for one plot item).
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape (n_tracks · (n_points + 2), 2) in m: each closed ellipse {c + d : dᵀG⁻¹d = 1}
+        (n_points + 1 vertices) followed by a NaN row.
+    """
+    n = len(tracks)
+    t = np.linspace(0.0, 2.0 * np.pi, n_points + 1)
+    circle = np.stack((np.cos(t), np.sin(t)))  # (2, n_points + 1)
+    out = np.full((n, n_points + 2, 2), np.nan)
+    for i in range(n):
+        # G = V Λ Vᵀ; boundary points c + V Λ^{1/2} u, |u| = 1
+        w, V = np.linalg.eigh(tracks.gate_shape_xy[i])
+        out[i, :-1] = (
+            tracks.gate_center_xy[i][:, None] + (V * np.sqrt(np.maximum(w, 0))) @ circle
+        ).T
+    return out.reshape(-1, 2)

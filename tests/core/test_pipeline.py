@@ -59,14 +59,22 @@ def assert_clouds_identical(a, b) -> None:
 
 
 def test_clutter_density_of_the_paper_scene() -> None:
+    from core.processing import expected_false_alarms_per_frame
+
     scene = Scene.from_json(ROOT / "resources/scenes/paper_class_c.json")
-    # (λ·A + false alarms) / (Δr · Δaz · 2 v_max) = (2.0892 + 5.5e-4) / (9.5 · 2.0944 · 14.482)
-    rho = scene_clutter_density(scene)
-    assert rho == pytest.approx(0.0073, abs=0.0001)
-    assert rho == pytest.approx((2.0892 + 5.5e-4) / (9.5 * 2.0944 * 14.482), rel=2e-3)
-    # without clutter only the chain's own false alarms remain: ~2e-6
+    volume = 9.5 * (2 * np.pi / 3) * 2 * scene.radar.max_velocity_mps  # 288.1 m·rad·m/s
+    assert volume == pytest.approx(288.1, abs=0.1)
+    # SPEC's "about 0.0073" is the clutter term: λ·A / V = 2.0892 / 288.1
     quiet = dataclasses.replace(scene, clutter_density_per_m2=0.0)
-    assert 0 < scene_clutter_density(quiet) < 1e-5
+    rho_fa = scene_clutter_density(quiet)
+    rho = scene_clutter_density(scene)
+    assert rho - rho_fa == pytest.approx(0.00725, abs=0.00001)
+    # plus the chain's own noise detections (joint two-stage CFAR): ~0.20 per frame
+    n_fa = expected_false_alarms_per_frame(scene.radar, pipeline.processing_settings(scene))
+    assert 0.1 < n_fa < 0.3
+    assert rho_fa == pytest.approx(n_fa / volume, rel=1e-12)
+    assert rho == pytest.approx((2.0892 + n_fa) / volume, rel=1e-4)
+    assert rho == pytest.approx(0.00795, abs=0.0001)
 
 
 # ---- the plan ---------------------------------------------------------------------------------
@@ -105,9 +113,13 @@ def test_stages_declare_consistent_needs_and_products() -> None:
         produced |= set(s.produces)
 
 
-def test_unknown_fidelity_is_an_input_error() -> None:
+def test_unknown_fidelity_consumer_or_stage_is_an_input_error() -> None:
     with pytest.raises(InputError, match="fidelity"):
         plan(short_scene(), fidelity="approximate")
+    with pytest.raises(InputError, match="consumer"):
+        plan(short_scene(), consumer="printer")
+    with pytest.raises(InputError, match="clutterr"):
+        plan(short_scene(), force=("clutterr",))
 
 
 # ---- skipped stages are not executed and change nothing --------------------------------------
@@ -249,3 +261,51 @@ def test_static_reflectors_are_removed_by_the_chain() -> None:
     # the only -1 reflectors are static: static clutter removal must take them all out
     assert not np.any(src == -1)
     assert np.mean([np.any(c.source == 0) for c in run.clouds]) > 0.9
+
+
+def test_frame_scatterers_are_persons_clutter_and_static_reflectors() -> None:
+    from core.pipeline import frame_scatterers
+
+    scene = dataclasses.replace(
+        Scene.from_json(ROOT / "resources/scenes/waypoints_static.json"),
+        clutter_density_per_m2=0.2,
+    )
+    t, xy, v = scene.truth()
+    for f in (0, 10):
+        s = frame_scatterers(scene, f)
+        person = s.source == 0
+        assert person.sum() == 1
+        np.testing.assert_array_equal(s.position_m[person, :2], xy[f, :1])
+        np.testing.assert_array_equal(s.velocity_mps[person, :2], v[f, :1])
+        assert s.rcs_dbsm[person][0] == -8.0  # fixed in the scene file
+        static = (s.source == -1) & (np.abs(s.velocity_mps).sum(axis=1) == 0)
+        assert static.sum() == 3
+        moving_clutter = (s.source == -1) & ~static
+        # same stream as in a full run: equals the clutter count iter_frames reports
+        n = next(iter_frames(scene, frames=[f])).n_clutter
+        assert moving_clutter.sum() == n
+        assert np.all(np.abs(s.radial_velocity_mps[moving_clutter]) >= 2 * 0.4526)
+
+
+def test_dataset_of_scenes_with_a_ti_cfg_radar_from_another_folder(tmp_path, monkeypatch) -> None:
+    cfg = ROOT / "resources" / "radar" / "paper.cfg"
+    (tmp_path / "radar").mkdir()
+    (tmp_path / "radar" / "r.cfg").write_text(cfg.read_text())
+    (tmp_path / "scenes").mkdir()
+    scenes = []
+    for i, cls in enumerate("ce"):
+        doc = {
+            "schema_version": 1,
+            "radar": "../radar/r.cfg",
+            "seed": i,
+            "clutter_density_per_m2": 0.02,
+            "persons": [{"trajectory": {"class": cls, "seed": i, "duration_s": 0.8}}],
+        }
+        path = tmp_path / "scenes" / f"s{i}.json"
+        path.write_text(__import__("json").dumps(doc))
+        scenes.append(Scene.from_json(path))
+    (tmp_path / "elsewhere" / "deeper").mkdir(parents=True)
+    monkeypatch.chdir(tmp_path / "elsewhere" / "deeper")
+    ds = build_dataset(scenes, seed=0, jobs=2, use_cache=False)  # worker processes
+    assert ds.n_frames == 20 and list(ds.trajectory_class) == ["c", "e"]
+    assert '"../radar/r.cfg"' in ds.scene_json  # the data set keeps the scene as written

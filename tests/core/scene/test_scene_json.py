@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
 from pathlib import Path
 
@@ -63,6 +64,8 @@ def test_round_trip_gives_the_same_scene(tmp_path: Path) -> None:
     scene.to_json(out)
     again = Scene.from_json(out)
     assert again.canonical_json() == scene.canonical_json()
+    assert again == scene
+    assert dataclasses.replace(again, seed=8) != scene
     for p, q in zip(scene.persons, again.persons):
         np.testing.assert_array_equal(p.trajectory.position_m, q.trajectory.position_m)
     assert [f.name for f in tmp_path.iterdir() if f.name.startswith(".")] == []
@@ -124,6 +127,10 @@ def modified(**changes):
         (modified(radar={"n_loopz": 3}), "n_loopz"),
         (modified(radar="missing.cfg"), "missing.cfg"),
         (modified(seed=-1), "seed"),
+        (modified(static_reflectors__0__x_m=0.0, static_reflectors__0__y_m=0.0), "range 0"),
+        (modified(static_reflectors__0__y_m=30.0), "maximum range"),
+        (modified(persons__2__trajectory__initial_position_m=[0.0, 4.0]), "within 0.0"),
+        (modified(persons__0__model="blob"), "persons[0].model"),
     ],
 )
 def test_bad_scene_names_the_field(tmp_path: Path, data, expected: str) -> None:

@@ -14,6 +14,7 @@ from core.simulation import (
     receiver_voltage_scale,
     signal_amplitude_v,
     synthesize_baseband,
+    synthesize_signal,
 )
 
 RADAR = RadarConfig()
@@ -118,3 +119,35 @@ def test_snr_after_both_ffts_rectangular(range_m: float, expected_db: float) -> 
     # the signal lands in exactly this cell: the highest of the map
     rd = np.sum(np.abs(S) ** 2, axis=0)
     assert np.unravel_index(np.argmax(rd), rd.shape) == (k, j)
+
+
+def test_scatterers_validate_shapes_and_values() -> None:
+    from core.errors import InputError
+
+    with pytest.raises(InputError, match="velocity_mps"):
+        Scatterers(
+            position_m=np.ones((2, 3)),
+            velocity_mps=np.ones((1, 3)),
+            rcs_dbsm=np.zeros(2),
+            source=np.zeros(2, dtype=np.int32),
+        )
+    with pytest.raises(InputError, match="rcs_dbsm must be finite"):
+        one([1.0, 2.0, 0.0], [0.0, 0.0, 0.0], rcs=np.nan)
+    with pytest.raises(InputError, match="range 0"):
+        one([0.0, 0.0, 0.0], [0.0, 1.0, 0.0])
+    sc = one([3.0, 4.0, 0.0], [0.0, 0.0, 0.0])
+    assert sc.range_m[0] == pytest.approx(5.0) and sc.is_planar
+    assert sc.radial_velocity_mps[0] == 0.0
+
+
+def test_only_visible_scatterers_are_synthesised() -> None:
+    """Behind the radar or beyond the maximum range (where the beat frequency would alias to
+    a short range) nothing is received; in front and in range everything is."""
+    inside = one([1.0, 5.0, 0.0], [0.0, 1.0, 0.0])
+    far = one([0.0, RADAR.max_range_m + 6.0, 0.0], [0.0, 1.0, 0.0], rcs=30.0)
+    behind = one([0.0, -3.0, 0.0], [0.0, 1.0, 0.0], rcs=30.0)
+    both = Scatterers.concatenate([inside, far, behind])
+    np.testing.assert_array_equal(
+        synthesize_signal(RADAR, both, IDEAL), synthesize_signal(RADAR, inside, IDEAL)
+    )
+    assert not synthesize_signal(RADAR, far, IDEAL).any()

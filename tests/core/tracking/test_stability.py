@@ -12,6 +12,7 @@ from core.tracking.params import TrackerParams
 from core.tracking.stability import (
     all_corners,
     condition_number,
+    corner_params,
     stability_scene,
     sweep,
 )
@@ -151,3 +152,16 @@ def test_10000_frames_keep_the_condition_number_bounded(model):
     # bounded: the last thousand frames are no worse than the second thousand, and small
     k = len(cond) // 10
     assert cond[-k:].max() <= 2 * cond[k : 2 * k].max() and cond.max() < 1e6, cond.max()
+
+
+@pytest.mark.parametrize("model", ["cv", "ca"])
+def test_reference_tracker_on_a_sample_of_corners(model):
+    ds = stability_scene(40)
+    z, f_off = ds.measurements(), ds.frame_offsets
+    for bits in all_corners(model, 4, seed=7):
+        res = run_tracker((z, f_off), corner_params(model, bits))
+        for ft in res.frames:
+            assert np.all(np.isfinite(ft.state)) and np.all((ft.psi >= 0) & (ft.psi <= 1))
+            for P in ft.covariance:
+                np.testing.assert_array_equal(P, P.T)
+                np.linalg.cholesky(P)  # raises unless positive definite

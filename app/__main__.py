@@ -1,0 +1,7 @@
+"""``python -m app`` starts the GUI (same as ``radartune gui``)."""
+
+import sys
+
+from app.main import main
+
+sys.exit(main())

@@ -1,0 +1,206 @@
+"""Frozen, Qt-free snapshots that workers hand to the GUI thread.
+
+Views only draw these; they never compute physics or tracking. All arrays are numpy, SI units,
+and the x-y plane is the radar's (x to the right, y along boresight).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from core.errors import InputError
+from core.pointcloud import PointCloud
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class FrameData:
+    """One simulated radar frame as the GUI needs it.
+
+    Attributes
+    ----------
+    index
+        Frame index within the scene (0-based).
+    t_s
+        Frame time in s.
+    cloud
+        The frame's point cloud (with the ground-truth ``source`` label).
+    truth_xy_m
+        Person positions, shape ``(n_persons, 2)`` in m (NaN where a person has no position).
+    rd_map_db
+        Range-Doppler map in dB, shape ``(n_range_bins, n_doppler_bins)``, zero velocity
+        centred, or ``None`` when maps were not kept.
+    detections
+        CFAR detections, shape ``(n_det, 2)`` int: range bin, Doppler bin index into the map.
+    """
+
+    index: int
+    t_s: float
+    cloud: PointCloud
+    truth_xy_m: np.ndarray
+    rd_map_db: np.ndarray | None = None
+    detections: np.ndarray = field(default_factory=lambda: np.zeros((0, 2), dtype=np.int64))
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class TrackFrame:
+    """Every live track at one frame (n tracks).
+
+    Attributes
+    ----------
+    track_id
+        ``(n,)`` int, unique over the run.
+    xy_m
+        ``(n, 2)`` estimated position in m.
+    gate_center_xy_m
+        ``(n, 2)`` centre of the gate in x-y (the predicted position), m.
+    gate_shape_xy_m2
+        ``(n, 2, 2)`` gate ellipse G in x-y: the points d with dᵀ G⁻¹ d ≤ 1 (γ included), m².
+    psi
+        ``(n,)`` existence probability ψ in [0, 1].
+    confirmed
+        ``(n,)`` bool, True once the track is confirmed.
+    """
+
+    track_id: np.ndarray
+    xy_m: np.ndarray
+    gate_center_xy_m: np.ndarray
+    gate_shape_xy_m2: np.ndarray
+    psi: np.ndarray
+    confirmed: np.ndarray
+
+    @classmethod
+    def empty(cls) -> TrackFrame:
+        return cls(
+            track_id=np.zeros(0, dtype=np.int64),
+            xy_m=np.zeros((0, 2)),
+            gate_center_xy_m=np.zeros((0, 2)),
+            gate_shape_xy_m2=np.zeros((0, 2, 2)),
+            psi=np.zeros(0),
+            confirmed=np.zeros(0, dtype=bool),
+        )
+
+    def __len__(self) -> int:
+        return len(self.track_id)
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class TrackingResult:
+    """A tracker run over the cached frames, prepared for drawing.
+
+    Attributes
+    ----------
+    frames
+        One :class:`TrackFrame` per tracked frame (length F).
+    estimate_xy_m
+        ``(F, 2)`` the scene estimate (confirmed track with the highest ψ), NaN when none.
+    truth_xy_m
+        ``(F, 2)`` position of person 0 in m (the paper's single-person loss).
+    running_loss
+        ``(F,)`` eq. (13) over frames ``0..k``: L = MSE / N_c (1.0 m² while N_c = 0).
+    running_rmse_m
+        ``(F,)`` position RMSE over the frames with an estimate so far (NaN while none).
+    ospa_m
+        ``(F,)`` OSPA distance (c = 1 m, p = 2) between confirmed tracks and persons per frame.
+    psi_t_s, psi_value
+        ψ of every track against time, one NaN-separated curve (tracks in id order).
+    psi_confirmed_t_s, psi_confirmed_value
+        The same restricted to frames where the track is confirmed.
+    trail_id, trail_t_index, trail_xy_m
+        Position of every track at every frame it lived, sorted by (id, frame).
+    params_key
+        Identifies the parameter vector the run used (drop stale results).
+    elapsed_s
+        Wall-clock time of the tracker run plus preparation, in s.
+    """
+
+    frames: tuple[TrackFrame, ...]
+    estimate_xy_m: np.ndarray
+    truth_xy_m: np.ndarray
+    running_loss: np.ndarray
+    running_rmse_m: np.ndarray
+    ospa_m: np.ndarray
+    psi_t_s: np.ndarray
+    psi_value: np.ndarray
+    psi_confirmed_t_s: np.ndarray
+    psi_confirmed_value: np.ndarray
+    trail_t_index: np.ndarray
+    trail_xy_m: np.ndarray
+    trail_id: np.ndarray
+    params_key: str = ""
+    elapsed_s: float = 0.0
+    #: False for the fast first stage (compiled kernel: estimate, confirmed positions, metrics;
+    #: no track ids, ψ or gates), True once the readable tracker delivered every track.
+    detail: bool = True
+
+    @property
+    def n_frames(self) -> int:
+        return len(self.frames)
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class ParamSpec:
+    """One slider: a tracker parameter with its search-space range.
+
+    ``name`` uses the search-space naming (``q_coeff``, ``p0_00`` …); ``log`` selects a
+    logarithmic slider.
+    """
+
+    name: str
+    low: float
+    high: float
+    log: bool
+    label: str = ""
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class StudyForm:
+    """What the study panel edits."""
+
+    model: str = "cv"
+    n_trials: int = 50
+    n_jobs: int = 1
+    storage: str = "radartune-studies.db"
+    study_name: str = ""
+    seed: int = 0
+    #: "scene": the current scene's cached point clouds; "paper": the paper's 35 trajectories
+    dataset: str = "scene"
+
+    def __post_init__(self) -> None:
+        if self.model not in ("cv", "ca"):
+            raise InputError(f"model must be 'cv' or 'ca', got {self.model!r}", "model")
+        if self.n_trials < 1:
+            raise InputError(f"trials must be >= 1, got {self.n_trials}", "trials")
+        if self.n_jobs < 1:
+            raise InputError(f"jobs must be >= 1, got {self.n_jobs}", "jobs")
+        if not self.storage.strip():
+            raise InputError("storage must not be empty", "storage")
+        if self.dataset not in ("scene", "paper"):
+            raise InputError(
+                f"data set must be 'scene' or 'paper', got {self.dataset!r}", "dataset"
+            )
+
+    @property
+    def effective_name(self) -> str:
+        return self.study_name or f"radartune-{self.model}"
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class StudyProgress:
+    """A snapshot of a study (from its storage)."""
+
+    n_complete: int = 0
+    n_pruned: int = 0
+    n_failed: int = 0
+    n_running: int = 0
+    best_loss: float = float("nan")
+    best_params: dict = field(default_factory=dict)
+    best_model: str = "cv"
+    #: best-so-far loss against wall-clock seconds since the first trial started
+    curve_t_s: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    curve_best: np.ndarray = field(default_factory=lambda: np.zeros(0))
+
+    @property
+    def n_finished(self) -> int:
+        return self.n_complete + self.n_pruned + self.n_failed

@@ -1,0 +1,102 @@
+"""ψ (existence probability) of every track against time, with the thresholds, and the
+running metrics (loss, RMSE, OSPA) against time."""
+
+from __future__ import annotations
+
+import numpy as np
+import pyqtgraph as pg
+from PySide6 import QtCore
+
+from app.data import TrackingResult
+
+
+class PsiView(pg.GraphicsLayoutWidget):
+    """Top: ψ per track (tentative yellow, confirmed green); bottom: running loss and OSPA."""
+
+    def __init__(self, parent=None) -> None:
+        super().__init__(parent)
+        self.setObjectName("psiView")
+        self.psi_plot = self.addPlot(row=0, col=0)
+        self.psi_plot.setTitle("Existence probability ψ")
+        self.psi_plot.setLabel("left", "ψ")
+        self.psi_plot.setLabel("bottom", "time", units="s")
+        self.psi_plot.setYRange(0.0, 1.05, padding=0)
+        self.psi_plot.showGrid(y=True, alpha=0.2)
+        self.psi_all = self.psi_plot.plot(pen=pg.mkPen((240, 220, 40, 120), width=1))
+        self.psi_confirmed = self.psi_plot.plot(pen=pg.mkPen((0, 220, 90), width=2))
+        self.confirm_line = pg.InfiniteLine(
+            angle=0,
+            pen=pg.mkPen((0, 220, 90), style=QtCore.Qt.DashLine),
+            label="confirm {value:.2f}",
+            labelOpts={"position": 0.9, "color": (0, 220, 90), "anchors": [(1, 1), (1, 1)]},
+        )
+        self.delete_line = pg.InfiniteLine(
+            angle=0,
+            pen=pg.mkPen((255, 80, 80), style=QtCore.Qt.DashLine),
+            label="delete {value:.2f}",
+            labelOpts={"position": 0.9, "color": (255, 80, 80), "anchors": [(1, 0), (1, 0)]},
+        )
+        self.psi_plot.addItem(self.confirm_line)
+        self.psi_plot.addItem(self.delete_line)
+        self.cursor = pg.InfiniteLine(angle=90, pen=pg.mkPen((200, 200, 200), width=1))
+        self.psi_plot.addItem(self.cursor)
+
+        self.metric_plot = self.addPlot(row=1, col=0)
+        self.metric_plot.setTitle("Running metrics")
+        self.metric_plot.setLabel("bottom", "time", units="s")
+        self.metric_plot.setLabel("left", "RMSE, OSPA", units="m")
+        self.metric_plot.addLegend(offset=(5, 5))
+        self.metric_plot.setXLink(self.psi_plot)
+        self.rmse_curve = self.metric_plot.plot(pen=pg.mkPen((255, 140, 0), width=2), name="RMSE")
+        self.ospa_curve = self.metric_plot.plot(pen=pg.mkPen((60, 140, 255), width=1), name="OSPA")
+        self.cursor2 = pg.InfiniteLine(angle=90, pen=pg.mkPen((200, 200, 200), width=1))
+        self.metric_plot.addItem(self.cursor2)
+        self.metric_text = pg.LabelItem(justify="left", color=(230, 230, 230), size="9pt")
+        self.addItem(self.metric_text, row=2, col=0)
+        self.ci.layout.setRowStretchFactor(0, 3)
+        self.ci.layout.setRowStretchFactor(1, 2)
+        self.set_thresholds(0.9, 0.1)
+        self._frame_period_s = 0.08
+        self._result: TrackingResult | None = None
+        self._metric_text = ""
+        self.n_draws = 0
+
+    def set_thresholds(self, confirm: float, delete: float) -> None:
+        self.confirm_line.setValue(confirm)
+        self.delete_line.setValue(delete)
+
+    def set_result(self, result: TrackingResult | None, frame_period_s: float) -> None:
+        """Redraw the curves of a whole tracker run."""
+        self._frame_period_s = frame_period_s
+        self._result = result
+        if result is None or result.n_frames == 0:
+            for c in (self.psi_all, self.psi_confirmed, self.rmse_curve, self.ospa_curve):
+                c.setData([], [])
+            return
+        self.psi_all.setData(result.psi_t_s, result.psi_value, connect="finite")
+        self.psi_confirmed.setData(
+            result.psi_confirmed_t_s, result.psi_confirmed_value, connect="finite"
+        )
+        t = np.arange(result.n_frames) * frame_period_s
+        self.rmse_curve.setData(t, result.running_rmse_m, connect="finite")
+        self.ospa_curve.setData(t, result.ospa_m, connect="finite")
+        self.psi_plot.setXRange(0.0, max(t[-1], frame_period_s), padding=0.02)
+
+    def set_frame(self, index: int) -> None:
+        self.n_draws += 1
+        t = index * self._frame_period_s
+        self.cursor.setValue(t)
+        self.cursor2.setValue(t)
+        r = self._result
+        if r is None or index >= r.n_frames:
+            text = "running loss –<br>RMSE – · OSPA –"
+        else:
+            rmse = r.running_rmse_m[index]
+            rmse_t = "–" if rmse != rmse else f"{rmse:.3f} m"
+            text = (
+                f"t = {t:.2f} s · running loss L = {r.running_loss[index]:.3g} m²<br>"
+                f"RMSE {rmse_t} · OSPA {r.ospa_m[index]:.3f} m"
+            )
+        if text != self._metric_text:
+            self._metric_text = text
+            self.metric_text.setText(text)

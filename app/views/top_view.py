@@ -1,0 +1,307 @@
+"""Top view (x-y): AOI, ground-truth paths, point cloud with persistence, tracker overlay.
+
+All pyqtgraph items are created once in ``__init__`` and updated with ``setData``. Point and
+track colours come from pre-built brush palettes (per-point brush construction is ~8× slower).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+import pyqtgraph as pg
+from PySide6 import QtCore, QtGui
+
+from app.data import FrameData, TrackFrame, TrackingResult
+from app.geometry import aoi_polyline, ellipse_polyline, trails_polyline
+
+SNR_MIN_DB = 10.0
+SNR_MAX_DB = 50.0
+N_SNR_COLOURS = 32
+N_PSI_LEVELS = 11
+
+LABEL_COLOURS = {"person": (255, 140, 0), "clutter": (60, 140, 255), "noise": (160, 160, 160)}
+
+
+def _snr_palette() -> list[QtGui.QBrush]:
+    cmap = pg.colormap.get("plasma")
+    colours = cmap.getLookupTable(0.0, 1.0, N_SNR_COLOURS, alpha=False)
+    return [pg.mkBrush(int(r), int(g), int(b), 230) for r, g, b in colours]
+
+
+def _psi_palette(rgb: tuple[int, int, int]) -> list[QtGui.QBrush]:
+    # opacity shows ψ: ψ = 0 → faint, ψ = 1 → opaque
+    return [pg.mkBrush(*rgb, int(40 + 215 * k / (N_PSI_LEVELS - 1))) for k in range(N_PSI_LEVELS)]
+
+
+class TopView(pg.PlotWidget):
+    """x-y plot of one frame; call :meth:`show_frame`.
+
+    Also the waypoint editor: in draw mode a click appends a waypoint (``waypoint_added``);
+    waypoints are draggable (``waypoints_moved`` with all rows ``[x_m, y_m, speed_mps]``).
+    """
+
+    waypoint_added = QtCore.Signal(float, float)
+    waypoints_moved = QtCore.Signal(list)
+
+    def __init__(self, parent=None) -> None:
+        super().__init__(parent)
+        self.setObjectName("topView")
+        self.setAspectLocked(True)
+        self.setLabel("bottom", "x", units="m")
+        self.setLabel("left", "y", units="m")
+        self.setTitle("Top view · points: SNR 10–50 dB")
+        self.showGrid(x=True, y=True, alpha=0.2)
+        self.addLegend(offset=(5, 5))
+        self._snr_brushes = _snr_palette()
+        self._label_brushes = {k: pg.mkBrush(*c, 220) for k, c in LABEL_COLOURS.items()}
+        self._snr_array = np.empty(N_SNR_COLOURS, dtype=object)
+        self._snr_array[:] = self._snr_brushes
+        self._label_array = np.empty(3, dtype=object)
+        self._label_array[:] = [self._label_brushes[k] for k in ("person", "clutter", "noise")]
+        self._confirmed_brushes = _psi_palette((0, 220, 90))
+        self._tentative_brushes = _psi_palette((240, 220, 40))
+
+        self.aoi = self.plot(pen=pg.mkPen((120, 120, 120), width=1, style=QtCore.Qt.DashLine))
+        self.reflectors = pg.ScatterPlotItem(
+            symbol="s", size=10, brush=pg.mkBrush(150, 75, 0), pen=None, name="static reflector"
+        )
+        self.addItem(self.reflectors)
+        self.truth_path = self.plot(
+            pen=pg.mkPen((255, 255, 255, 110), width=1.5), connect="finite", name="truth path"
+        )
+        self.points = pg.ScatterPlotItem(size=6, pen=None, name="points")
+        self.addItem(self.points)
+        self.trails = self.plot(pen=pg.mkPen((0, 220, 90, 150), width=1.5), connect="finite")
+        self.gates_confirmed = self.plot(
+            pen=pg.mkPen((0, 220, 90), width=1), connect="finite", name="gate (confirmed)"
+        )
+        self.gates_tentative = self.plot(
+            pen=pg.mkPen((240, 220, 40), width=1, style=QtCore.Qt.DotLine),
+            connect="finite",
+            name="gate (tentative)",
+        )
+        self.truth_now = pg.ScatterPlotItem(
+            symbol="star",
+            size=14,
+            brush=None,
+            pen=pg.mkPen((255, 255, 255), width=1.5),
+            name="truth",
+        )
+        self.addItem(self.truth_now)
+        self.tracks = pg.ScatterPlotItem(size=13, pen=pg.mkPen("k", width=1), name="tracks")
+        self.addItem(self.tracks)
+        self.estimate = pg.ScatterPlotItem(
+            symbol="x", size=16, pen=pg.mkPen((255, 40, 40), width=2), brush=None, name="estimate"
+        )
+        self.addItem(self.estimate)
+        self._labels: list[pg.TextItem] = []
+        # drawing order: gates and tracks under the points, truth and estimate on top
+        for z, item in enumerate(
+            (self.aoi, self.truth_path, self.trails, self.gates_tentative, self.gates_confirmed,
+             self.tracks, self.reflectors, self.points, self.truth_now, self.estimate)
+        ):  # fmt: skip
+            item.setZValue(z)
+        self.waypoint_line = self.plot(
+            pen=pg.mkPen((255, 0, 255), width=1, style=QtCore.Qt.DashLine), symbol=None
+        )
+        self._waypoint_items: list[pg.TargetItem] = []
+        self._waypoint_rows: list[list[float]] = []
+        self.draw_mode = False
+        self.scene().sigMouseClicked.connect(self._on_click)
+
+        self.colour_by = "snr"  # or "label"
+        self.persistence = 5
+        self.trail_length = 25
+        self.n_draws = 0
+        self.last_n_points = 0
+        self.last_n_tracks = 0
+        self.set_aoi(0.5, 10.0, 60.0)
+        # once the user pans or zooms, the view stays where they put it
+        self.getPlotItem().vb.sigRangeChangedManually.connect(self._stop_auto_fit)
+
+    # ---- static content ---------------------------------------------------------------------
+    def set_aoi(self, min_range_m: float, max_range_m: float, max_azimuth_deg: float) -> None:
+        line = aoi_polyline(min_range_m, max_range_m, max_azimuth_deg)
+        self.aoi.setData(line[:, 0], line[:, 1])
+        half = max_range_m * np.sin(np.deg2rad(max_azimuth_deg))
+        self._aoi_rect = QtCore.QRectF(-half - 0.5, -0.2, 2 * half + 1.0, max_range_m + 0.7)
+        self._auto_fit = True
+        self.fit_aoi()
+
+    def fit_aoi(self) -> None:
+        """Show the whole AOI (the aspect lock widens whichever axis it must)."""
+        self.getPlotItem().vb.setRange(rect=self._aoi_rect, padding=0)
+
+    def resizeEvent(self, event) -> None:
+        super().resizeEvent(event)
+        if getattr(self, "_auto_fit", False):
+            self.fit_aoi()
+
+    def _stop_auto_fit(self, *_args) -> None:
+        self._auto_fit = False
+
+    def set_reflectors(self, xy_m: np.ndarray) -> None:
+        xy = np.asarray(xy_m, dtype=float).reshape(-1, 2)
+        self.reflectors.setData(xy[:, 0], xy[:, 1])
+
+    def set_truth_paths(self, paths_m: Sequence[np.ndarray]) -> None:
+        """Full ground-truth path of every person, each ``(F_i, 2)`` in m."""
+        parts = []
+        for p in paths_m:
+            parts.append(np.asarray(p, dtype=float).reshape(-1, 2))
+            parts.append(np.full((1, 2), np.nan))
+        line = np.vstack(parts) if parts else np.zeros((0, 2))
+        self.truth_path.setData(line[:, 0], line[:, 1], connect="finite")
+
+    # ---- waypoint editor ---------------------------------------------------------------------
+    def set_draw_mode(self, on: bool) -> None:
+        self.draw_mode = bool(on)
+        self.setCursor(QtCore.Qt.CrossCursor if on else QtCore.Qt.ArrowCursor)
+
+    def set_waypoints(self, rows) -> None:
+        """Show the selected person's waypoints (``None``: not a drawn trajectory)."""
+        rows = [list(map(float, r)) for r in (rows or [])]
+        self._waypoint_rows = rows
+        while len(self._waypoint_items) > len(rows):
+            self.removeItem(self._waypoint_items.pop())
+        while len(self._waypoint_items) < len(rows):
+            item = pg.TargetItem(
+                pos=(0.0, 0.0), size=12, movable=True, pen=pg.mkPen((255, 0, 255), width=2)
+            )
+            item.sigPositionChangeFinished.connect(self._on_waypoint_dragged)
+            self.addItem(item)
+            self._waypoint_items.append(item)
+        for item, (x, y, _v) in zip(self._waypoint_items, rows):
+            item.blockSignals(True)
+            item.setPos(x, y)
+            item.blockSignals(False)
+        xy = np.array([r[:2] for r in rows]).reshape(-1, 2)
+        self.waypoint_line.setData(xy[:, 0], xy[:, 1])
+
+    def _on_waypoint_dragged(self, *_args) -> None:
+        rows = []
+        for item, row in zip(self._waypoint_items, self._waypoint_rows):
+            p = item.pos()
+            rows.append([round(p.x(), 3), round(p.y(), 3), row[2]])
+        self.waypoints_moved.emit(rows)
+
+    def _on_click(self, event) -> None:
+        if not self.draw_mode or event.button() != QtCore.Qt.LeftButton:
+            return
+        p = self.getPlotItem().vb.mapSceneToView(event.scenePos())
+        self.waypoint_added.emit(float(p.x()), float(p.y()))
+
+    # ---- per frame ----------------------------------------------------------------------------
+    def set_colour_by(self, mode: str) -> None:
+        self.colour_by = mode
+        self.setTitle(
+            "Top view · points: SNR 10–50 dB"
+            if mode == "snr"
+            else "Top view · points: person / clutter / noise"
+        )
+
+    def _point_brushes(
+        self, frames: Sequence[FrameData]
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        xs, ys, keys = [], [], []
+        for f in frames:
+            c = f.cloud
+            xs.append(c.x_m)
+            ys.append(c.y_m)
+            if self.colour_by == "snr":
+                k = (c.snr_db - SNR_MIN_DB) / (SNR_MAX_DB - SNR_MIN_DB) * (N_SNR_COLOURS - 1)
+                keys.append(np.clip(np.round(k), 0, N_SNR_COLOURS - 1).astype(int))
+            else:
+                keys.append(np.asarray(c.source))
+        if not xs:
+            return np.zeros(0), np.zeros(0), np.zeros(0, dtype=object)
+        x, y, key = np.concatenate(xs), np.concatenate(ys), np.concatenate(keys)
+        if self.colour_by == "snr":
+            brushes = self._snr_array[key]
+        else:
+            # source >= 0 person, -1 clutter, -2 noise  ->  palette index 0, 1, 2
+            brushes = self._label_array[np.clip(-key, 0, 2)]
+        return x, y, brushes
+
+    def show_frame(
+        self,
+        index: int,
+        frames: Sequence[FrameData],
+        tracking: TrackingResult | None = None,
+    ) -> None:
+        """Draw frame ``index`` with the points of the last ``persistence`` frames.
+
+        ``frames`` is the cache (``frames[i].index == i``); ``tracking`` may cover fewer frames.
+        """
+        self.n_draws += 1
+        if not frames or index < 0:
+            self.points.setData([], [])
+            self.truth_now.setData([], [])
+            self._show_tracks(TrackFrame.empty(), None, index)
+            return
+        index = min(index, len(frames) - 1)
+        window = frames[max(0, index - self.persistence + 1) : index + 1]
+        x, y, brushes = self._point_brushes(window)
+        self.points.setData(x=x, y=y, brush=brushes)
+        self.last_n_points = len(x)
+        truth = frames[index].truth_xy_m
+        ok = np.isfinite(truth).all(axis=1)
+        self.truth_now.setData(truth[ok, 0], truth[ok, 1])
+        if tracking is not None and index < tracking.n_frames:
+            self._show_tracks(tracking.frames[index], tracking, index)
+        else:
+            self._show_tracks(TrackFrame.empty(), None, index)
+
+    def _show_tracks(self, tf: TrackFrame, tracking: TrackingResult | None, index: int) -> None:
+        n = len(tf)
+        self.last_n_tracks = n
+        if n == 0:
+            self.tracks.setData([], [])
+            self.gates_confirmed.setData([], [])
+            self.gates_tentative.setData([], [])
+            self.trails.setData([], [])
+            self.estimate.setData([], [])
+            for label in self._labels:
+                label.hide()
+            return
+        psi = np.nan_to_num(tf.psi, nan=1.0)  # fast stage: ψ not known yet, drawn opaque
+        level = np.clip(np.round(psi * (N_PSI_LEVELS - 1)), 0, N_PSI_LEVELS - 1).astype(int)
+        brushes = [
+            (self._confirmed_brushes if c else self._tentative_brushes)[k]
+            for k, c in zip(level, tf.confirmed)
+        ]
+        symbols = ["o" if c else "t" for c in tf.confirmed]
+        self.tracks.setData(x=tf.xy_m[:, 0], y=tf.xy_m[:, 1], brush=brushes, symbol=symbols)
+        conf = tf.confirmed
+        c, g = tf.gate_center_xy_m, tf.gate_shape_xy_m2
+        e = ellipse_polyline(c[conf], g[conf], 1.0)
+        self.gates_confirmed.setData(e[:, 0], e[:, 1], connect="finite")
+        e = ellipse_polyline(c[~conf], g[~conf], 1.0)
+        self.gates_tentative.setData(e[:, 0], e[:, 1], connect="finite")
+        if tracking is not None:
+            t = trails_polyline(
+                tracking.trail_id,
+                tracking.trail_t_index,
+                tracking.trail_xy_m,
+                index,
+                self.trail_length,
+                tf.track_id[tf.confirmed],
+            )
+            self.trails.setData(t[:, 0], t[:, 1], connect="finite")
+            est = tracking.estimate_xy_m[index]
+            if np.isfinite(est).all():
+                self.estimate.setData([est[0]], [est[1]])
+            else:
+                self.estimate.setData([], [])
+        while len(self._labels) < n:
+            label = pg.TextItem(color=(230, 230, 230), anchor=(0, 1))
+            self.addItem(label)
+            self._labels.append(label)
+        for k, label in enumerate(self._labels):
+            if k < n and tf.track_id[k] >= 0:
+                label.setText(f"{tf.track_id[k]} ψ={tf.psi[k]:.2f}")
+                label.setPos(float(tf.xy_m[k, 0]) + 0.1, float(tf.xy_m[k, 1]) + 0.1)
+                label.show()
+            else:
+                label.hide()

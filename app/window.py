@@ -1,0 +1,731 @@
+"""The main window: live views in the centre, editor panels in docks, playback toolbar,
+persistence of settings and layout (QSettings)."""
+
+from __future__ import annotations
+
+import json
+import time
+import webbrowser
+from collections import deque
+from pathlib import Path
+
+from PySide6 import QtCore, QtGui, QtWidgets
+
+from app.engine import Engine
+from app.models import (
+    FrameCache,
+    PlaybackModel,
+    RadarModel,
+    SceneModel,
+    TrackerParamsModel,
+    TrackingModel,
+)
+from app.panels.radar_panel import RadarPanel
+from app.panels.scene_panel import ScenePanel
+from app.panels.study_panel import StudyPanel
+from app.panels.tracker_panel import TrackerPanel
+from app.study import StudyController, StudyModel
+from app.views.psi_view import PsiView
+from app.views.rd_view import RangeDopplerView
+from app.views.top_view import TopView
+from app.workers import SimulationController, TrackingController, describe_error, freeze_heap
+from core.config import PAPER_RADAR
+from core.errors import InputError
+
+DRAW_INTERVAL_MS = 30  # GUI draw timer: at most ~33 redraws per second, stale frames dropped
+SPEEDS = (0.25, 0.5, 1.0, 2.0, 4.0, 8.0)
+RETRACK_EVERY_N_FRAMES = 20  # while the simulation fills the cache
+
+
+class MainWindow(QtWidgets.QMainWindow):
+    """RadarTune main window. ``settings`` must be given (tests pass a temporary one)."""
+
+    def __init__(
+        self,
+        settings: QtCore.QSettings,
+        engine: Engine | None = None,
+        *,
+        load_scene: bool = True,
+        scene_path: str | None = None,
+        restore: bool = True,
+    ) -> None:
+        super().__init__()
+        self.setObjectName("mainWindow")
+        self.setWindowTitle("RadarTune")
+        self.settings = settings
+        self.engine = engine or Engine()
+        self.errors: list[str] = []
+        self._error_box: QtWidgets.QMessageBox | None = None
+
+        # ---- models ----------------------------------------------------------------------------
+        self.scene_model = SceneModel(self.engine, self)
+        self.radar_model = RadarModel(PAPER_RADAR, self)
+        self.params_model = TrackerParamsModel(self.engine, self)
+        self.cache = FrameCache(self)
+        self.tracking_model = TrackingModel(self)
+        self.playback = PlaybackModel(self)
+        self.study_model = StudyModel(self)
+
+        # ---- controllers -----------------------------------------------------------------------
+        self.sim = SimulationController(self.engine, self.cache, self)
+        self.tracker = TrackingController(
+            self.engine, self.cache, self.params_model, self.tracking_model, parent=self
+        )
+        self.study = StudyController(self.engine, self.study_model, parent=self)
+
+        # ---- views -----------------------------------------------------------------------------
+        self.top_view = TopView()
+        self.rd_view = RangeDopplerView()
+        self.psi_view = PsiView()
+        right = QtWidgets.QSplitter(QtCore.Qt.Vertical)
+        right.setObjectName("rightSplitter")
+        right.addWidget(self.rd_view)
+        right.addWidget(self.psi_view)
+        right.setSizes([350, 350])
+        central = QtWidgets.QSplitter(QtCore.Qt.Horizontal)
+        central.setObjectName("centralSplitter")
+        central.addWidget(self.top_view)
+        central.addWidget(right)
+        central.setSizes([620, 480])
+        self.central_splitter, self.right_splitter = central, right
+        self.setCentralWidget(central)
+
+        # ---- panels in docks -----------------------------------------------------------------
+        self.scene_panel = ScenePanel(self.scene_model, self.engine)
+        self.radar_panel = RadarPanel(self.radar_model)
+        self.tracker_panel = TrackerPanel(self.params_model)
+        self.study_panel = StudyPanel(self.study_model)
+        self.docks: dict[str, QtWidgets.QDockWidget] = {}
+        self._dock("Scene", self.scene_panel, QtCore.Qt.LeftDockWidgetArea)
+        self._dock("Radar", self.radar_panel, QtCore.Qt.LeftDockWidgetArea)
+        self._dock("Tracker", self.tracker_panel, QtCore.Qt.RightDockWidgetArea)
+        self._dock("Study", self.study_panel, QtCore.Qt.RightDockWidgetArea)
+        self.tabifyDockWidget(self.docks["Scene"], self.docks["Radar"])
+        self.tabifyDockWidget(self.docks["Tracker"], self.docks["Study"])
+        self.docks["Scene"].raise_()
+        self.docks["Tracker"].raise_()
+
+        self._build_playback_bar()
+        self._build_view_bar()
+        self._build_menus()
+        self._build_status()
+
+        # ---- wiring ----------------------------------------------------------------------------
+        self.scene_model.changed.connect(self._on_scene_changed)
+        self.radar_model.changed.connect(self._on_radar_edited)
+        self.cache.reset.connect(self._on_cache_reset)
+        self.cache.frames_added.connect(self._on_frames_added)
+        self.cache.finished.connect(self._on_cache_finished)
+        self.sim.failed.connect(lambda m: self.show_error(f"simulation failed: {m}"))
+        self.tracker.failed.connect(lambda m: self.show_error(f"tracking failed: {m}"))
+        self.tracker.finished.connect(self._on_tracked)
+        self.tracking_model.changed.connect(self._on_tracking_changed)
+        self.params_model.changed.connect(self._on_params_changed)
+        self.playback.frame_changed.connect(self._on_frame_changed)
+        self.playback.playing_changed.connect(self._on_playing_changed)
+        self.playback.speed_changed.connect(self._on_speed_changed)
+        for panel in (self.scene_panel, self.radar_panel, self.tracker_panel, self.study_panel):
+            panel.error.connect(self.show_error)
+        self.radar_panel.load_cfg_requested.connect(self.load_cfg_dialog)
+        self.scene_panel.draw_mode_changed.connect(self.top_view.set_draw_mode)
+        self.top_view.waypoint_added.connect(self.scene_panel.append_waypoint)
+        self.top_view.waypoints_moved.connect(self.scene_panel.set_waypoints)
+        self.tracker_panel.apply_best_requested.connect(self.apply_best)
+        self.study_panel.apply_best_requested.connect(self.apply_best)
+        self.study_panel.start_requested.connect(self.start_study)
+        self.study_panel.stop_requested.connect(self.study.stop)
+        self.study_panel.enqueue_requested.connect(self.enqueue_current)
+        self.study_panel.dashboard_requested.connect(self.open_dashboard)
+        self.study_panel.browse_requested.connect(self.browse_storage)
+        self.study_model.progress_changed.connect(
+            lambda p: self.tracker_panel.apply_best_button.setEnabled(bool(p.best_params))
+        )
+        self.study_model.message.connect(lambda m: self.statusBar().showMessage(m, 8000))
+        self.study_model.form_changed.connect(lambda _f: self.study.refresh())
+
+        self._scene_timer = QtCore.QTimer(self)
+        self._scene_timer.setSingleShot(True)
+        self._scene_timer.setInterval(150)
+        self._scene_timer.timeout.connect(self._resimulate)
+        self._play_timer = QtCore.QTimer(self)
+        self._play_timer.timeout.connect(self._on_play_tick)
+        self._draw_timer = QtCore.QTimer(self)
+        self._draw_timer.setInterval(DRAW_INTERVAL_MS)
+        self._draw_timer.timeout.connect(self._draw)
+        self._draw_timer.start()
+        self._dirty = True
+        self._draw_times: deque[float] = deque(maxlen=60)
+        self.n_draws = 0
+        self._frame_period_s = PAPER_RADAR.frame_period_s
+        self._update_play_interval()
+
+        if restore:
+            self.restore_settings()
+        if load_scene:
+            self.load_initial_scene(scene_path)
+        freeze_heap()
+
+    # ---- construction helpers ----
+    def _dock(self, title: str, widget: QtWidgets.QWidget, area) -> None:
+        scroll = QtWidgets.QScrollArea()
+        scroll.setWidget(widget)
+        scroll.setWidgetResizable(True)
+        scroll.setFrameShape(QtWidgets.QFrame.NoFrame)
+        dock = QtWidgets.QDockWidget(title, self)
+        dock.setObjectName(f"dock{title}")
+        dock.setWidget(scroll)
+        dock.setMinimumWidth(300)
+        self.addDockWidget(area, dock)
+        self.docks[title] = dock
+
+    def _build_playback_bar(self) -> None:
+        bar = QtWidgets.QToolBar("Playback", self)
+        bar.setObjectName("playbackBar")
+        self.playback_bar = bar
+        self.addToolBar(QtCore.Qt.BottomToolBarArea, bar)
+        style = self.style()
+        self.act_back = bar.addAction(
+            style.standardIcon(QtWidgets.QStyle.SP_MediaSeekBackward), "Step back"
+        )
+        self.act_play = bar.addAction(style.standardIcon(QtWidgets.QStyle.SP_MediaPlay), "Play")
+        self.act_play.setCheckable(True)
+        self.act_fwd = bar.addAction(
+            style.standardIcon(QtWidgets.QStyle.SP_MediaSeekForward), "Step forward"
+        )
+        self.act_back.setShortcut(QtGui.QKeySequence(QtCore.Qt.Key_Left))
+        self.act_fwd.setShortcut(QtGui.QKeySequence(QtCore.Qt.Key_Right))
+        self.act_play.setShortcut(QtGui.QKeySequence(QtCore.Qt.Key_Space))
+        self.speed_combo = QtWidgets.QComboBox()
+        self.speed_combo.setObjectName("speedCombo")
+        for s in SPEEDS:
+            self.speed_combo.addItem(f"{s:g}×", s)
+        self.speed_combo.setCurrentIndex(SPEEDS.index(1.0))
+        bar.addWidget(QtWidgets.QLabel(" speed "))
+        bar.addWidget(self.speed_combo)
+        self.timeline = QtWidgets.QSlider(QtCore.Qt.Horizontal)
+        self.timeline.setObjectName("timeline")
+        self.timeline.setRange(0, 0)
+        self.timeline.setMinimumWidth(300)
+        bar.addWidget(self.timeline)
+        self.frame_label = QtWidgets.QLabel("frame – / –")
+        self.frame_label.setObjectName("frameLabel")
+        self.frame_label.setMinimumWidth(170)
+        bar.addWidget(self.frame_label)
+        self.fps_label = QtWidgets.QLabel()
+        self.fps_label.setObjectName("fpsLabel")
+        self.fps_label.setMinimumWidth(230)
+        bar.addWidget(self.fps_label)
+        self.act_back.triggered.connect(lambda: self._step(-1))
+        self.act_fwd.triggered.connect(lambda: self._step(1))
+        self.act_play.toggled.connect(self.playback.set_playing)
+        self.speed_combo.currentIndexChanged.connect(
+            lambda i: self.playback.set_speed(self.speed_combo.itemData(i))
+        )
+        self.timeline.valueChanged.connect(self.playback.set_frame)
+
+    def _build_view_bar(self) -> None:
+        bar = QtWidgets.QToolBar("View", self)
+        bar.setObjectName("viewBar")
+        self.addToolBar(QtCore.Qt.TopToolBarArea, bar)
+        bar.addWidget(QtWidgets.QLabel(" points coloured by "))
+        self.colour_combo = QtWidgets.QComboBox()
+        self.colour_combo.setObjectName("colourCombo")
+        self.colour_combo.addItem("SNR", "snr")
+        self.colour_combo.addItem("label (person / clutter / noise)", "label")
+        bar.addWidget(self.colour_combo)
+        bar.addWidget(QtWidgets.QLabel("  persistence "))
+        self.persistence_spin = QtWidgets.QSpinBox()
+        self.persistence_spin.setObjectName("persistenceSpin")
+        self.persistence_spin.setRange(1, 100)
+        self.persistence_spin.setSuffix(" frames")
+        bar.addWidget(self.persistence_spin)
+        bar.addWidget(QtWidgets.QLabel("  trail "))
+        self.trail_spin = QtWidgets.QSpinBox()
+        self.trail_spin.setObjectName("trailSpin")
+        self.trail_spin.setRange(1, 1000)
+        self.trail_spin.setSuffix(" frames")
+        bar.addWidget(self.trail_spin)
+        self.colour_combo.currentIndexChanged.connect(self._on_view_options)
+        self.persistence_spin.valueChanged.connect(self._on_view_options)
+        self.trail_spin.valueChanged.connect(self._on_view_options)
+        self._sync_view_options()
+
+    def _build_menus(self) -> None:
+        file_menu = self.menuBar().addMenu("&File")
+        file_menu.addAction("&Open scene …", QtGui.QKeySequence.Open, self.open_scene_dialog)
+        file_menu.addAction("&Save scene as …", QtGui.QKeySequence.SaveAs, self.save_scene_dialog)
+        file_menu.addAction("Paper scene", self.load_paper_scene)
+        file_menu.addSeparator()
+        file_menu.addAction("Load TI radar .cfg …", self.load_cfg_dialog)
+        file_menu.addAction("Load tracker parameters …", self.load_params_dialog)
+        file_menu.addAction("Save tracker parameters …", self.save_params_dialog)
+        file_menu.addSeparator()
+        file_menu.addAction("&Quit", QtGui.QKeySequence.Quit, self.close)
+        view_menu = self.menuBar().addMenu("&View")
+        for dock in self.docks.values():
+            view_menu.addAction(dock.toggleViewAction())
+
+    def _build_status(self) -> None:
+        self.retrack_label = QtWidgets.QLabel()
+        self.retrack_label.setObjectName("retrackLabel")
+        self.metrics_label = QtWidgets.QLabel()
+        self.metrics_label.setObjectName("metricsLabel")
+        self.statusBar().addPermanentWidget(self.metrics_label)
+        self.statusBar().addPermanentWidget(self.retrack_label)
+
+    # ---- errors ----
+    def show_error(self, message: str) -> None:
+        """One message naming the problem; never blocks, never crashes."""
+        self.errors.append(message)
+        self.statusBar().showMessage(message, 10000)
+        if self._error_box is None:
+            self._error_box = QtWidgets.QMessageBox(self)
+            self._error_box.setObjectName("errorBox")
+            self._error_box.setIcon(QtWidgets.QMessageBox.Warning)
+            self._error_box.setWindowTitle("RadarTune")
+            self._error_box.setModal(False)
+        self._error_box.setText(message)
+        self._error_box.show()
+
+    # ---- scene ----
+    def load_initial_scene(self, path: str | None) -> None:
+        if path:
+            try:
+                self.scene_model.load(path)
+                self._remember_scene(path)
+                return
+            except InputError as exc:
+                self.show_error(str(exc))
+        self.load_paper_scene()
+
+    def load_paper_scene(self) -> None:
+        try:
+            self.scene_model.set_document(self.engine.paper_document())
+        except InputError as exc:
+            self.show_error(str(exc))
+
+    def load_scene(self, path: str | Path) -> bool:
+        """Load a scene file; on error show it and keep the current scene."""
+        try:
+            self.scene_model.load(path)
+        except InputError as exc:
+            self.show_error(str(exc))
+            return False
+        self._remember_scene(str(path))
+        return True
+
+    def _remember_scene(self, path: str) -> None:
+        self.settings.setValue("scene/last_dir", str(Path(path).resolve().parent))
+
+    def open_scene_dialog(self) -> None:
+        start = self.settings.value("scene/last_dir", str(Path.cwd()), type=str)
+        path, _ = QtWidgets.QFileDialog.getOpenFileName(
+            self, "Open scene", start, "Scene JSON (*.json);;All files (*)"
+        )
+        if path:
+            self.load_scene(path)
+
+    def save_scene_dialog(self) -> None:
+        start = self.settings.value("scene/last_dir", str(Path.cwd()), type=str)
+        path, _ = QtWidgets.QFileDialog.getSaveFileName(
+            self, "Save scene", str(Path(start) / "scene.json"), "Scene JSON (*.json)"
+        )
+        if path:
+            try:
+                self.scene_model.save(path)
+                self._remember_scene(path)
+                self.statusBar().showMessage(f"scene saved to {path}", 5000)
+            except InputError as exc:
+                self.show_error(str(exc))
+
+    def _on_scene_changed(self) -> None:
+        scene = self.scene_model.scene
+        info = self.engine.scene_info(scene)
+        self._frame_period_s = info.frame_period_s
+        self.tracker.frame_period_s = info.frame_period_s
+        self.top_view.set_aoi(
+            info.aoi["min_range_m"], info.aoi["max_range_m"], info.aoi["max_azimuth_deg"]
+        )
+        self.top_view.set_reflectors(info.reflectors_xy_m)
+        self.top_view.set_truth_paths(info.truth_paths)
+        doc = self.scene_model.document
+        sel = self.scene_model.selected_person
+        traj = doc["persons"][sel]["trajectory"] if doc.get("persons") else {}
+        self.top_view.set_waypoints(traj.get("waypoints"))
+        self.rd_view.set_radar(info.radar)
+        self.radar_model.set_radar(info.radar)
+        self._update_play_interval()
+        self._scene_timer.start()
+
+    def _resimulate(self) -> None:
+        scene = self.scene_model.scene
+        if scene is None:
+            return
+        self.tracker.invalidate()
+        self.sim.start(scene)
+
+    def _on_radar_edited(self, radar) -> None:
+        scene = self.scene_model.scene
+        if scene is None or scene.radar == radar:
+            return
+        spec = "paper" if radar == PAPER_RADAR else radar.to_dict()
+        try:
+            self.scene_model.edit(radar=spec)
+        except InputError as exc:
+            self.show_error(str(exc))
+            self.radar_model.set_radar(scene.radar)
+
+    def load_cfg(self, path: str | Path) -> bool:
+        """Load a TI .cfg into the radar; on error show it, keep the current radar."""
+        try:
+            radar = self.engine.read_ti_cfg(path)
+        except InputError as exc:
+            self.show_error(str(exc))
+            return False
+        except Exception as exc:  # a reader bug must not crash the app
+            self.show_error(f"{path}: {describe_error(exc)}")
+            return False
+        self.radar_model.set_radar(radar)
+        return True
+
+    def load_cfg_dialog(self) -> None:
+        start = self.settings.value("radar/last_dir", str(Path.cwd()), type=str)
+        path, _ = QtWidgets.QFileDialog.getOpenFileName(
+            self, "Load TI mmWave .cfg", start, "TI config (*.cfg);;All files (*)"
+        )
+        if path:
+            self.settings.setValue("radar/last_dir", str(Path(path).parent))
+            self.load_cfg(path)
+
+    # ---- tracker parameters ----
+    def load_params_dialog(self) -> None:
+        path, _ = QtWidgets.QFileDialog.getOpenFileName(
+            self, "Load tracker parameters", str(Path.cwd()), "JSON (*.json)"
+        )
+        if path:
+            self.load_params(path)
+
+    def load_params(self, path: str | Path) -> bool:
+        try:
+            data = json.loads(Path(path).read_text())
+            from core.optimization import flat_params
+
+            model = data.get("model", "cv") if isinstance(data, dict) else "cv"
+            params = self.engine.make_params(model, self.engine.default_values(model), {})
+            full = {**params.to_dict(), **data}
+            tp = type(params).from_dict(full, source=str(path))
+            d = tp.to_dict()
+            self.params_model.set_values(flat_params(d), model=d["model"])
+            self.params_model.set_extra(**{k: d[k] for k in self.engine.default_extra()})
+            return True
+        except (OSError, json.JSONDecodeError) as exc:
+            self.show_error(f"{path}: {exc}")
+        except InputError as exc:
+            self.show_error(str(exc) if exc.source else f"{path}: {exc}")
+        return False
+
+    def save_params_dialog(self) -> None:
+        path, _ = QtWidgets.QFileDialog.getSaveFileName(
+            self, "Save tracker parameters", str(Path.cwd() / "tracker.json"), "JSON (*.json)"
+        )
+        if path:
+            try:
+                self.params_model.params().save(path)
+            except (InputError, OSError) as exc:
+                self.show_error(str(exc))
+
+    def _on_params_changed(self) -> None:
+        extra = self.params_model.extra_effective()
+        self.psi_view.set_thresholds(extra["confirm_threshold"], extra["delete_threshold"])
+
+    def apply_best(self) -> None:
+        p = self.study_model.progress
+        if not p.best_params:
+            self.show_error("no completed trial yet")
+            return
+        try:
+            self.params_model.set_values(p.best_params, model=p.best_model)
+            self.statusBar().showMessage(f"applied best trial (loss {p.best_loss:.4g} m²)", 5000)
+        except InputError as exc:
+            self.show_error(str(exc))
+
+    # ---- cache, tracking ----
+    def _on_cache_reset(self) -> None:
+        self.playback.set_available(0)
+        self.playback.set_frame(0)
+        self.timeline.setRange(0, 0)
+        self._dirty = True
+
+    def _on_frames_added(self, n: int) -> None:
+        self.playback.set_available(n)
+        self.timeline.blockSignals(True)
+        self.timeline.setRange(0, max(n - 1, 0))
+        self.timeline.blockSignals(False)
+        if n == 1 or n % RETRACK_EVERY_N_FRAMES == 0:
+            self.tracker.request()
+        if self.playback.frame >= n - 1:
+            self._dirty = True
+        self._update_frame_label()
+
+    def _on_cache_finished(self) -> None:
+        freeze_heap()  # the cached frames live as long as the scene
+        self.tracker.request()
+
+    def _on_tracked(self, fast_s: float, detail_s: float) -> None:
+        n = self.tracking_model.result.n_frames if self.tracking_model.result else len(self.cache)
+        self.retrack_label.setText(
+            f"re-track {n} frames: {fast_s * 1e3:.0f} ms (+ tracks {detail_s * 1e3:.0f} ms)"
+        )
+        self.tracker_panel.show_timing(fast_s, detail_s, n)
+
+    def _on_tracking_changed(self, result) -> None:
+        self.psi_view.set_result(result, self._frame_period_s)
+        self._dirty = True
+
+    # ---- playback ----
+    def _step(self, delta: int) -> None:
+        self.playback.set_playing(False)
+        self.playback.step(delta)
+
+    def _on_frame_changed(self, index: int) -> None:
+        self.timeline.blockSignals(True)
+        self.timeline.setValue(index)
+        self.timeline.blockSignals(False)
+        self._dirty = True
+        self._update_frame_label()
+
+    def _on_playing_changed(self, playing: bool) -> None:
+        self.act_play.blockSignals(True)
+        self.act_play.setChecked(playing)
+        self.act_play.blockSignals(False)
+        icon = QtWidgets.QStyle.SP_MediaPause if playing else QtWidgets.QStyle.SP_MediaPlay
+        self.act_play.setIcon(self.style().standardIcon(icon))
+        self.act_play.setText("Pause" if playing else "Play")
+        if playing:
+            self._play_timer.start()
+        else:
+            self._play_timer.stop()
+
+    def _on_speed_changed(self, speed: float) -> None:
+        i = self.speed_combo.findData(speed)
+        if i >= 0:
+            self.speed_combo.blockSignals(True)
+            self.speed_combo.setCurrentIndex(i)
+            self.speed_combo.blockSignals(False)
+        self._update_play_interval()
+
+    def _update_play_interval(self) -> None:
+        self._play_timer.setInterval(
+            max(1, int(round(1000 * self._frame_period_s / self.playback.speed)))
+        )
+
+    def _on_play_tick(self) -> None:
+        n = self.playback.n_available
+        if n == 0:
+            return
+        if self.playback.frame + 1 < n:
+            self.playback.step(1)
+        elif self.cache.complete and self.playback.loop:
+            self.playback.set_frame(0)
+
+    def _update_frame_label(self) -> None:
+        total = self.cache.expected or len(self.cache)
+        t = self.playback.frame * self._frame_period_s
+        self.frame_label.setText(
+            f" frame {self.playback.frame + 1 if len(self.cache) else 0} / {len(self.cache)}"
+            f" (of {total}) · {t:5.2f} s"
+        )
+
+    # ---- drawing ----
+    def _on_view_options(self, *_args) -> None:
+        self.top_view.set_colour_by(self.colour_combo.currentData())
+        self.top_view.persistence = self.persistence_spin.value()
+        self.top_view.trail_length = self.trail_spin.value()
+        self._dirty = True
+
+    def _sync_view_options(self) -> None:
+        for w in (self.colour_combo, self.persistence_spin, self.trail_spin):
+            w.blockSignals(True)
+        self.colour_combo.setCurrentIndex(self.colour_combo.findData(self.top_view.colour_by))
+        self.persistence_spin.setValue(self.top_view.persistence)
+        self.trail_spin.setValue(self.top_view.trail_length)
+        for w in (self.colour_combo, self.persistence_spin, self.trail_spin):
+            w.blockSignals(False)
+
+    def _draw(self) -> None:
+        """GUI timer: draw only the latest state (intermediate frames are dropped)."""
+        if not self._dirty:
+            self._update_fps()
+            return
+        self._dirty = False
+        self.redraw()
+
+    def redraw(self) -> None:
+        frames = self.cache.frames
+        index = self.playback.frame
+        result = self.tracking_model.result
+        frame = frames[index] if 0 <= index < len(frames) else None
+        self.top_view.show_frame(index, frames, result)
+        self.rd_view.show_frame(frame)
+        self.psi_view.set_frame(index)
+        self._show_metrics(index, result)
+        self.n_draws += 1
+        self._draw_times.append(time.perf_counter())
+        self._update_fps()
+
+    def _show_metrics(self, index: int, result) -> None:
+        if result is None or index >= result.n_frames:
+            self.metrics_label.setText("loss – · RMSE – · OSPA –")
+            return
+        loss = result.running_loss[index]
+        rmse = result.running_rmse_m[index]
+        ospa = result.ospa_m[index]
+        rmse_t = "–" if rmse != rmse else f"{rmse:.3f} m"
+        self.metrics_label.setText(
+            f"running loss {loss:.3g} m² · RMSE {rmse_t} · OSPA {ospa:.3f} m"
+        )
+
+    def _update_fps(self) -> None:
+        now = time.perf_counter()
+        recent = [t for t in self._draw_times if now - t <= 1.0]
+        rendered = len(recent)
+        self.fps_label.setText(
+            f" rendered {rendered:d} fps · simulated {self.sim.rate_fps:.1f} fps"
+            + (" (done)" if self.cache.complete else "")
+        )
+
+    # ---- study ----
+    def start_study(self) -> None:
+        """Start a study on the current scene's point clouds (written as a data set first)."""
+        if self.study.running:
+            return
+        form = self.study_model.form
+        try:
+            dataset = None
+            if form.dataset == "scene":
+                if not self.cache.complete:
+                    raise InputError("the scene is still being simulated; wait until it is done")
+                storage = Path(form.storage).expanduser().resolve()
+                dataset = storage.with_name(storage.stem + "-scene.npz")
+                self.engine.scene_dataset(self.cache.frames, self.scene_model.scene, dataset)
+            self.study.start(dataset_path=None if dataset is None else str(dataset))
+        except InputError as exc:
+            self.show_error(str(exc))
+        except Exception as exc:
+            self.show_error(f"cannot start study: {describe_error(exc)}")
+
+    def enqueue_current(self) -> None:
+        self.study.enqueue(
+            self.params_model.values,
+            self.params_model.model,
+            on_error=lambda m: self.show_error(f"cannot enqueue: {m}"),
+        )
+
+    def open_dashboard(self) -> None:
+        try:
+            url = self.study.open_dashboard()
+        except InputError as exc:
+            self.show_error(str(exc))
+            return
+        except Exception as exc:
+            self.show_error(f"cannot start the dashboard: {describe_error(exc)}")
+            return
+        self.statusBar().showMessage(f"dashboard at {url}", 10000)
+        QtCore.QTimer.singleShot(1500, lambda: webbrowser.open(url))
+
+    def browse_storage(self) -> None:
+        path, _ = QtWidgets.QFileDialog.getSaveFileName(
+            self,
+            "Study storage",
+            self.study_model.form.storage,
+            "SQLite (*.sqlite3 *.db);;Journal (*.log)",
+            options=QtWidgets.QFileDialog.DontConfirmOverwrite,
+        )
+        if path:
+            try:
+                self.study_model.set_form(storage=path)
+            except InputError as exc:
+                self.show_error(str(exc))
+
+    # ---- persistence ----
+    def save_settings(self) -> None:
+        s = self.settings
+        s.setValue("window/geometry", self.saveGeometry())
+        s.setValue("window/state", self.saveState())
+        s.setValue("window/central_splitter", self.central_splitter.saveState())
+        s.setValue("window/right_splitter", self.right_splitter.saveState())
+        s.setValue("playback/speed", float(self.playback.speed))
+        s.setValue("view/colour_by", str(self.top_view.colour_by))
+        s.setValue("view/persistence", int(self.top_view.persistence))
+        s.setValue("view/trail_length", int(self.top_view.trail_length))
+        s.setValue("tracker/model", self.params_model.model)
+        s.setValue("tracker/values", json.dumps(self.params_model.values))
+        s.setValue("tracker/extra", json.dumps(self.params_model.extra))
+        f = self.study_model.form
+        s.setValue("study/model", f.model)
+        s.setValue("study/n_trials", int(f.n_trials))
+        s.setValue("study/n_jobs", int(f.n_jobs))
+        s.setValue("study/storage", f.storage)
+        s.setValue("study/dataset", f.dataset)
+        s.sync()
+
+    def restore_settings(self) -> None:
+        s = self.settings
+        geometry = s.value("window/geometry", type=QtCore.QByteArray)
+        if geometry is not None and not geometry.isEmpty():
+            self.restoreGeometry(geometry)
+        else:
+            self.resize(1500, 900)
+        state = s.value("window/state", type=QtCore.QByteArray)
+        if state is not None and not state.isEmpty():
+            self.restoreState(state)
+        for key, splitter in (
+            ("window/central_splitter", self.central_splitter),
+            ("window/right_splitter", self.right_splitter),
+        ):
+            st = s.value(key, type=QtCore.QByteArray)
+            if st is not None and not st.isEmpty():
+                splitter.restoreState(st)
+        try:
+            self.playback.set_speed(s.value("playback/speed", 1.0, type=float))
+        except InputError:
+            pass
+        colour = s.value("view/colour_by", "snr", type=str)
+        self.top_view.set_colour_by(colour if colour in ("snr", "label") else "snr")
+        self.top_view.persistence = max(1, min(100, s.value("view/persistence", 5, type=int)))
+        self.top_view.trail_length = max(1, min(1000, s.value("view/trail_length", 25, type=int)))
+        self._sync_view_options()
+        try:
+            model = s.value("tracker/model", "cv", type=str)
+            values = json.loads(s.value("tracker/values", "{}", type=str) or "{}")
+            extra = json.loads(s.value("tracker/extra", "{}", type=str) or "{}")
+            if values:
+                self.params_model.set_values(values, model=model)
+            if extra:
+                self.params_model.set_extra(**extra)
+        except (InputError, ValueError, TypeError) as exc:
+            self.statusBar().showMessage(f"stored tracker parameters ignored: {exc}", 8000)
+        try:
+            self.study_model.set_form(
+                model=s.value("study/model", "cv", type=str),
+                n_trials=s.value("study/n_trials", 50, type=int),
+                n_jobs=s.value("study/n_jobs", 1, type=int),
+                storage=s.value("study/storage", self.study_model.form.storage, type=str),
+                dataset=s.value("study/dataset", "scene", type=str),
+            )
+        except InputError as exc:
+            self.statusBar().showMessage(f"stored study settings ignored: {exc}", 8000)
+
+    def shutdown(self) -> None:
+        """Stop timers and workers (close, tests)."""
+        self._draw_timer.stop()
+        self._play_timer.stop()
+        self._scene_timer.stop()
+        self.sim.wait()
+        self.tracker.wait()
+        self.study.shutdown()
+
+    def closeEvent(self, event: QtGui.QCloseEvent) -> None:
+        self.save_settings()
+        self.shutdown()
+        super().closeEvent(event)

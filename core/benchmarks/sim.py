@@ -1,0 +1,300 @@
+"""``radartune bench sim``: frames per second of the exact radar chain on the paper scene.
+
+The paper scene per frame: one walking person (RCS from eq. 5) and Poisson(0.02 m⁻² x AOI area
+= 2.09) clutter reflectors with a post-processing SNR of 15-30 dB and |v_r| >= 2 velocity bins,
+i.e. about 1 + Poisson(2.1) scatterers. The same frames run through
+
+- the exact chain, :func:`core.simulation.simulate_frame` (numba synthesis, complex64,
+  ``scipy.fft``), and
+- a plain, straightforward numpy implementation of the same chain written here (loop over
+  scatterers, complex128 ``numpy.exp`` over the whole cube, ``numpy.fft``, the same CFAR
+  thresholds with sliding sums, angle FFT per detection),
+
+in the same run, single-threaded, interleaved in blocks (10 exact frames, 1 plain frame) so
+that both see the same load, and the ratio is reported (the machine is shared and noisy).
+If ``core.pipeline.paper_dataset`` is importable, generating the 35-trajectory data set
+(uncached, one process) is timed too.
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+from core.config import SPEED_OF_LIGHT_MPS, ProcessingSettings, RadarConfig
+
+AOI_MIN_M, AOI_MAX_M, AOI_AZ_DEG = 0.5, 10.0, 60.0
+CLUTTER_DENSITY_PER_M2 = 0.02
+
+
+def aoi_area_m2() -> float:
+    return np.radians(2 * AOI_AZ_DEG) / 2 * (AOI_MAX_M**2 - AOI_MIN_M**2)
+
+
+def paper_scene_frames(radar: RadarConfig, n_frames: int, rng: np.random.Generator, antenna):
+    """Scatterers of ``n_frames`` frames: a person walking a straight line plus clutter."""
+    from core.simulation import Scatterers, draw_person_rcs_dbsm, rcs_for_snr_db
+
+    settings = ProcessingSettings()
+    frames = []
+    pos = np.array([-2.0, 3.0, 0.0])
+    vel = np.array([0.9, 0.8, 0.0])
+    vres = radar.velocity_resolution_mps
+    for f in range(n_frames):
+        p = pos + vel * radar.frame_period_s * (f % 100)
+        n_c = rng.poisson(CLUTTER_DENSITY_PER_M2 * aoi_area_m2())
+        # uniform in the AOI sector: r^2 uniform, az uniform
+        r = np.sqrt(rng.uniform(AOI_MIN_M**2, AOI_MAX_M**2, n_c))
+        az = np.radians(rng.uniform(-AOI_AZ_DEG, AOI_AZ_DEG, n_c))
+        u = np.column_stack((np.sin(az), np.cos(az), np.zeros(n_c)))
+        # |v_r| uniform over [2 bins, v_max], random sign
+        vr = rng.uniform(2 * vres, radar.max_velocity_mps, n_c) * rng.choice([-1.0, 1.0], n_c)
+        rcs = rcs_for_snr_db(radar, r, az, rng.uniform(15, 30, n_c), antenna, settings)
+        frames.append(
+            Scatterers(
+                position_m=np.vstack((p, r[:, None] * u)),
+                velocity_mps=np.vstack((vel, vr[:, None] * u)),
+                rcs_dbsm=np.concatenate((draw_person_rcs_dbsm(rng, 1), rcs)),
+                source=np.concatenate(([0], np.full(n_c, -1))).astype(np.int32),
+            )
+        )
+    return frames
+
+
+# ---- the plain reference implementation ---------------------------------------------------------
+def _plain_cfar_sums(p: np.ndarray, n: int, g: int, axis: int, cyclic: bool):
+    """Left and right training sums with a plain sliding window (numpy.convolve per line)."""
+    p = np.moveaxis(p, axis, 0)
+    size = p.shape[0]
+    kernel = np.ones(n)
+    left = np.full(p.shape, np.nan)
+    right = np.full(p.shape, np.nan)
+    off = n + g if cyclic else 0
+    i = np.arange(size)
+    lo = i + off - g - n
+    hi = i + off + g + 1
+    for col in range(p.shape[1]):
+        line = p[:, col]
+        if cyclic:
+            line = np.concatenate((line[-(n + g) :], line, line[: n + g]))
+        sums = np.convolve(line, kernel, mode="valid")  # sums[j] = line[j] + ... + line[j+n-1]
+        ok_l = lo >= 0
+        ok_r = hi + n <= len(line)
+        left[ok_l, col] = sums[lo[ok_l]]
+        right[ok_r, col] = sums[hi[ok_r]]
+    return np.moveaxis(left, 0, axis), np.moveaxis(right, 0, axis)
+
+
+def plain_frame(radar: RadarConfig, scatterers, rng: np.random.Generator, antenna, settings):
+    """The same chain written plainly. Returns (range_m, azimuth_rad, velocity_mps, snr_db)."""
+    from core.processing.cfar import make_cfar
+    from core.simulation.link import noise_power_v2, received_power_w, signal_amplitude_v
+
+    n_v, n_l, n_s = radar.n_virtual, radar.n_loops, radar.n_samples
+    lam = radar.wavelength_m
+    cube = np.zeros((radar.n_tx, n_l, radar.n_rx, n_s), dtype=np.complex128)
+    n = np.arange(n_s)
+    for i in range(len(scatterers)):
+        p0, v = scatterers.position_m[i], scatterers.velocity_mps[i]
+        r0 = np.linalg.norm(p0)
+        az = np.arctan2(p0[0], p0[1])
+        el = np.arctan2(p0[2], np.hypot(p0[0], p0[1]))
+        amp = signal_amplitude_v(
+            radar, received_power_w(radar, r0, az, scatterers.rcs_dbsm[i], antenna)
+        )
+        t = (np.arange(n_l)[None, :] * radar.n_tx + np.arange(radar.n_tx)[:, None]) * (
+            radar.chirp_period_s
+        )
+        r = np.linalg.norm(p0[None, None, :] + v[None, None, :] * t[..., None], axis=-1)
+        fb = 2 * radar.slope_hz_per_s * r / SPEED_OF_LIGHT_MPS
+        apos = np.reshape(radar.azimuth_positions, (radar.n_tx, radar.n_rx))
+        epos = np.reshape(radar.elevation_positions, (radar.n_tx, radar.n_rx))
+        ang = np.pi * (apos * np.sin(az) * np.cos(el) + epos * np.sin(el))  # (tx, rx)
+        phase = (
+            2 * np.pi * fb[:, :, None, None] * n / radar.sample_rate_hz
+            + 4 * np.pi * r[:, :, None, None] / lam
+            + ang[:, None, :, None]
+        )
+        cube += amp * np.exp(1j * phase)
+    sigma = np.sqrt(noise_power_v2(radar) / 2)
+    cube += sigma * (rng.standard_normal(cube.shape) + 1j * rng.standard_normal(cube.shape))
+    x = cube.transpose(0, 2, 1, 3).reshape(n_v, n_l, n_s)
+    w_r = np.hanning(n_s + 1)[:-1]
+    w_d = np.hanning(n_l + 1)[:-1]
+    x = np.fft.fft(x * w_r, axis=2)
+    x = x - x.mean(axis=1, keepdims=True)
+    x = np.fft.fftshift(np.fft.fft(x * w_d[None, :, None], axis=1), axes=1)  # [v, doppler, range]
+    rd = np.sum(np.abs(x) ** 2, axis=0).T  # [range, doppler]
+    # CFAR: the same thresholds and noise model as the exact chain, plain sliding sums
+    from core.processing.cfar import _effective
+    from core.processing.spectrum import clutter_removal_noise_profile
+
+    prof = clutter_removal_noise_profile("hann", n_l)
+    white = rd / prof
+    rc, dc = settings.range_cfar, settings.doppler_cfar
+    cr = make_cfar(rc, n_v, _effective("hann", n_s, rc.n_train))
+    cd = make_cfar(dc, n_v, _effective("hann", n_l, dc.n_train))
+    left, right = _plain_cfar_sums(white, rc.n_train, rc.n_guard, 0, False)
+    both = ~np.isnan(left) & ~np.isnan(right)
+    mu_r = np.where(both, np.minimum(left, right), np.where(np.isnan(left), right, left))
+    mu_r = mu_r / rc.n_train
+    alpha_r = np.where(both, cr.alpha(), cr.alpha_one_side())
+    left_d, right_d = _plain_cfar_sums(white, dc.n_train, dc.n_guard, 1, True)
+    mu_d = (left_d + right_d) / (2 * dc.n_train)
+    det = (white > alpha_r * mu_r) & (white > cd.alpha() * mu_d)
+    k = np.arange(n_s) * radar.range_resolution_m
+    det &= ((k >= settings.min_range_m) & (k <= settings.max_range_m))[:, None]
+    out = []
+    for rb, db in zip(*np.nonzero(det)):
+        nb = [
+            rd[rr, dd % n_l]
+            for rr in (rb - 1, rb, rb + 1)
+            for dd in (db - 1, db, db + 1)
+            if 0 <= rr < n_s and (rr, dd) != (rb, db)
+        ]
+        if rd[rb, db] < max(nb):
+            continue
+        d = db - n_l // 2
+        chan = x[:, db, rb] * np.exp(
+            -2j * np.pi * d * (np.arange(n_v) // radar.n_rx) / (n_l * radar.n_tx)
+        )
+        row = np.zeros(64, dtype=complex)
+        row[:4] = chan[0:4]
+        row[4:8] = chan[8:12]
+        spec = np.abs(np.fft.fftshift(np.fft.fft(row))) ** 2
+        kk = int(np.argmax(spec))
+        az = np.arcsin(np.clip(2 * (kk - 32) / 64, -1, 1))
+        snr = 10 * np.log10(white[rb, db] / mu_r[rb, db])
+        out.append((rb * radar.range_resolution_m, az, d * radar.velocity_resolution_mps, snr))
+    return out
+
+
+# ---- the benchmark ------------------------------------------------------------------------------
+def _time_frames(fn, frames) -> tuple[float, float, list]:
+    """Wall-clock and CPU seconds (this process) for running ``fn`` on every frame."""
+    results = []
+    t0, c0 = time.perf_counter(), time.process_time()
+    for f in frames:
+        results.append(fn(f))
+    return time.perf_counter() - t0, time.process_time() - c0, results
+
+
+def run(quick: bool = False) -> dict:
+    from core.simulation import AntennaGain, simulate_frame
+
+    radar = RadarConfig()
+    settings = ProcessingSettings()
+    rng = np.random.default_rng(2024)
+    antenna = AntennaGain.draw(radar, rng)
+    n_exact = 60 if quick else 1000
+    n_plain = 15 if quick else 100
+    frames = paper_scene_frames(radar, n_exact, rng, antenna)
+    n_scatterers = float(np.mean([len(f) for f in frames]))
+    # warm up (numba compilation, FFT plans, threshold caches)
+    simulate_frame(radar, frames[0], np.random.default_rng(0), antenna=antenna)
+    plain_frame(radar, frames[0], np.random.default_rng(0), antenna, settings)
+
+    # interleaved blocks (10 exact frames, then 1 plain frame) so that both see the same load
+    rng_e = np.random.default_rng(1)
+    rng_p = np.random.default_rng(1)
+    block = n_exact // n_plain
+    t_exact = c_exact = t_plain = c_plain = 0.0
+    outs: list = []
+    plain: list = []
+    for b in range(n_plain):
+        chunk = frames[b * block : (b + 1) * block]
+        t, c, o = _time_frames(
+            lambda f: simulate_frame(radar, f, rng_e, antenna=antenna, settings=settings), chunk
+        )
+        t_exact, c_exact = t_exact + t, c_exact + c
+        outs += o
+        t, c, o = _time_frames(
+            lambda f: plain_frame(radar, f, rng_p, antenna, settings), frames[b : b + 1]
+        )
+        t_plain, c_plain = t_plain + t, c_plain + c
+        plain += o
+    n_exact = len(outs)
+    fps_exact = n_exact / t_exact
+    fps_plain = n_plain / t_plain
+    person_found = float(np.mean([0 in o.point_cloud.source for o in outs]))
+    points = float(np.mean([len(o.point_cloud) for o in outs]))
+    plain_points = float(np.mean([len(p) for p in plain]))
+    result = {
+        "frames_exact": n_exact,
+        "frames_plain": n_plain,
+        "mean_scatterers_per_frame": n_scatterers,
+        "exact_fps": fps_exact,
+        "exact_ms_per_frame": 1e3 / fps_exact,
+        "plain_fps": fps_plain,
+        "plain_ms_per_frame": 1e3 / fps_plain,
+        "speedup": fps_exact / fps_plain,
+        # CPU time of this process: less sensitive to other load on a shared machine
+        "exact_fps_cpu": n_exact / c_exact,
+        "plain_fps_cpu": n_plain / c_plain,
+        "speedup_cpu": (n_exact / c_exact) / (n_plain / c_plain),
+        "load_average_1min": _load(),
+        "goal": {"speedup": 4.0, "fps": 250.0},
+        "exact_points_per_frame": points,
+        "plain_points_per_frame": plain_points,
+        "exact_person_detected_fraction": person_found,
+    }
+    result["dataset"] = _time_dataset(quick)
+    return result
+
+
+def _load() -> float | None:
+    try:
+        import os
+
+        return os.getloadavg()[0]
+    except (OSError, AttributeError):
+        return None
+
+
+def _time_dataset(quick: bool) -> dict | None:
+    try:
+        from core.pipeline import paper_dataset
+    except ImportError:
+        return None
+    import tempfile
+
+    n_traj = 2 if quick else 35
+    with tempfile.TemporaryDirectory() as tmp:
+        t0 = time.perf_counter()
+        ds = paper_dataset(0, n_traj, cache_dir=tmp, jobs=1)
+        seconds = time.perf_counter() - t0
+    n_frames = len(ds.trajectory) if hasattr(ds, "trajectory") else None
+    out = {"trajectories": n_traj, "seconds": seconds, "jobs": 1}
+    if n_frames:
+        out["frames"] = int(n_frames)
+        out["frames_per_s"] = n_frames / seconds
+    return out
+
+
+def summary(result: dict) -> str:
+    lines = [
+        "radar chain, paper scene "
+        f"({result['mean_scatterers_per_frame']:.2f} scatterers/frame, one core)",
+        f"  exact chain : {result['exact_fps']:7.1f} frames/s "
+        f"({result['exact_ms_per_frame']:.2f} ms/frame, {result['frames_exact']} frames)",
+        f"  plain numpy : {result['plain_fps']:7.1f} frames/s "
+        f"({result['plain_ms_per_frame']:.2f} ms/frame, {result['frames_plain']} frames)",
+        f"  speed-up    : {result['speedup']:.1f}x (goal >= 4x and >= 250 frames/s)",
+        f"  by CPU time : exact {result['exact_fps_cpu']:.1f} frames/s, plain "
+        f"{result['plain_fps_cpu']:.1f} frames/s, {result['speedup_cpu']:.1f}x "
+        f"(load average {result['load_average_1min']})",
+        f"  points/frame: exact {result['exact_points_per_frame']:.2f}, "
+        f"plain {result['plain_points_per_frame']:.2f}; person detected in "
+        f"{100 * result['exact_person_detected_fraction']:.0f} % of frames",
+    ]
+    ds = result.get("dataset")
+    if ds:
+        lines.append(
+            f"  paper data set ({ds['trajectories']} trajectories, uncached, 1 process): "
+            f"{ds['seconds']:.1f} s"
+            + (f", {ds['frames_per_s']:.0f} frames/s" if "frames_per_s" in ds else "")
+        )
+    elif ds is None:
+        lines.append("  paper data set: core.pipeline.paper_dataset not importable, skipped")
+    return "\n".join(lines)

@@ -1,0 +1,93 @@
+"""Qt-free parts of the app: slider mapping, drawing geometry, the engine's loss and tracks."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from app.data import ParamSpec
+from app.geometry import aoi_polyline, chi2_2dof_quantile, ellipse_polyline, trails_polyline
+from app.panels.tracker_panel import SLIDER_STEPS, from_slider, to_slider
+
+
+def test_log_slider_midpoint_is_the_geometric_mean_and_round_trips() -> None:
+    spec = ParamSpec(name="q_coeff", low=0.1, high=30.0, log=True)
+    # log scale: the middle of the slider is sqrt(low * high)
+    assert from_slider(spec, SLIDER_STEPS // 2) == pytest.approx(math.sqrt(0.1 * 30.0), rel=1e-9)
+    assert from_slider(spec, 0) == pytest.approx(0.1)
+    assert from_slider(spec, SLIDER_STEPS) == pytest.approx(30.0)
+    for v in (0.1, 0.37, 1.0, 7.7, 30.0):
+        assert from_slider(spec, to_slider(spec, v)) == pytest.approx(v, rel=0.01)
+    lin = ParamSpec(name="p_d", low=0.8, high=0.99, log=False)
+    assert from_slider(lin, SLIDER_STEPS // 2) == pytest.approx(0.895)
+    assert to_slider(lin, 5.0) == SLIDER_STEPS  # clipped into the range
+
+
+def test_ellipse_points_lie_on_the_gate_boundary() -> None:
+    rng = np.random.default_rng(1)
+    a = rng.normal(size=(3, 2, 2))
+    g = a @ np.swapaxes(a, 1, 2) + 0.1 * np.eye(2)  # SPD gate shapes G
+    c = rng.normal(size=(3, 2))
+    line = ellipse_polyline(c, g, 1.0)
+    assert line.shape == (3 * 34, 2)
+    pts = line.reshape(3, 34, 2)
+    assert np.isnan(pts[:, -1]).all()
+    for k in range(3):
+        d = pts[k, :-1] - c[k]
+        # dᵀ G⁻¹ d = 1 on the boundary
+        m = np.einsum("ni,ij,nj->n", d, np.linalg.inv(g[k]), d)
+        np.testing.assert_allclose(m, 1.0, rtol=1e-9)
+
+
+def test_chi2_two_dof_quantile() -> None:
+    # P(χ²₂ ≤ γ) = 1 − exp(−γ/2)
+    assert 1 - math.exp(-chi2_2dof_quantile(0.99) / 2) == pytest.approx(0.99)
+    assert chi2_2dof_quantile(0.99) == pytest.approx(9.2103, abs=1e-4)
+
+
+def test_aoi_outline_and_trails() -> None:
+    line = aoi_polyline(0.5, 10.0, 60.0)
+    r = np.hypot(line[:, 0], line[:, 1])
+    assert r.max() == pytest.approx(10.0) and r.min() == pytest.approx(0.5)
+    az = np.degrees(np.arctan2(line[:, 0], line[:, 1]))
+    assert np.abs(az).max() == pytest.approx(60.0)
+    ids = np.array([1, 1, 1, 2, 2])
+    t = np.array([0, 1, 2, 1, 2])
+    xy = np.arange(10.0).reshape(5, 2)
+    out = trails_polyline(ids, t, xy, frame=2, length=2, live_ids=np.array([1, 2]))
+    # track 1 frames 1..2, NaN, track 2 frames 1..2
+    assert out.shape == (5, 2) and np.isnan(out[2]).all()
+    np.testing.assert_array_equal(out[[0, 1, 3, 4]], xy[[1, 2, 3, 4]])
+    assert len(trails_polyline(ids, t, xy, 2, 5, np.array([7]))) == 0
+
+
+def test_running_loss_ends_at_the_paper_loss(long_scene_frames) -> None:
+    from app import engine
+    from core.evaluation import trajectory_loss
+
+    scene, frames = long_scene_frames
+    params = engine.make_params("cv", engine.default_values("cv"), {})
+    full = engine.track(frames, params, scene.radar.frame_period_s)
+    fast = engine.track_fast(frames, params, scene.radar.frame_period_s)
+    assert full.detail and not fast.detail
+    assert full.n_frames == fast.n_frames == len(frames) == 250
+    # the compiled kernel and the readable tracker are the same algorithm
+    np.testing.assert_allclose(fast.estimate_xy_m, full.estimate_xy_m, atol=1e-9, equal_nan=True)
+    has = np.isfinite(full.estimate_xy_m[:, 0])
+    loss, mse, n_c = trajectory_loss(full.estimate_xy_m, has, full.truth_xy_m)
+    assert n_c > 100  # the person is tracked most of the time
+    assert full.running_loss[-1] == pytest.approx(loss, rel=1e-12)
+    assert full.running_rmse_m[-1] == pytest.approx(math.sqrt(mse), rel=1e-12)
+    np.testing.assert_allclose(fast.running_loss, full.running_loss, rtol=1e-9)
+    # before the first confirmation the loss is the N_c = 0 value (1.0 m²)
+    first = int(np.argmax(has))
+    assert np.all(full.running_loss[:first] == 1.0)
+    # every track frame agrees with the per-frame confirmed count of the kernel
+    n_conf_full = np.array([tf.confirmed.sum() for tf in full.frames])
+    n_conf_fast = np.array([len(tf) for tf in fast.frames])
+    np.testing.assert_array_equal(n_conf_full, n_conf_fast)
+    assert np.all((full.ospa_m >= 0) & (full.ospa_m <= 1.0))
+    psi = full.psi_value[np.isfinite(full.psi_value)]
+    assert psi.size and psi.min() >= 0 and psi.max() <= 1

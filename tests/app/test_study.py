@@ -1,0 +1,118 @@
+"""A short study started from the panel completes in separate processes and fills the
+best-parameter table, while the event loop keeps running (a test QTimer measures it)."""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+import pytest
+from PySide6 import QtCore
+
+
+def test_short_study_from_panel_keeps_event_loop_alive(
+    window, qtbot, tmp_path, long_scene_frames, long_scene_doc, fill_cache, monkeypatch
+) -> None:
+    scene, frames = long_scene_frames
+    fill_cache(window, long_scene_doc, frames)
+    storage = tmp_path / "study.db"
+    panel = window.study_panel
+    panel.trials.setValue(4)
+    panel.jobs.setValue(1)
+    panel.storage.setText(str(storage))
+    panel.storage.editingFinished.emit()
+    assert window.study_model.form.storage == str(storage)
+
+    qtbot.waitUntil(lambda: window.tracker.n_runs >= 1 and window.tracker.idle, timeout=60000)
+    ticks: list[float] = []
+    timer = QtCore.QTimer()
+    timer.setInterval(10)
+    timer.timeout.connect(lambda: ticks.append(time.perf_counter()))
+    timer.start()
+    qtbot.wait(100)
+
+    events = []
+    window.study_model.message.connect(lambda m: events.append((time.perf_counter(), m)))
+    window.study_model.progress_changed.connect(
+        lambda p: events.append((time.perf_counter(), f"progress {p.n_finished}"))
+    )
+    t_click = time.perf_counter()
+    panel.start_button.click()
+    events.append((time.perf_counter(), "click returned"))
+    assert window.study_model.running and not panel.start_button.isEnabled()
+    window.study_model.message.connect(lambda m: print("study:", m, flush=True))
+    finished = []
+    window.study.finished.connect(lambda: finished.append(True))
+    qtbot.waitUntil(lambda: bool(finished), timeout=120000)
+    timer.stop()
+
+    p = window.study_model.progress
+    assert p.n_complete + p.n_pruned == 4, window.errors
+    assert p.n_complete >= 1 and np.isfinite(p.best_loss) and p.best_loss > 0
+    assert panel.table.rowCount() == len(window.engine.param_specs("cv")) == 12
+    names = {panel.table.item(i, 0).text() for i in range(panel.table.rowCount())}
+    assert names == {s.name for s in window.engine.param_specs("cv")}
+    assert panel.progress_bar.value() == 4
+    assert f"complete {p.n_complete}" in panel.counts.text()
+    assert len(p.curve_t_s) == p.n_complete and np.all(np.diff(p.curve_best) <= 0)
+    assert not window.study_model.running and panel.start_button.isEnabled()
+
+    gaps = np.diff(ticks)
+    i = int(np.argmax(gaps))
+    print(f"gaps > 50 ms: {np.sum(gaps > 0.05)}, median {np.median(gaps) * 1e3:.1f} ms")
+    print(
+        f"\nevent loop: {len(ticks)} ticks, longest gap {gaps.max() * 1e3:.0f} ms "
+        f"at {ticks[i] - t_click:.2f} s after start"
+    )
+    for t, m in events:
+        print(f"  {t - t_click:7.2f} s  {m}")
+    assert gaps.max() < 0.1
+
+    # apply best: the sliders take the best trial's parameters (and re-track)
+    panel.apply_button.click()
+    for name, value in p.best_params.items():
+        assert window.params_model.values[name] == pytest.approx(value)
+        assert window.tracker_panel.rows[name].spin.value() == pytest.approx(value, abs=1e-4)
+    # enqueue the current sliders as the next trial of the stored study
+    window.params_model.set_value("q_coeff", 3.0)
+    panel.enqueue_button.click()
+    qtbot.waitUntil(lambda: any("enqueued" in m for _, m in events), timeout=30000)
+    assert not window.errors
+
+    # the dashboard serves this storage (the browser call is intercepted)
+    opened = []
+    monkeypatch.setattr("webbrowser.open", lambda url: opened.append(url))
+    panel.dashboard_button.click()
+    qtbot.waitUntil(lambda: bool(opened), timeout=10000)
+    import json
+    import urllib.request
+
+    for _ in range(60):
+        try:
+            with urllib.request.urlopen(opened[0] + "api/studies", timeout=2) as r:
+                studies = json.loads(r.read())["study_summaries"]
+            break
+        except OSError:
+            qtbot.wait(500)
+    else:
+        raise AssertionError("optuna-dashboard did not answer")
+    assert [s["study_name"] for s in studies] == ["radartune-cv"]
+
+
+def test_stop_ends_a_running_study_early(
+    window, qtbot, tmp_path, long_scene_frames, long_scene_doc, fill_cache
+) -> None:
+    scene, frames = long_scene_frames
+    fill_cache(window, long_scene_doc, frames)
+    window.study_model.set_form(n_trials=500, n_jobs=1, storage=str(tmp_path / "stop.db"))
+    window.study_panel.start_button.click()
+    qtbot.waitUntil(lambda: window.study_model.progress.n_finished >= 2, timeout=120000)
+    assert window.study_panel.stop_button.isEnabled()
+    window.study_panel.stop_button.click()
+    finished = []
+    window.study.finished.connect(lambda: finished.append(True))
+    qtbot.waitUntil(lambda: bool(finished), timeout=60000)
+    p = window.study_model.progress
+    assert 2 <= p.n_finished < 500
+    assert p.n_running == 0  # the worker finished its trial; nothing is left RUNNING
+    assert window.study_panel.start_button.isEnabled()

@@ -1,0 +1,39 @@
+"""``radartune track`` and ``radartune stability`` end to end."""
+
+import json
+
+from core.cli import main
+from core.tracking import TrackerParams
+from core.tracking.synthetic import synthetic_dataset
+
+
+def test_track_prints_table_and_writes_json(tmp_path, capsys):
+    data = synthetic_dataset(0, 1, n_frames=80).save(tmp_path / "d.npz")
+    params = TrackerParams.default("ca").save(tmp_path / "p.json")
+    out = tmp_path / "r.json"
+    code = main(["track", "--data", str(data), "--params", str(params), "--out", str(out)])
+    assert code == 0
+    text = capsys.readouterr().out
+    assert "total" in text and "OSPA" in text
+    doc = json.loads(out.read_text())
+    assert doc["params"]["model"] == "ca"
+    assert [r["class"] for r in doc["table"]] == ["A", "B", "C", "D", "E", "total"]
+    assert len(doc["trajectories"]) == 5 and doc["loss_total"] > 0
+
+
+def test_track_bad_params_exit_2_and_leave_nothing(tmp_path, capsys):
+    data = synthetic_dataset(0, 1, classes="a", n_frames=60).save(tmp_path / "d.npz")
+    bad = tmp_path / "bad.json"
+    bad.write_text(json.dumps({"model": "cv", "r33": "fast"}))
+    out = tmp_path / "r.json"
+    code = main(["track", "--data", str(data), "--params", str(bad), "--out", str(out)])
+    assert code == 2
+    err = capsys.readouterr().err
+    assert "bad.json" in err and "r33" in err and err.count("\n") == 1
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["bad.json", "d.npz"]
+
+
+def test_stability_quick(capsys):
+    assert main(["stability", "--quick", "--frames", "100"]) == 0
+    out = capsys.readouterr().out
+    assert "cv: 256 corners" in out and "stability: OK" in out

@@ -1,0 +1,63 @@
+"""The readable tracker: per-frame output for the GUI, the gate ellipse, management rules."""
+
+import numpy as np
+import pytest
+from scipy.stats import chi2
+
+from core.tracking import TrackerParams, run_tracker
+from core.tracking import management as mg
+from core.tracking.tracker import gate_ellipses_xy
+
+
+def test_every_track_is_reported_and_births_follow_the_rules():
+    # frame 0: two far-apart points → two tentative tracks, none confirmed in its birth frame
+    z0 = np.array([[3.0, 0.0, 0.5], [6.0, 0.5, -1.0]])
+    p = TrackerParams(p_te=0.95)  # even P_te ≥ 0.9 does not confirm in the birth frame
+    res = run_tracker([z0, z0 + [0.0, 0.0, 0.0]], p)
+    f0, f1 = res.frames
+    assert list(f0.ids) == [0, 1] and not f0.confirmed.any() and f0.estimate == -1
+    np.testing.assert_allclose(f0.state[0], [0, 3.0, 0, 0.5])
+    np.testing.assert_allclose(f0.psi, [0.95, 0.95])
+    # frame 1: both re-detected inside their gates → updated, confirmed, no new tracks
+    assert list(f1.ids) == [0, 1] and f1.confirmed.all()
+    assert res.has_estimate.tolist() == [False, True]
+    assert res.estimate_id[1] == f1.ids[np.argmax(f1.psi)]
+    assert f1.state.shape == (2, 4) and f1.covariance.shape == (2, 4, 4)
+
+
+def test_gate_ellipse_matches_the_gate_shape():
+    res = run_tracker([np.array([[4.0, 0.2, 0.0]])], TrackerParams())
+    ft = res.frames[0]
+    curve = gate_ellipses_xy(ft, 32)
+    assert curve.shape == (34, 2) and np.isnan(curve[-1]).all()
+    d = curve[:-1] - ft.gate_center_xy[0]
+    G = ft.gate_shape_xy[0]
+    # every boundary point satisfies dᵀ G⁻¹ d = 1
+    np.testing.assert_allclose(np.einsum("ij,jk,ik->i", d, np.linalg.inv(G), d), 1.0, rtol=1e-9)
+
+
+def test_merge_keeps_the_higher_psi_and_older_on_ties():
+    pos = np.array([[0.0, 5.0], [0.1, 5.0], [3.0, 5.0]])
+    cov = np.repeat(np.eye(2)[None] * 0.01, 3, axis=0)
+    g2 = chi2.ppf(0.99, 2)
+    keep = mg.merge(pos, cov, np.array([0.5, 0.8, 0.9]), np.array([0, 1, 2]), g2)
+    assert keep.tolist() == [False, True, True]
+    keep = mg.merge(pos, cov, np.array([0.7, 0.7, 0.9]), np.array([0, 1, 2]), g2)
+    assert keep.tolist() == [True, False, True]
+
+
+def test_cap_and_best_confirmed():
+    psi = np.array([0.3, 0.9, 0.3, 0.95])
+    ids = np.array([4, 5, 6, 7])
+    assert mg.cap(psi, ids, 3).tolist() == [True, True, False, True]  # tie: the youngest goes
+    assert mg.best_confirmed(psi, ids, np.array([True, True, True, False])) == 1
+    assert mg.best_confirmed(np.array([0.9, 0.9]), np.array([3, 2]), np.ones(2, bool)) == 1
+    assert mg.best_confirmed(psi, ids, np.zeros(4, bool)) == -1
+
+
+@pytest.mark.parametrize("bad", [[np.array([[1.0, np.nan, 0.0]])]])
+def test_non_finite_measurements_are_an_input_error(bad):
+    from core.errors import InputError
+
+    with pytest.raises(InputError, match="frame 0"):
+        run_tracker(bad, TrackerParams())
