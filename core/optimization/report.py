@@ -108,12 +108,16 @@ def load_studies(storage: str) -> list[StudyRecord]:
 
 
 def main_study(studies: Sequence[StudyRecord], model: str) -> StudyRecord | None:
-    """TPE + ASHA study of ``model`` with the most counted trials (else any with the most)."""
+    """The study of ``model`` holding its best trial (lowest L_t over every study of the model).
+
+    All studies of a storage track the same data set (the report checks), so the best
+    parameters found by any sampler or pruner are the model's optimal parameters; the report
+    names the study and lists every study's budget.
+    """
     mine = [s for s in studies if s.model == model and s.best is not None]
     if not mine:
         return None
-    preferred = [s for s in mine if s.sampler == "tpe" and s.pruner == "asha"] or mine
-    return max(preferred, key=lambda s: (s.counted(), s.name))
+    return min(mine, key=lambda s: (s.best.value, s.name))
 
 
 def _write_text(path: Path, text: str) -> None:
@@ -159,8 +163,8 @@ def plot_loss_vs_time(studies: Sequence[StudyRecord], model: str, path: Path) ->
         return False
     fig, ax = plt.subplots(figsize=(7, 4.2))
     styles = {"tpe": "-", "random": "--"}
-    colors = {"asha": "tab:blue", "wilcoxon": "tab:green", "none": "tab:orange"}
-    for s in mine:
+    colors = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    for i, s in enumerate(mine):
         secs, best = s.best_against_time()
         if len(secs) == 0:
             continue
@@ -169,7 +173,7 @@ def plot_loss_vs_time(studies: Sequence[StudyRecord], model: str, path: Path) ->
             best * 1e3,
             where="post",
             ls=styles.get(s.sampler, ":"),
-            color=colors.get(s.pruner, "k"),
+            color=colors[i % len(colors)],
             label=f"{s.sampler.upper()} + {s.pruner} ({s.counted()} trials, {s.name})",
         )
     ax.set_yscale("log")
@@ -266,6 +270,12 @@ def write_report(
     mains = {m: s for m, s in mains.items() if s is not None}
     if not mains:
         raise InputError(f"storage {redact(storage)}: no study has a completed trial")
+    used = {s.dataset for s in studies if s.dataset}
+    if dataset is None and len(used) > 1:
+        raise InputError(
+            f"storage {redact(storage)}: studies ran on different data sets {sorted(used)}; "
+            "pass --dataset to choose one (best parameters are compared on one data set)"
+        )
     train_path = dataset or next(iter(mains.values())).dataset
     if not train_path:
         raise InputError("the studies record no data set; pass --dataset")
@@ -399,18 +409,23 @@ def render_markdown(r: dict[str, Any]) -> str:
         "(m², over trajectories that confirm) and mean N_c per class:",
         "",
         "| model | class | L ×10⁻³ | mean MSE (m²) | √MSE (m) | mean N_c | trajectories | "
-        "never confirmed |",
-        "|---|---|---|---|---|---|---|---|",
+        "never confirmed | far frames (> 1 m) | worst L(k) ×10⁻³ |",
+        "|---|---|---|---|---|---|---|---|---|---|",
     ]
     for model in ("cv", "ca"):
         if model not in models:
             continue
+        per_traj = models[model]["training"]["trajectories"]
         for row in models[model]["training"]["table"]:
+            mine = [t for t in per_traj if row["class"] in ("total", t["class"].upper())]
+            far = sum(t["far_frames"] for t in mine)
+            worst = max((t["loss"] for t in mine if t["loss"] is not None), default=None)
             mse = row["mse"]
             lines.append(
                 f"| {model.upper()} | {row['class']} | {_f(row['loss_x1e3'], '.4f')} | "
                 f"{_f(mse, '.5f')} | {_f(None if mse is None else math.sqrt(mse), '.3f')} | "
-                f"{_f(row['n_c'], '.1f')} | {row['n_trajectories']} | {row['n_unconfirmed']} |"
+                f"{_f(row['n_c'], '.1f')} | {row['n_trajectories']} | {row['n_unconfirmed']} | "
+                f"{far} | {_f(None if worst is None else worst * 1e3, '.4f')} |"
             )
     lines += [
         "",

@@ -194,7 +194,11 @@ def make_pruner(kind: str) -> Any:
             bootstrap_count=0,
         )
     if kind == "wilcoxon":
-        return optuna.pruners.WilcoxonPruner(p_threshold=0.1, n_startup_steps=5)
+        import warnings
+
+        with warnings.catch_warnings():  # "experimental" since Optuna 3.6; chosen knowingly
+            warnings.simplefilter("ignore", optuna.exceptions.ExperimentalWarning)
+            return optuna.pruners.WilcoxonPruner(p_threshold=0.1, n_startup_steps=5)
     if kind == "none":
         return optuna.pruners.NopPruner()
     raise InputError(f"pruner must be one of {', '.join(PRUNERS)}, got {kind!r}")

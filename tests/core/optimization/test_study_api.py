@@ -116,3 +116,22 @@ def test_worker_seeds_differ_per_worker_and_per_resume() -> None:
     assert len(set(a)) == 3
     assert a == worker_seeds(0, 3, 0)
     assert set(a).isdisjoint(worker_seeds(0, 3, 10))
+
+
+@pytest.mark.parametrize(("pruner", "pruned"), [("wilcoxon", True), ("none", False)])
+def test_wilcoxon_prunes_and_none_never_does(tmp_path: Path, pruner: str, pruned: bool) -> None:
+    s = settings(
+        tmp_path, n_trials=30, pruner=pruner, sampler="random",
+        objective_options={"n_trajectories": 20},
+    )  # fmt: skip
+    summaries = run(s, seed=2)
+    states = [t.state for t in summaries]
+    assert states.count("COMPLETE") + states.count("PRUNED") == 30
+    assert ("PRUNED" in states) == pruned
+    study = optuna.load_study(study_name=s.name, storage=open_storage(s.storage))
+    for t in study.get_trials():
+        if pruner == "wilcoxon":
+            # per-trajectory losses reported at the trajectory's index
+            assert set(t.intermediate_values) <= set(range(20))
+        else:
+            assert t.intermediate_values == {}
