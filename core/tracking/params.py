@@ -81,7 +81,8 @@ class TrackerParams:
     r11: float = 0.05
     r22: float = 0.03
     r33: float = 0.3
-    p0: tuple[float, ...] = DEFAULT_P0["cv"]
+    #: ``None`` takes the model's default (4 entries for CV, 6 for CA).
+    p0: tuple[float, ...] | None = None
     p_d: float = 0.9
     p_te: float = 0.2
     p11: float = 0.98
@@ -95,6 +96,8 @@ class TrackerParams:
     def __post_init__(self) -> None:
         if self.model not in MODELS:
             raise InputError(f"model must be one of {MODELS}, got model={self.model!r}")
+        if self.p0 is None:
+            object.__setattr__(self, "p0", DEFAULT_P0[self.model])
         try:
             p0 = tuple(float(v) for v in self.p0)
         except (TypeError, ValueError):
