@@ -6,29 +6,13 @@ import argparse
 import sys
 import traceback
 
+from core.cli.gui import add_arguments
+
 
 def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="radartune gui", description="Start the RadarTune window.")
     add_arguments(p)
     return p
-
-
-def add_arguments(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--scene", metavar="FILE", help="scene JSON to open (default: the paper scene)")
-    p.add_argument(
-        "--quit-after",
-        metavar="SECONDS",
-        type=float,
-        default=None,
-        help="close the window after this many seconds (smoke tests)",
-    )
-    p.add_argument("--paused", action="store_true", help="do not start playing")
-    p.add_argument(
-        "--settings",
-        metavar="FILE",
-        default=None,
-        help="settings file (INI); default: the user's RadarTune settings",
-    )
 
 
 def run(
