@@ -52,6 +52,7 @@ SIMULATORS: dict[str, str] = {
 #: ``core.simulation.measurement.simulate_frames_measurement``. They must give the same frames
 #: as the per-frame simulator with the same per-frame generators (tested).
 BATCH_SIMULATORS: dict[str, str] = {
+    "fast": "core.simulation.fast:simulate_frames_fast",
     "measurement": "core.simulation.measurement:simulate_frames_measurement",
 }
 
