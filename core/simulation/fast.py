@@ -607,7 +607,13 @@ def _cfar_line(p, n, g, cyclic, method, alpha_both, alpha_one, mask, mu, cs):  #
     # prefix sums over the (cyclically padded) line: cs[j] = sum of the first j padded cells
     cs[0] = 0.0
     for j in range(size + 2 * pad):
-        cs[j + 1] = cs[j] + p[(j - pad) % size]
+        # p[(j - pad) mod size] without an integer division
+        q = j - pad
+        while q < 0:
+            q += size
+        while q >= size:
+            q -= size
+        cs[j + 1] = cs[j] + p[q]
     for i in range(size):
         c = i + pad
         if cyclic:
