@@ -35,6 +35,12 @@ from the exact conditional law given those draws (:func:`detected_channels`). Th
 angle, SNR and labelling stages as the
 exact chain then run unchanged.
 
+Entry points: :func:`simulate_frame_fast` (one frame, the GUI's) and
+:func:`simulate_frames_fast` (all frames of a trajectory, the data-set path: per-scatterer inputs
+computed once, then per frame the noise map and one compiled kernel for patches, CFAR, detected
+channels, points and labels). The first is the second with one frame, so both give the same
+frames for the same per-frame generators.
+
 Known approximations (measured in ``docs/fidelity.md``): neighbouring cells of the exact chain's
 noise are correlated through the windows (range |rho|^2 = 0.44 for Hann), here they are
 independent; the beat tone's drift over the frame (<= 0.2 range bins at 1.8 m/s) is reduced to
