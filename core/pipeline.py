@@ -52,6 +52,7 @@ SIMULATORS: dict[str, str] = {
 #: ``core.simulation.measurement.simulate_frames_measurement``. They must give the same frames
 #: as the per-frame simulator with the same per-frame generators (tested).
 BATCH_SIMULATORS: dict[str, str] = {
+    "fast": "core.simulation.fast:simulate_frames_fast",
     "measurement": "core.simulation.measurement:simulate_frames_measurement",
 }
 
@@ -65,8 +66,14 @@ _STREAM = {"antenna": 0, "person_rcs": 1, "clutter": 2, "noise": 3}
 
 
 def stage_rng(seed: int, stage: str, frame: int = 0) -> np.random.Generator:
-    """The random stream of one stage in one frame: ``SeedSequence(seed, spawn_key=(s, f))``."""
-    return np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(_STREAM[stage], frame)))
+    """The random stream of one stage in one frame: ``SeedSequence(seed, spawn_key=(s, f))``.
+
+    (``Generator(PCG64(seq))`` is ``default_rng(seq)`` without its dispatch: ~10 µs less per
+    call, and data sets make two calls per frame.)
+    """
+    return np.random.Generator(
+        np.random.PCG64(np.random.SeedSequence(seed, spawn_key=(_STREAM[stage], frame)))
+    )
 
 
 # ---- the plan ----------------------------------------------------------------------------------
@@ -346,6 +353,7 @@ class _Reflectors:
     run_rcs: bool
     run_clutter: bool
     run_static: bool
+    _consts: _FrameConstants
 
     @classmethod
     def build(cls, scene: Scene, p: Plan, seed: int, antenna, settings) -> _Reflectors:
@@ -353,6 +361,7 @@ class _Reflectors:
         extended = np.array([q.model == "extended" for q in scene.persons], dtype=bool)
         if not p.runs("body_model"):
             extended[:] = False
+        fixed_rcs = np.array([np.nan if q.rcs_dbsm is None else q.rcs_dbsm for q in scene.persons])
         return cls(
             scene=scene,
             seed=seed,
@@ -361,9 +370,7 @@ class _Reflectors:
             truth_t_s=t_s,
             truth_xy_m=xy,
             truth_v_mps=v,
-            fixed_rcs=np.array(
-                [np.nan if q.rcs_dbsm is None else q.rcs_dbsm for q in scene.persons]
-            ),
+            fixed_rcs=fixed_rcs,
             extended=extended,
             headings={
                 i: walking_headings(q.trajectory.velocity_mps)
@@ -373,63 +380,142 @@ class _Reflectors:
             run_rcs=p.runs("person_rcs"),
             run_clutter=p.runs("clutter"),
             run_static=p.runs("static_reflectors"),
+            _consts=cls._constants(scene, fixed_rcs, p.runs("static_reflectors"), settings),
         )
 
     def frame(self, f: int) -> tuple[Any, int]:
-        """Scatterers of frame ``f`` and the number of clutter reflectors among them."""
+        """Scatterers of frame ``f`` and the number of clutter reflectors among them.
+
+        Bit for bit the reflectors of the straightforward construction (persons, body parts,
+        clutter, static reflectors, in this order) with the same per-frame streams; the
+        per-frame cost is kept low (about 0.2 ms) because data sets call it for every frame:
+        link-budget constants come from :attr:`_consts`, the arrays are filled in place and
+        validated with one combined check.
+        """
         from core import simulation as sim
 
-        scene, radar = self.scene, self.scene.radar
+        scene = self.scene
+        k = self._consts
         xy, v = self.truth_xy_m[f], self.truth_v_mps[f]
-        rcs = self.fixed_rcs.copy()
+        rcs = self.fixed_rcs
         if self.run_rcs:
             # σ_dBsm ~ N(−8, 16), eq. (5), drawn afresh every frame
             drawn = stage_rng(self.seed, "person_rcs", f).normal(
                 PERSON_RCS_MEAN_DBSM, PERSON_RCS_STD_DB, scene.n_persons
             )
-            rcs = np.where(np.isnan(self.fixed_rcs), drawn, self.fixed_rcs)
+            rcs = np.where(k.drawn_rcs, drawn, self.fixed_rcs)
         active = ~np.isnan(xy[:, 0])
         # persons: one point scatterer at the trajectory position, z = 0
-        point = active & ~self.extended
-        pos = [np.column_stack((xy[point], np.zeros(point.sum())))]
-        vel = [np.column_stack((v[point], np.zeros(point.sum())))]
-        rcs_list = [rcs[point]]
-        src = [np.flatnonzero(point).astype(np.int32)]
+        point = np.flatnonzero(active & ~self.extended)
+        pos2, vel2, rcs_list = [xy[point]], [v[point]], [rcs[point]]
+        src = [point.astype(np.int32)]
         for i in np.flatnonzero(active & self.extended):
             bp, bv, frac = body_scatterers(xy[i], v[i], self.headings[i][f], self.truth_t_s[f])
-            pos.append(np.column_stack((bp, np.zeros(len(bp)))))
-            vel.append(np.column_stack((bv, np.zeros(len(bv)))))
+            pos2.append(bp)
+            vel2.append(bv)
             # σ_part = σ · share (linear power)
             rcs_list.append(rcs[i] + 10 * np.log10(frac))
             src.append(np.full(len(bp), i, dtype=np.int32))
         n_clutter = 0
         if self.run_clutter:
             c = draw_clutter(
-                scene.aoi, scene.clutter_density_per_m2, radar, stage_rng(self.seed, "clutter", f)
+                scene.aoi,
+                scene.clutter_density_per_m2,
+                scene.radar,
+                stage_rng(self.seed, "clutter", f),
             )
             n_clutter = len(c)
             if n_clutter:
-                r = np.hypot(c.position_m[:, 0], c.position_m[:, 1])
-                az = np.arctan2(c.position_m[:, 0], c.position_m[:, 1])
-                pos.append(np.column_stack((c.position_m, np.zeros(n_clutter))))
-                vel.append(np.column_stack((c.velocity_mps, np.zeros(n_clutter))))
-                rcs_list.append(
-                    sim.rcs_for_snr_db(radar, r, az, c.snr_db, self.antenna, self.settings)
-                )
+                pos2.append(c.position_m)
+                vel2.append(c.velocity_mps)
+                rcs_list.append(self._clutter_rcs_dbsm(c.position_m, c.snr_db))
                 src.append(np.full(n_clutter, -1, dtype=np.int32))
-        static = scene.static_reflectors
-        if self.run_static and static:
-            pos.append(np.array([[q.x_m, q.y_m, q.z_m] for q in static]))
-            vel.append(np.zeros((len(static), 3)))
-            rcs_list.append(np.array([q.rcs_dbsm for q in static], dtype=np.float64))
-            src.append(np.full(len(static), -1, dtype=np.int32))
-        scatterers = sim.Scatterers(
-            position_m=np.concatenate(pos).astype(np.float64),
-            velocity_mps=np.concatenate(vel).astype(np.float64),
-            rcs_dbsm=np.concatenate(rcs_list).astype(np.float64),
-            source=np.concatenate(src).astype(np.int32),
+        moving = np.concatenate(pos2)
+        n_moving = len(moving)
+        n = n_moving + len(k.static_rcs)
+        position = np.zeros((n, 3))
+        velocity = np.zeros((n, 3))
+        position[:n_moving, :2] = moving
+        velocity[:n_moving, :2] = np.concatenate(vel2)
+        position[n_moving:] = k.static_position
+        if len(k.static_rcs):
+            rcs_list.append(k.static_rcs)
+            src.append(k.static_source)
+        rcs_all = np.concatenate(rcs_list).astype(np.float64)
+        source = np.concatenate(src).astype(np.int32)
+        return _scatterers(sim, position, velocity, rcs_all, source), n_clutter
+
+    @staticmethod
+    def _constants(scene: Scene, fixed_rcs, run_static: bool, settings) -> _FrameConstants:
+        """What does not change from frame to frame."""
+        from core import simulation as sim
+
+        radar, static = scene.radar, scene.static_reflectors
+        run_static = run_static and bool(static)
+        return _FrameConstants(
+            drawn_rcs=np.isnan(fixed_rcs),
+            pt_w=10 ** ((radar.tx_power_dbm - 30.0) / 10),
+            wavelength2_m2=radar.wavelength_m**2,
+            noise_power_w=radar.noise_power_w,
+            processing_gain_db=sim.processing_gain_db(radar, settings),
+            static_position=np.array([[q.x_m, q.y_m, q.z_m] for q in static], dtype=np.float64)
+            if run_static
+            else np.zeros((0, 3)),
+            static_rcs=np.array([q.rcs_dbsm for q in static], dtype=np.float64)
+            if run_static
+            else np.zeros(0),
+            static_source=np.full(len(static) if run_static else 0, -1, dtype=np.int32),
         )
-        return scatterers, n_clutter
+
+    def _clutter_rcs_dbsm(self, xy_m: np.ndarray, snr_db: np.ndarray) -> np.ndarray:
+        """RCS giving each clutter reflector its drawn SNR: ``core.simulation.rcs_for_snr_db``
+        with the frame-independent factors cached (same operations, same bits; tested)."""
+        k = self._consts
+        r = np.hypot(xy_m[:, 0], xy_m[:, 1])
+        az = np.arctan2(xy_m[:, 0], xy_m[:, 1])
+        g = 10 ** (self.antenna.gain_db(az) / 10)  # Gt = Gr
+        # Pr = Pt Gt Gr lambda^2 sigma / ((4 pi)^3 R^4), sigma = 1 m² (0 dBsm)
+        pr = k.pt_w * g * g * k.wavelength2_m2 / ((4 * np.pi) ** 3 * r**4)
+        # SNR(0 dBsm) = 10 log10(Pr / (k T F Be)) + G_proc;  σ_dBsm = SNR - SNR(0 dBsm)
+        return np.asarray(snr_db) - (10 * np.log10(pr / k.noise_power_w) + k.processing_gain_db)
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class _FrameConstants:
+    """Frame-independent inputs of :meth:`_Reflectors.frame`."""
+
+    drawn_rcs: np.ndarray  # (n_persons,) bool: RCS drawn every frame
+    pt_w: float
+    wavelength2_m2: float
+    noise_power_w: float
+    processing_gain_db: float
+    static_position: np.ndarray  # (S, 3)
+    static_rcs: np.ndarray  # (S,)
+    static_source: np.ndarray  # (S,) int32, -1
+
+
+def _scatterers(sim, position, velocity, rcs_dbsm, source):
+    """``Scatterers`` of arrays checked here in one pass (finite, off the radar); arrays that
+    fail go through the validating constructor, which names the field."""
+    ok = (
+        np.isfinite(position).all()
+        and np.isfinite(velocity).all()
+        and np.isfinite(rcs_dbsm).all()
+        and (len(position) == 0 or np.einsum("ij,ij->i", position, position).min() > 0)
+    )
+    if not ok:
+        return sim.Scatterers(
+            position_m=position, velocity_mps=velocity, rcs_dbsm=rcs_dbsm, source=source
+        )
+    s = object.__new__(sim.Scatterers)
+    for name, value in (
+        ("position_m", position),
+        ("velocity_mps", velocity),
+        ("rcs_dbsm", rcs_dbsm),
+        ("source", source),
+    ):
+        object.__setattr__(s, name, value)
+    return s
 
 
 def frame_scatterers(scene: Scene, frame: int, *, seed: int | None = None, the_plan=None):

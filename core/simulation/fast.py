@@ -35,6 +35,12 @@ from the exact conditional law given those draws (:func:`detected_channels`). Th
 angle, SNR and labelling stages as the
 exact chain then run unchanged.
 
+Entry points: :func:`simulate_frame_fast` (one frame, the GUI's) and
+:func:`simulate_frames_fast` (all frames of a trajectory, the data-set path: per-scatterer inputs
+computed once, then per frame the noise map and one compiled kernel for patches, CFAR, detected
+channels, points and labels). The first is the second with one frame, so both give the same
+frames for the same per-frame generators.
+
 Known approximations (measured in ``docs/fidelity.md``): neighbouring cells of the exact chain's
 noise are correlated through the windows (range |rho|^2 = 0.44 for Hann), here they are
 independent; the beat tone's drift over the frame (<= 0.2 range bins at 1.8 m/s) is reduced to
@@ -45,6 +51,8 @@ from __future__ import annotations
 
 import dataclasses
 import functools
+from collections.abc import Sequence
+from dataclasses import dataclass
 from typing import NamedTuple
 
 import numba
@@ -59,7 +67,8 @@ from core.config import (
     ProcessingSettings,
     RadarConfig,
 )
-from core.pointcloud import SOURCE_OTHER, PointCloud
+from core.errors import InputError
+from core.pointcloud import POINT_FIELDS, SOURCE_OTHER, PointCloud
 from core.processing import (
     Detections,
     estimate_angles,
@@ -486,33 +495,14 @@ def simulate_frame_fast(
     docstring for the model. ``rng`` draws the noise (a different stream from the exact level's,
     so the same seed gives statistically equivalent, not identical, frames).
     """
-    spec = fast_spectrum(
-        radar,
-        scatterers,
-        rng,
-        antenna=antenna,
-        settings=settings,
-        noise=noise,
-        n_range_bins=None if keep_rd_map else cfar_range_bins(radar, settings),
+    out, maps = _frames_fast(
+        radar, [scatterers], [rng], antenna, settings, elevation, noise, keep_rd_map
     )
-    rd = spec.rd_map
-    det = two_stage_cfar_compiled(rd, radar, settings, independent_cells=True)
-    if elevation is None:
-        elevation = needs_elevation(radar, scatterers)
-    pc = PointCloud.empty()
-    if len(det):
-        ch = detected_channels(radar, spec, det, rng)
-        pc = label_points(
-            radar, points_compiled(radar, settings, rd, det, ch, elevation), scatterers
-        )
     rd_db = None
     if keep_rd_map:
+        rd = maps[0]
         rd_db = (10 * np.log10(np.maximum(rd, np.finfo(np.float32).tiny))).astype(np.float32)
-    return FrameOutput(
-        point_cloud=pc,
-        rd_map_db=rd_db,
-        detections=np.column_stack((det.range_bin, det.doppler_index)).astype(np.int64),
-    )
+    return FrameOutput(point_cloud=out.point_cloud, rd_map_db=rd_db, detections=out.detections)
 
 
 def detected_channels(
@@ -623,7 +613,13 @@ def _cfar_line(p, n, g, cyclic, method, alpha_both, alpha_one, mask, mu, cs):  #
     # prefix sums over the (cyclically padded) line: cs[j] = sum of the first j padded cells
     cs[0] = 0.0
     for j in range(size + 2 * pad):
-        cs[j + 1] = cs[j] + p[(j - pad) % size]
+        # p[(j - pad) mod size] without an integer division
+        q = j - pad
+        while q < 0:
+            q += size
+        while q >= size:
+            q -= size
+        cs[j + 1] = cs[j] + p[q]
     for i in range(size):
         c = i + pad
         if cyclic:
@@ -1011,3 +1007,390 @@ def points_compiled(
         z_m=rng_m * np.sin(el),
         source=np.full(len(det), SOURCE_OTHER, dtype=np.int32),
     )
+
+
+@dataclass(frozen=True, slots=True, kw_only=True, eq=False)
+class FramesOutput:
+    """Points of many frames, concatenated (the batch simulators' result).
+
+    Attributes
+    ----------
+    point_cloud
+        Points of every frame in frame order, ``(n_points,)`` per field.
+    counts
+        ``(F,)`` int64: points per frame.
+    detections
+        ``(n_points, 2)`` int64: range bin, Doppler index (as :class:`FrameOutput`).
+    """
+
+    point_cloud: PointCloud
+    counts: np.ndarray
+    detections: np.ndarray
+
+    def clouds(self) -> list[PointCloud]:
+        """The per-frame point clouds (views into the concatenated arrays)."""
+        edges = np.concatenate(([0], np.cumsum(self.counts)))
+        pc = self.point_cloud
+        names = (*POINT_FIELDS, "source")
+        return [
+            PointCloud(**{k: getattr(pc, k)[a:b] for k in names})
+            for a, b in zip(edges[:-1].tolist(), edges[1:].tolist())
+        ]
+
+
+# ---- all frames of a trajectory: the batch path -------------------------------------------------
+# Everything after the noise map in one compiled call per frame (patches, CFAR, detected
+# channels, points, labels); the per-scatterer inputs (link budget, slow-time sequences,
+# steering) are computed once for all frames. simulate_frame_fast is this path with one frame,
+# so the per-frame (GUI) and batch (data set) entry points give the same frames.
+
+
+@numba.njit(cache=True, nogil=True)
+def _detected_channels_kernel(rng, rd, r, d, cells_k, cells_d, x, along, ortho):  # pragma: no cover
+    """:func:`detected_channels` compiled (same conditional laws, same draw order)."""
+    n_det = r.shape[0]
+    n_v = x.shape[1]
+    n_d = rd.shape[1]
+    # z = N(0, 1) + j N(0, 1): all real parts first, then all imaginary parts
+    zr = np.empty((n_det, n_v))
+    zi = np.empty((n_det, n_v))
+    for i in range(n_det):
+        for v in range(n_v):
+            zr[i, v] = rng.standard_normal()
+    for i in range(n_det):
+        for v in range(n_v):
+            zi[i, v] = rng.standard_normal()
+    out = np.empty((n_det, n_v), dtype=np.complex128)
+    n_c = cells_k.shape[0]
+    u = np.empty(n_v, dtype=np.complex128)
+    w = np.empty(n_v, dtype=np.complex128)
+    for i in range(n_det):
+        want = r[i] * n_d + d[i]
+        # patch cells are sorted by linear index (range bin, then Doppler index)
+        lo, hi = 0, n_c
+        while lo < hi:
+            mid = (lo + hi) // 2
+            if cells_k[mid] * n_d + cells_d[mid] < want:
+                lo = mid + 1
+            else:
+                hi = mid
+        j = lo if lo < n_c and cells_k[lo] * n_d + cells_d[lo] == want else -1
+        for v in range(n_v):
+            w[v] = zr[i, v] + 1j * zi[i, v]
+        if j >= 0:
+            norm2 = 0.0
+            for v in range(n_v):
+                norm2 += x[j, v].real ** 2 + x[j, v].imag ** 2
+            norm = np.sqrt(norm2)
+            for v in range(n_v):
+                # u = s / |s| (first unit vector when s = 0)
+                u[v] = x[j, v] / norm if norm > 0 else (1.0 + 0j if v == 0 else 0j)
+            proj = 0j
+            for v in range(n_v):
+                proj += np.conj(u[v]) * w[v]
+            p2 = 0.0
+            for v in range(n_v):
+                w[v] -= u[v] * proj  # w orthogonal to u
+                p2 += w[v].real ** 2 + w[v].imag ** 2
+            scale = np.sqrt(ortho[j] / p2)
+            for v in range(n_v):
+                # x = s + n_1 u + w,  |w|^2 = drawn orthogonal power
+                out[i, v] = x[j, v] + along[j] * u[v] + w[v] * scale
+        else:
+            p2 = 0.0
+            for v in range(n_v):
+                p2 += w[v].real ** 2 + w[v].imag ** 2
+            # x = P^(1/2) z / |z|
+            scale = np.sqrt(np.float64(rd[r[i], d[i]]) / p2)
+            for v in range(n_v):
+                out[i, v] = w[v] * scale
+    return out
+
+
+@numba.njit(cache=True, nogil=True)
+def _label_kernel(range_m, vr_m, pos, vel, source, t_mid, res_r, res_v, span):  # pragma: no cover
+    """:func:`core.processing.label_sources` with reflectors at mid-frame, compiled."""
+    n = range_m.shape[0]
+    n_s = pos.shape[0]
+    out = np.full(n, -2, dtype=np.int32)
+    r_ref = np.empty(n_s)
+    v_ref = np.empty(n_s)
+    for s in range(n_s):
+        p0 = pos[s, 0] + vel[s, 0] * t_mid
+        p1 = pos[s, 1] + vel[s, 1] * t_mid
+        p2 = pos[s, 2] + vel[s, 2] * t_mid
+        r_ref[s] = np.sqrt(p0 * p0 + p1 * p1 + p2 * p2)
+        # v_r = p(t_mid) . v / |p(t_mid)|
+        v_ref[s] = (p0 * vel[s, 0] + p1 * vel[s, 1] + p2 * vel[s, 2]) / r_ref[s]
+    for i in range(n):
+        best = np.inf
+        for s in range(n_s):
+            dr = (range_m[i] - r_ref[s]) / res_r
+            # radial velocities compared modulo 2 v_max (Doppler aliasing)
+            dv = ((vr_m[i] - v_ref[s]) + span / 2) % span - span / 2
+            dv /= res_v
+            if abs(dr) <= 1.0 and abs(dv) <= 1.0:
+                dist = dr * dr + dv * dv
+                if dist < best:
+                    best = dist
+                    out[i] = source[s]
+    return out
+
+
+@numba.njit(cache=True, nogil=True)
+def _frame_kernel(
+    rng,
+    rd,
+    amp,
+    theta,
+    slow,
+    slow1,
+    steer,
+    pos,
+    vel,
+    source,
+    elevation,
+    noise,
+    n_use,
+    wd,
+    b,
+    s2,
+    slot,
+    threshold,
+    tw_r,
+    tw_d,
+    has_cfar,
+    profile,
+    lo,
+    hi,
+    a,
+    bb,
+    rn,
+    rg,
+    rcyc,
+    rmeth,
+    ralpha,
+    ralpha1,
+    dn,
+    dg,
+    dcyc,
+    dmeth,
+    dalpha,
+    dalpha1,
+    peak,
+    n_tx,
+    n_rx,
+    row_ch,
+    row_pos,
+    upper,
+    lower,
+    tw_a,
+    res_r,
+    res_v,
+    t_mid,
+    span,
+):  # pragma: no cover
+    """One frame after its noise map: patches, CFAR, detected channels, points, labels.
+
+    Returns ``(det_r, det_d, f64 (n, 8), source)`` with ``f64`` columns range, azimuth,
+    elevation, radial velocity, SNR, x, y, z.
+    """
+    cells_k, cells_d, x, along, ortho = _signal_kernel(
+        rng,
+        rd,
+        amp,
+        theta,
+        slow,
+        slow1,
+        wd,
+        b,
+        s2,
+        steer,
+        slot,
+        threshold,
+        tw_r,
+        tw_d,
+        noise,
+        n_use,
+    )
+    if has_cfar:
+        r, d, nz = _two_stage_kernel(
+            rd,
+            profile,
+            lo,
+            hi,
+            a,
+            bb,
+            rn,
+            rg,
+            rcyc,
+            rmeth,
+            ralpha,
+            ralpha1,
+            dn,
+            dg,
+            dcyc,
+            dmeth,
+            dalpha,
+            dalpha1,
+            peak,
+        )
+    else:
+        r = np.zeros(0, dtype=np.int64)
+        d = np.zeros(0, dtype=np.int64)
+        nz = np.zeros(0)
+    n_det = r.shape[0]
+    f64 = np.empty((n_det, 8))
+    src = np.full(n_det, -2, dtype=np.int32)
+    if n_det == 0:
+        return r, d, f64, src
+    ch = _detected_channels_kernel(rng, rd, r, d, cells_k, cells_d, x, along, ortho)
+    r_bin, d_bin, az, el = _points_kernel(
+        rd, r, d, ch, n_tx, n_rx, row_ch, row_pos, upper, lower, tw_a, elevation
+    )
+    for i in range(n_det):
+        rng_m = r_bin[i] * res_r
+        horiz = rng_m * np.cos(el[i])
+        f64[i, 0] = rng_m
+        f64[i, 1] = az[i]
+        f64[i, 2] = el[i]
+        f64[i, 3] = d_bin[i] * res_v
+        # SNR = 10 log10(P / noise estimate)
+        f64[i, 4] = 10 * np.log10(np.float64(rd[r[i], d[i]]) / nz[i])
+        f64[i, 5] = horiz * np.sin(az[i])
+        f64[i, 6] = horiz * np.cos(az[i])
+        f64[i, 7] = rng_m * np.sin(el[i])
+    if pos.shape[0]:
+        src = _label_kernel(f64[:, 0], f64[:, 3], pos, vel, source, t_mid, res_r, res_v, span)
+    return r, d, f64, src  # fmt: skip
+
+
+def _frames_fast(
+    radar: RadarConfig,
+    frames: Sequence[Scatterers],
+    rngs: Sequence[np.random.Generator | None],
+    antenna: AntennaGain,
+    settings: ProcessingSettings,
+    elevation: bool | None,
+    noise: bool,
+    keep_rd_map: bool,
+):
+    """Shared body of :func:`simulate_frames_fast` and :func:`simulate_frame_fast`.
+
+    Returns ``(FramesOutput, rd maps or None)``.
+    """
+    if len(frames) != len(rngs):
+        raise InputError(f"rngs: {len(rngs)} generators for {len(frames)} frames")
+    n_f = len(frames)
+    n_r, n_d, n_v = radar.n_samples, radar.n_loops, radar.n_virtual
+    s2 = cell_noise_power_v2(radar, settings)  # (n_d,)
+    s2_32 = s2.astype(np.float32)
+    n_use = n_r if keep_rd_map else max(0, min(n_r, cfar_range_bins(radar, settings)))
+    counts = np.fromiter((len(s) for s in frames), dtype=np.int64, count=n_f)
+    start = np.zeros(n_f + 1, dtype=np.int64)
+    np.cumsum(counts, out=start[1:])
+    every = Scatterers.concatenate(list(frames)) if start[-1] else Scatterers.empty()
+    # per scatterer, all frames at once: link budget, beat tone, slow time, steering
+    power = received_power_w(radar, every.range_m, every.azimuth_rad, every.rcs_dbsm, antenna)
+    amp = signal_amplitude_v(radar, power)  # (N,)
+    t_mid = 0.5 * radar.n_loops * radar.n_tx * radar.chirp_period_s
+    r_mid = np.linalg.norm(every.position_m + every.velocity_mps * t_mid, axis=1)
+    # theta = 2 pi (2 S R / c) / Fs   (rad per sample)
+    theta = _beat_rad_per_sample_per_m(radar) * r_mid
+    slow, slow1 = slow_time_sequences(radar, every, settings)
+    steer = np.ascontiguousarray(steering_vectors(radar, every))
+    pos = np.ascontiguousarray(every.position_m, dtype=np.float64)
+    vel = np.ascontiguousarray(every.velocity_mps, dtype=np.float64)
+    source = np.ascontiguousarray(every.source, dtype=np.int32)
+    cfar = _cfar_arguments(radar, settings, n_v, n_r, n_d, True)
+    has_cfar = cfar is not None
+    if cfar is None:  # no range bin inside the limits: nothing is tested
+        e = np.ones(1)
+        cfar = (e, 0, 0, 0, 0, 1, 0, False, 0, 1.0, 1.0, 1, 0, False, 0, 1.0, 1.0, False)
+    consts = (
+        window(settings.doppler_window, n_d).astype(np.float64),
+        _cosine_sum_coefficients(settings.range_window, n_r),
+        s2,
+        np.arange(n_v) // radar.n_rx,
+        PATCH_THRESHOLD,
+        *_twiddles(n_r, n_d),
+        has_cfar,
+        *cfar,
+        radar.n_tx,
+        radar.n_rx,
+        *array_rows(radar),
+        angle_twiddles(radar, settings.angle_fft_size),
+        radar.range_resolution_m,
+        radar.velocity_resolution_mps,
+        t_mid,
+        2 * radar.max_velocity_mps,
+    )
+    quiet = np.random.default_rng(0)
+    out_r, out_d, out_f, out_s, maps = [], [], [], [], []
+    n_out = np.zeros(n_f, dtype=np.int64)
+    for f in range(n_f):
+        a, b = start[f], start[f + 1]
+        rng = rngs[f] if noise else quiet
+        if noise:
+            # noise-only cell: sum of L exponentials of mean s2[d] ~ s2[d] Gamma(L)
+            rd = np.empty((n_r, n_d), dtype=np.float32)
+            rd[:n_use] = rng.standard_gamma(float(n_v), (n_use, n_d), dtype=np.float32)
+            rd[:n_use] *= s2_32[None, :]
+            rd[n_use:] = (n_v * s2).astype(np.float32)[None, :]
+        else:
+            rd = np.zeros((n_r, n_d), dtype=np.float32)
+        elev = needs_elevation(radar, frames[f]) if elevation is None else bool(elevation)
+        r, d, f64, src = _frame_kernel(
+            rng, rd, amp[a:b], theta[a:b], slow[a:b], slow1[a:b], steer[a:b],
+            pos[a:b], vel[a:b], source[a:b], elev, bool(noise), n_use, *consts,
+        )  # fmt: skip
+        out_r.append(r)
+        out_d.append(d)
+        out_f.append(f64)
+        out_s.append(src)
+        n_out[f] = len(r)
+        if keep_rd_map:
+            maps.append(rd)
+    f64 = np.concatenate(out_f) if n_f else np.zeros((0, 8))
+    pc = PointCloud(
+        range_m=f64[:, 0].copy(),
+        azimuth_rad=f64[:, 1].copy(),
+        elevation_rad=f64[:, 2].copy(),
+        radial_velocity_mps=f64[:, 3].copy(),
+        snr_db=f64[:, 4].copy(),
+        x_m=f64[:, 5].copy(),
+        y_m=f64[:, 6].copy(),
+        z_m=f64[:, 7].copy(),
+        source=np.concatenate(out_s) if n_f else np.zeros(0, dtype=np.int32),
+    )
+    det = np.zeros((0, 2), dtype=np.int64)
+    if n_f:
+        det = np.column_stack((np.concatenate(out_r), np.concatenate(out_d))).astype(np.int64)
+    return FramesOutput(point_cloud=pc, counts=n_out, detections=det), (maps or None)
+
+
+def simulate_frames_fast(
+    radar: RadarConfig,
+    frames: Sequence[Scatterers],
+    rngs: Sequence[np.random.Generator | None],
+    *,
+    antenna: AntennaGain,
+    settings: ProcessingSettings = DEFAULT_PROCESSING,
+    elevation: bool | None = None,
+    noise: bool = True,
+) -> FramesOutput:
+    """Many frames at the ``fast`` level (the data-set path).
+
+    Frame ``f`` draws only from ``rngs[f]``, in the order :func:`simulate_frame_fast` draws,
+    so the result equals the per-frame entry point's frames bit for bit (tested).
+
+    Parameters
+    ----------
+    frames
+        ``F`` frames' reflectors.
+    rngs
+        ``F`` generators, one per frame (the pipeline's ``stage_rng(seed, "noise", f)``).
+    elevation
+        Estimate elevation; ``None``: per frame, when the radar can and the frame is not planar.
+    """
+    return _frames_fast(radar, frames, rngs, antenna, settings, elevation, noise, False)[0]

@@ -68,12 +68,13 @@ import numpy as np
 
 from core.config import DEFAULT_PROCESSING, SPEED_OF_LIGHT_MPS, ProcessingSettings, RadarConfig
 from core.errors import InputError
-from core.pointcloud import POINT_FIELDS, SOURCE_OTHER, PointCloud
+from core.pointcloud import SOURCE_OTHER, PointCloud
 from core.processing import estimate_angles, make_cfar
 from core.processing.angle import log_parabolic_offset
 from core.processing.spectrum import window
 from core.simulation.antenna import AntennaGain
 from core.simulation.fast import (
+    FramesOutput,
     angle_twiddles,
     angles_of,
     array_rows,
@@ -393,35 +394,6 @@ def _constants(radar: RadarConfig, settings: ProcessingSettings):
         "bin_hi": int(ok[-1]) if ok.size else -1,
         "m_az": min(n_row, len(set(radar.azimuth_positions))),
     }
-
-
-@dataclass(frozen=True, slots=True, kw_only=True, eq=False)
-class FramesOutput:
-    """Result of :func:`simulate_frames_measurement`: the points of many frames, concatenated.
-
-    Attributes
-    ----------
-    point_cloud
-        Points of every frame in frame order, ``(n_points,)`` per field.
-    counts
-        ``(F,)`` int64: points per frame.
-    detections
-        ``(n_points, 2)`` int64: range bin, Doppler index (as :class:`FrameOutput`).
-    """
-
-    point_cloud: PointCloud
-    counts: np.ndarray
-    detections: np.ndarray
-
-    def clouds(self) -> list[PointCloud]:
-        """The per-frame point clouds (views into the concatenated arrays)."""
-        edges = np.concatenate(([0], np.cumsum(self.counts)))
-        pc = self.point_cloud
-        names = (*POINT_FIELDS, "source")
-        return [
-            PointCloud(**{k: getattr(pc, k)[a:b] for k in names})
-            for a, b in zip(edges[:-1].tolist(), edges[1:].tolist())
-        ]
 
 
 def frame_seed(rng: np.random.Generator | None) -> np.ndarray:
