@@ -892,13 +892,15 @@ def paper_dataset(
     jobs: int | None = None,
     progress: ProgressCallback | None = None,
     use_cache: bool = True,
+    person_model: str = "point",
 ) -> Dataset:
     """The paper's data set: :func:`core.scene.paper_scenes` simulated (cached).
 
     Each trajectory is simulated with its scene's own seed, so ``simulate_scene(scene)`` of any
-    of the scenes reproduces its frames of the data set bit for bit.
+    of the scenes reproduces its frames of the data set bit for bit. ``person_model``
+    (``"point"`` or ``"extended"``) changes only the person's scattering model.
     """
-    scenes = paper_scenes(seed, n_trajectories)
+    scenes = paper_scenes(seed, n_trajectories, person_model=person_model)
     return build_dataset(
         scenes,
         seeds=[s.seed for s in scenes],
@@ -951,13 +953,15 @@ def paper_dataset_file(
     cache_dir: str | os.PathLike | None = None,
     jobs: int | None = None,
     progress: ProgressCallback | None = None,
+    person_model: str = "point",
 ) -> Path:
     """Path of the cached paper data set (simulated first if not cached).
 
     For study workers, which should receive a file path rather than an in-memory data set: the
-    file lives in the cache under its content key, so it is never stale.
+    file lives in the cache under its content key, so it is never stale. ``person_model`` as in
+    :func:`paper_dataset`.
     """
-    scenes = paper_scenes(seed, n_trajectories)
+    scenes = paper_scenes(seed, n_trajectories, person_model=person_model)
     seeds = [s.seed for s in scenes]
     root = Path(cache_dir) if cache_dir is not None else default_cache_dir()
     key = dataset_key(scenes, fidelity=fidelity, seed=seed, seeds=seeds)

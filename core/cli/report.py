@@ -17,13 +17,24 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         default="paper:1",
         help="second data set from another seed (default: %(default)s; 'none' skips it)",
     )
+    p.add_argument(
+        "--person-model",
+        default=None,
+        help="person model of a paper:SEED generalisation set: point (default) or extended",
+    )
     p.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
+    from core.errors import InputError
     from core.optimization.report import write_report
 
     gen = None if args.generalisation in ("none", "") else args.generalisation
+    if args.person_model is not None:
+        if gen is None or not gen.startswith("paper:"):
+            raise InputError("--person-model needs a paper:SEED --generalisation set")
+        if gen.count(":") == 1:
+            gen = f"{gen}:{args.person_model}"
     command = "radartune " + " ".join(shlex.quote(a) for a in sys.argv[1:])
     r = write_report(
         args.storage, args.out, dataset=args.dataset, generalisation_dataset=gen, command=command

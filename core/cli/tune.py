@@ -32,6 +32,12 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         help="data-set .npz, or paper:SEED (default: the paper's data set, seed 0, cached)",
     )
     p.add_argument(
+        "--person-model",
+        default=None,
+        help="person model of the paper data set: point (default) or extended; same "
+        "trajectories and seeds (docs/report/extended-person.md)",
+    )
+    p.add_argument(
         "--objective", default="tracker", help="tracker, or quadratic (machinery tests only)"
     )
     p.add_argument(
@@ -82,7 +88,7 @@ def run(args: argparse.Namespace) -> int:
                 "data set: the paper's (simulated once and cached; minutes the first time)",
                 file=sys.stderr,
             )
-        path = resolve_dataset(args.dataset)
+        path = resolve_dataset(args.dataset, person_model=args.person_model)
     handle = start_study(settings, dataset_path=path)
     bar = None
     if not args.no_progress:

@@ -12,22 +12,51 @@ from pathlib import Path
 from core.errors import InputError
 
 
-def resolve_dataset(dataset: str | None, *, n_trajectories: int = 35) -> str:
+def resolve_dataset(
+    dataset: str | None, *, n_trajectories: int = 35, person_model: str | None = None
+) -> str:
     """A data-set argument → an existing ``.npz`` path.
 
     ``None`` or ``"paper"``: the paper's data set of seed 0; ``"paper:SEED"``: of another seed
-    (35 trajectories, 7 per class); anything else: a path to a data-set file.
+    (35 trajectories, 7 per class); ``"paper:SEED:MODEL"``: with the person model ``MODEL``
+    (``point`` or ``extended``; same trajectories and seeds); anything else: a path to a
+    data-set file. ``person_model``, if given, applies to the ``paper`` forms without a model
+    (and must agree with one given in the string).
     """
     if dataset in (None, "", "paper") or str(dataset).startswith("paper:"):
         seed = 0
-        if dataset and ":" in dataset:
+        model = person_model or "point"
+        parts = str(dataset).split(":") if dataset else ["paper"]
+        if len(parts) > 3:
+            raise InputError(f"data set {dataset!r}: expected paper:SEED or paper:SEED:MODEL")
+        if len(parts) >= 2:
             try:
-                seed = int(dataset.split(":", 1)[1])
+                seed = int(parts[1])
             except ValueError:
-                raise InputError(f"data set {dataset!r}: expected paper:SEED") from None
+                raise InputError(
+                    f"data set {dataset!r}: expected paper:SEED or paper:SEED:MODEL"
+                ) from None
+        if len(parts) == 3:
+            if person_model is not None and person_model != parts[2]:
+                raise InputError(
+                    f"data set {dataset!r} names person model {parts[2]!r}, "
+                    f"but --person-model is {person_model!r}"
+                )
+            model = parts[2]
         from core.pipeline import paper_dataset_file
+        from core.scene.scene import PERSON_MODELS
 
-        return str(paper_dataset_file(seed, n_trajectories))
+        if model not in PERSON_MODELS:
+            raise InputError(
+                f"data set {dataset!r}: person model must be one of {list(PERSON_MODELS)}, "
+                f"got {model!r}"
+            )
+        return str(paper_dataset_file(seed, n_trajectories, person_model=model))
+    if person_model not in (None, "point"):
+        raise InputError(
+            f"--person-model {person_model!r} applies to the paper data sets only, "
+            f"not to the file {dataset!r}"
+        )
     path = Path(dataset)
     if not path.is_file():
         raise InputError(f"data set {dataset!r} does not exist")

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 import os
@@ -500,17 +501,31 @@ def class_scene(
     )
 
 
-def paper_scenes(seed: int, n_trajectories: int = 35) -> list[Scene]:
+def paper_scenes(
+    seed: int, n_trajectories: int = 35, *, person_model: str = "point"
+) -> list[Scene]:
     """The paper's data set: 7 trajectories per class, ordered round-robin a, b, c, d, e, a, …
 
     Trajectory ``k`` has class ``"abcde"[k % 5]``; its trajectory seed and its scene seed come
     from ``numpy.random.SeedSequence(seed).spawn(n_trajectories)`` (child ``k`` →
     two 32-bit words), so the set depends on ``seed`` only.
+
+    ``person_model`` (``"point"``, the paper's, or ``"extended"``) changes only the person's
+    scattering model (:class:`Person` ``model``): trajectories, scene seeds and everything else
+    are those of the point-model set of the same ``seed``.
     """
     if n_trajectories < 1:
         raise InputError(f"n_trajectories must be >= 1, got {n_trajectories}")
+    if person_model not in PERSON_MODELS:
+        raise InputError(f"person_model must be one of {list(PERSON_MODELS)}, got {person_model!r}")
     scenes = []
     for k, child in enumerate(np.random.SeedSequence(seed).spawn(n_trajectories)):
         traj_seed, scene_seed = (int(s) for s in child.generate_state(2))
-        scenes.append(class_scene(TRAJECTORY_CLASSES[k % 5], traj_seed, seed=scene_seed))
+        scene = class_scene(TRAJECTORY_CLASSES[k % 5], traj_seed, seed=scene_seed)
+        if person_model != "point":
+            scene = dataclasses.replace(
+                scene,
+                persons=tuple(dataclasses.replace(p, model=person_model) for p in scene.persons),
+            )
+        scenes.append(scene)
     return scenes
