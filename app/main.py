@@ -15,6 +15,50 @@ def build_parser() -> argparse.ArgumentParser:
     return p
 
 
+def missing_platform_libraries() -> list[str]:
+    """System libraries Qt's X11 platform plugin needs but cannot find (empty when fine).
+
+    Qt aborts the whole process with a long message when its ``xcb`` plugin cannot load, so this
+    is checked before Qt starts: ``ldd`` of the plugin and its XCB library, plus
+    ``libxcb-cursor``, which Qt >= 6.5 opens at run time. Only on Linux with X11.
+    """
+    import ctypes.util
+    import os
+    import subprocess
+    from pathlib import Path
+
+    platform = os.environ.get("QT_QPA_PLATFORM", "")
+    if not sys.platform.startswith("linux") or platform not in ("", "xcb"):
+        return []
+    if not os.environ.get("DISPLAY"):
+        return []  # Wayland or no display at all: Qt says so itself
+    try:
+        import PySide6
+    except ImportError:
+        return []
+    qt = Path(PySide6.__file__).parent / "Qt"
+    missing: list[str] = []
+    for lib in (qt / "plugins/platforms/libqxcb.so", qt / "lib/libQt6XcbQpa.so.6"):
+        try:
+            out = subprocess.run(["ldd", str(lib)], capture_output=True, text=True, timeout=10)
+        except (OSError, subprocess.SubprocessError):
+            return []  # cannot tell: let Qt try
+        for line in out.stdout.splitlines():
+            if "not found" in line:
+                name = line.split("=>")[0].strip()
+                if name not in missing:
+                    missing.append(name)
+    if ctypes.util.find_library("xcb-cursor") is None:
+        missing.append("libxcb-cursor.so.0")
+    return missing
+
+
+def debian_package(soname: str) -> str:
+    """Debian package of a shared library: ``libxcb-icccm.so.4`` -> ``libxcb-icccm4``."""
+    name, _, version = soname.partition(".so.")
+    return f"{name}-{version}" if name[-1].isdigit() else f"{name}{version}"
+
+
 def run(
     scene: str | None = None,
     quit_after: float | None = None,
@@ -22,6 +66,15 @@ def run(
     settings_file: str | None = None,
 ) -> int:
     """Create the QApplication and the main window, play, and run the event loop."""
+    missing = missing_platform_libraries()
+    if missing:
+        packages = " ".join(debian_package(m) for m in missing)
+        print(
+            "radartune gui: error: Qt's X11 platform plugin cannot load; missing system "
+            f"libraries {', '.join(missing)} (Debian/Ubuntu: sudo apt-get install {packages})",
+            file=sys.stderr,
+        )
+        return 2
     import pyqtgraph as pg
     from PySide6 import QtCore, QtWidgets
 
