@@ -357,6 +357,28 @@ def _kernel_args(c: _SidedCfar) -> tuple:
 
 
 @numba.njit(cache=True, nogil=True)
+def cfar_level(left, right, ok_l, ok_r, n, method, a_both, a_one):  # pragma: no cover
+    """Noise level and threshold factor of one cell from its training-window sums.
+
+    ``left``/``right`` are the sums of the ``n`` training cells on each side, ``ok_l``/``ok_r``
+    whether that side exists; ``method`` 0 CA (mean of both), 1 CASO (smaller), 2 CAGO (greater).
+    With one side only, that side's mean and the one-sided factor ``a_one``; with none, NaN (no
+    detection). Shared by the library's CFAR and the ``fast`` level's compiled copy.
+    """
+    if ok_l and ok_r:
+        if method == 0:
+            return (left + right) / (2 * n), a_both
+        if method == 1:
+            return min(left, right) / n, a_both
+        return max(left, right) / n, a_both
+    if ok_l:
+        return left / n, a_one
+    if ok_r:
+        return right / n, a_one
+    return np.nan, a_one
+
+
+@numba.njit(cache=True, nogil=True)
 def _cfar_line(p, n, g, cyclic, method, a_both, a_one, mask, noise):  # pragma: no cover
     """One line of a sided CFAR; the same arithmetic as ``_SidedCfar.detect``."""
     size = p.shape[0]
@@ -371,23 +393,7 @@ def _cfar_line(p, n, g, cyclic, method, a_both, a_one, mask, noise):  # pragma: 
         ok_r = cyclic or i + g + n <= size - 1
         left = cs[c - g] - cs[c - g - n] if ok_l else 0.0
         right = cs[c + g + 1 + n] - cs[c + g + 1] if ok_r else 0.0
-        if ok_l and ok_r:
-            if method == 0:
-                mu = (left + right) / (2 * n)
-            elif method == 1:
-                mu = min(left, right) / n
-            else:
-                mu = max(left, right) / n
-            alpha = a_both
-        elif ok_l:
-            mu = left / n
-            alpha = a_one
-        elif ok_r:
-            mu = right / n
-            alpha = a_one
-        else:
-            mu = np.nan
-            alpha = a_one
+        mu, alpha = cfar_level(left, right, ok_l, ok_r, n, method, a_both, a_one)
         noise[i] = mu
         mask[i] = p[i] > alpha * mu
 

@@ -78,7 +78,7 @@ from core.processing import (
     window,
 )
 from core.processing.angle import azimuth_row, elevation_pairs
-from core.processing.cfar import two_stage_pfa
+from core.processing.cfar import cfar_level, two_stage_pfa
 from core.processing.spectrum import clutter_removal_noise_profile, effective_cells
 from core.simulation.antenna import AntennaGain
 from core.simulation.baseband import steering_vectors
@@ -632,26 +632,9 @@ def _cfar_line(p, n, g, cyclic, method, alpha_both, alpha_one, mask, mu, cs):  #
             ok_r = i + g + n <= size - 1
             left = cs[max(0, i - g)] - cs[max(0, i - g - n)]
             right = cs[min(size, i + g + 1 + n)] - cs[min(size, i + g + 1)]
-        if ok_l and ok_r:
-            if method == 0:
-                m = (left + right) / (2 * n)
-            elif method == 1:
-                m = min(left, right) / n
-            else:
-                m = max(left, right) / n
-            a = alpha_both
-        elif ok_l:
-            m = left / n
-            a = alpha_one
-        elif ok_r:
-            m = right / n
-            a = alpha_one
-        else:
-            mu[i] = np.nan
-            mask[i] = False
-            continue
+        m, a = cfar_level(left, right, ok_l, ok_r, n, method, alpha_both, alpha_one)
         mu[i] = m
-        mask[i] = p[i] > a * m
+        mask[i] = p[i] > a * m  # False when no training side exists (m is NaN)
 
 
 @numba.njit(cache=True, nogil=True)
