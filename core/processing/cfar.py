@@ -331,22 +331,21 @@ def _cfar_plan(radar: RadarConfig, settings: ProcessingSettings, n_r: int, n_d: 
     lo, hi = int(inside[0]), int(inside[-1])
     rc, dc = settings.range_cfar, settings.doppler_cfar
     ne_r = ne_d = None
-    profile = None
-    dead = np.zeros(n_d, dtype=np.bool_)
+    profile = np.ones(n_d)
     if settings.cfar_noise_model:
         ne_r = _effective(settings.range_window, radar.n_samples, rc.n_train)
         ne_d = _effective(settings.doppler_window, n_d, dc.n_train)
         if settings.static_clutter_removal:
-            g = clutter_removal_noise_profile(settings.doppler_window, n_d)
-            dead = g < 0.01
-            profile = np.where(dead, 1.0, g)
-            profile.flags.writeable = False
-    dead.flags.writeable = False
+            # whitening profile; bins below 0.01 (rectangular window: zero Doppler) are dead
+            profile = np.ascontiguousarray(
+                clutter_removal_noise_profile(settings.doppler_window, n_d), dtype=np.float64
+            )
+    profile.flags.writeable = False
     # the range stage needs training cells beyond the limits: run it on a margin around them
     margin = rc.n_train + rc.n_guard
     a, b = max(0, lo - margin), min(n_r, hi + 1 + margin)
     args = (*_kernel_args(make_cfar(rc, L, ne_r)), *_kernel_args(make_cfar(dc, L, ne_d)))
-    return lo, hi, a, b, profile, dead, args
+    return lo, hi, a, b, profile, args
 
 
 _METHOD_CODE = {"ca": 0, "caso": 1, "cago": 2}
@@ -399,44 +398,101 @@ def _cfar_line(p, n, g, cyclic, method, a_both, a_one, mask, noise):  # pragma: 
 
 
 @numba.njit(cache=True, nogil=True)
-def _two_stage_kernel(
-    sub, lo, hi, dead, n_r, g_r, cyc_r, m_r, ab_r, ao_r, n_d, g_d, cyc_d, m_d_code, ab_d, ao_d
-):  # pragma: no cover
-    """Range stage on every column, Doppler stage on the rows with a range detection in
-    ``lo..hi``; returns the rows, columns and range-stage noise of cells passing both."""
-    n_rows, n_cols = sub.shape
-    mask_r = np.zeros((n_rows, n_cols), dtype=np.bool_)
-    noise_r = np.empty((n_rows, n_cols))
-    line = np.empty(n_rows)
-    m_line = np.empty(n_rows, dtype=np.bool_)
-    z_line = np.empty(n_rows)
+def two_stage_kernel(
+    rd, profile, lo, hi, a, b, n_r, g_r, cyc_r, m_r, ab_r, ao_r, n_d, g_d, cyc_d, m_d_code, ab_d,
+    ao_d, peak,
+):  # fmt: skip  # pragma: no cover
+    """Both CFAR stages and peak grouping on ``rd`` ``[range bin, Doppler bin]`` in one pass.
+
+    The map is whitened (``rd / profile[d]``; bins with ``profile < 0.01``, emptied by clutter
+    removal, carry 0 and are never detected) on the range bins ``a .. b-1``; the range stage
+    (``n_r`` training and ``g_r`` guard cells, method code ``m_r``, factors ``ab_r`` both sides /
+    ``ao_r`` one side) runs on every column, with the prefix sums of all columns built row by row;
+    the Doppler stage (``_cfar_line``) on the rows ``lo .. hi`` with a range detection. With
+    ``peak`` a detection must be a local maximum of ``rd`` (>= its 8 neighbours, range edges
+    open, Doppler cyclic). Returns range bins, Doppler indices and the range stage's noise
+    estimate in the map's units, row by row. The same arithmetic, operation for operation, as
+    composing :class:`CaCfar`/:class:`CasoCfar`/:class:`CagoCfar` (tested).
+    """
+    n_rows, n_cols = rd.shape
+    size = b - a
+    dead = np.empty(n_cols, dtype=np.bool_)
     for j in range(n_cols):
-        if dead[j]:
-            continue
-        for i in range(n_rows):
-            line[i] = sub[i, j]
-        _cfar_line(line, n_r, g_r, cyc_r, m_r, ab_r, ao_r, m_line, z_line)
-        for i in range(n_rows):
-            mask_r[i, j] = m_line[i]
-            noise_r[i, j] = z_line[i]
-    out_r = []
-    out_d = []
-    out_z = []
+        dead[j] = profile[j] < 0.01
+    # whitened map: equal noise in every Doppler bin
+    sub = np.empty((size, n_cols))
+    for i in range(size):
+        for j in range(n_cols):
+            sub[i, j] = 0.0 if dead[j] else rd[a + i, j] / profile[j]
+    # range stage: cs[t + 1, j] = cs[t, j] + sub[(t - pad) mod size, j] down every column
+    pad = n_r + g_r if cyc_r else 0
+    cs = np.empty((size + 2 * pad + 1, n_cols))
+    for j in range(n_cols):
+        cs[0, j] = 0.0
+    for t in range(size + 2 * pad):
+        q = t - pad
+        while q < 0:
+            q += size
+        while q >= size:
+            q -= size
+        for j in range(n_cols):
+            cs[t + 1, j] = cs[t, j] + sub[q, j]
+    i0 = lo - a
+    i1 = hi - a
+    mask_r = np.zeros((size, n_cols), dtype=np.bool_)
+    noise_r = np.empty((size, n_cols))
+    row_hit = np.zeros(size, dtype=np.bool_)
+    for i in range(i0, i1 + 1):
+        c = i + pad
+        ok_l = cyc_r or i - g_r - n_r >= 0
+        ok_r = cyc_r or i + g_r + n_r <= size - 1
+        for j in range(n_cols):
+            if dead[j]:
+                continue
+            # Z_left = sum of the n cells before the guard;  Z_right = the n cells after it
+            left = cs[c - g_r, j] - cs[c - g_r - n_r, j] if ok_l else 0.0
+            right = cs[c + g_r + 1 + n_r, j] - cs[c + g_r + 1, j] if ok_r else 0.0
+            mu, alpha = cfar_level(left, right, ok_l, ok_r, n_r, m_r, ab_r, ao_r)
+            noise_r[i, j] = mu
+            if sub[i, j] > alpha * mu:
+                mask_r[i, j] = True
+                row_hit[i] = True
+    out_r = np.empty(16, dtype=np.int64)
+    out_d = np.empty(16, dtype=np.int64)
+    out_z = np.empty(16)
+    n_out = 0
     m_d = np.empty(n_cols, dtype=np.bool_)
     z_d = np.empty(n_cols)
-    for i in range(lo, hi + 1):
-        hit = False
-        for j in range(n_cols):
-            hit = hit or mask_r[i, j]
-        if not hit:
+    for i in range(i0, i1 + 1):
+        if not row_hit[i]:
             continue
         _cfar_line(sub[i], n_d, g_d, cyc_d, m_d_code, ab_d, ao_d, m_d, z_d)
+        r = a + i
         for j in range(n_cols):
-            if mask_r[i, j] and m_d[j]:
-                out_r.append(i)
-                out_d.append(j)
-                out_z.append(noise_r[i, j])
-    return np.array(out_r, dtype=np.int64), np.array(out_d, dtype=np.int64), np.array(out_z)
+            if not (mask_r[i, j] and m_d[j]):
+                continue
+            if peak:
+                centre = rd[r, j]
+                keep = True
+                for dr in range(-1, 2):
+                    rr = r + dr
+                    if rr < 0 or rr >= n_rows:
+                        continue
+                    for dd in range(-1, 2):
+                        if (dr != 0 or dd != 0) and rd[rr, (j + dd) % n_cols] > centre:
+                            keep = False
+                if not keep:
+                    continue
+            if n_out == out_r.shape[0]:
+                out_r = np.concatenate((out_r, np.empty(n_out, dtype=np.int64)))
+                out_d = np.concatenate((out_d, np.empty(n_out, dtype=np.int64)))
+                out_z = np.concatenate((out_z, np.empty(n_out)))
+            out_r[n_out] = r
+            out_d[n_out] = j
+            # back to the map's units at the cell under test
+            out_z[n_out] = noise_r[i, j] * profile[j]
+            n_out += 1
+    return out_r[:n_out], out_d[:n_out], out_z[:n_out]
 
 
 def two_stage_cfar(
@@ -472,26 +528,13 @@ def two_stage_cfar(
     plan = _cfar_plan(radar, settings, n_r, n_d, L)
     if plan is None:
         return _empty_detections()
-    lo, hi, a, b, profile, dead, kernel_args = plan
-    if profile is None:
-        sub = np.asarray(rd[a:b], dtype=np.float64)
-    else:
-        # whiten: equal noise in every Doppler bin; bins the removal empties (rectangular
-        # window: zero Doppler) carry nothing and are never detected
-        sub = rd[a:b] / profile
-        if dead.any():
-            sub[:, dead] = 0.0
-    # both stages in one compiled pass (same arithmetic as CaCfar/CasoCfar/CagoCfar.detect)
-    rr, d, noise = _two_stage_kernel(np.ascontiguousarray(sub), lo - a, hi - a, dead, *kernel_args)
-    r = rr + a
-    if settings.peak_grouping and r.size:
-        keep = _local_maxima(rd, r, d)
-        r, d, noise = r[keep], d[keep], noise[keep]
-    if profile is not None:
-        noise = noise * profile[d]  # back to the map's units at the cell under test
+    lo, hi, a, b, profile, kernel_args = plan
+    # whitening, both stages and peak grouping in one compiled pass (same arithmetic as
+    # CaCfar/CasoCfar/CagoCfar.detect composed, then _local_maxima)
+    r, d, noise = two_stage_kernel(rd, profile, lo, hi, a, b, *kernel_args, settings.peak_grouping)
     return Detections(
-        range_bin=r.astype(np.int64),
-        doppler_index=d.astype(np.int64),
+        range_bin=r,
+        doppler_index=d,
         power=rd[r, d].astype(np.float64),
         noise_power=noise,
     )
