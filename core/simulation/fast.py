@@ -78,12 +78,13 @@ from core.processing import (
     window,
 )
 from core.processing.angle import azimuth_row, elevation_pairs
-from core.processing.cfar import cfar_level, two_stage_pfa
+from core.processing.cfar import _METHOD_CODE, two_stage_kernel, two_stage_pfa
 from core.processing.spectrum import clutter_removal_noise_profile, effective_cells
 from core.simulation.antenna import AntennaGain
 from core.simulation.baseband import steering_vectors
 from core.simulation.frame import FrameOutput, needs_elevation
 from core.simulation.link import noise_power_v2, received_power_w, signal_amplitude_v
+from core.simulation.rng_kernels import fill_normal, gamma_dc, gamma_l, normal, state_from
 from core.simulation.scatterers import Scatterers
 
 #: Per-channel signal power, relative to the cell's noise power, above which a cell gets
@@ -263,16 +264,66 @@ def _slow_time_kernel(
 
 
 @numba.njit(cache=True, nogil=True)
-def _signal_kernel(
-    rng, rd, amp, theta, slow, slow1, wd, b, s2, steer, slot, threshold, tw_r, tw_d, noise, k_max
+def _noise_map(s, rd, s2, n_use, n_v):  # pragma: no cover
+    """Noise-only map: ``rd[k, d] = s2[d] Gamma(L)`` for ``k < n_use`` (row by row), the mean
+    ``L s2[d]`` beyond (never read by the CFAR). Draws from the state ``s`` (advanced)."""
+    n_r, n_d = rd.shape
+    # Marsaglia-Tsang constants of Gamma(L): d = L - 1/3, c = 1 / sqrt(9 d)
+    dk = n_v - 1.0 / 3.0
+    ck = 1.0 / np.sqrt(9.0 * dk)
+    s0, s1, s2_, s3 = s[0], s[1], s[2], s[3]  # the generator state in registers
+    for k in range(n_use):
+        for d in range(n_d):
+            g, s0, s1, s2_, s3 = gamma_l(s0, s1, s2_, s3, dk, ck)
+            # noise-only cell: sum of L exponentials of mean s2[d] ~ s2[d] Gamma(L)
+            rd[k, d] = np.float32(s2[d] * g)
+    s[0], s[1], s[2], s[3] = s0, s1, s2_, s3
+    for k in range(n_use, n_r):
+        for d in range(n_d):
+            rd[k, d] = np.float32(n_v * s2[d])
+
+
+@numba.njit(cache=True, nogil=True)
+def _fft_pow2(a, tw):  # pragma: no cover
+    """In-place radix-2 FFT of ``a`` (length a power of 2); ``tw[k] = exp(-j 2 pi k / n)``."""
+    n = a.shape[0]
+    j = 0
+    for i in range(1, n):
+        bit = n >> 1
+        while j & bit:
+            j ^= bit
+            bit >>= 1
+        j |= bit
+        if i < j:
+            a[i], a[j] = a[j], a[i]
+    size = 2
+    while size <= n:
+        half = size // 2
+        step = n // size
+        for first in range(0, n, size):
+            for k in range(half):
+                # butterfly: (u, v w) -> (u + v w, u - v w)
+                v = a[first + k + half] * tw[k * step]
+                u = a[first + k]
+                a[first + k] = u + v
+                a[first + k + half] = u - v
+        size *= 2
+
+
+@numba.njit(cache=True, nogil=True)
+def _patches_kernel(
+    s, rd, amp, theta, slow, slow1, wd, b, s2, steer, slot, threshold, tw_r, tw_d, noise, k_max
 ):  # pragma: no cover
     """Patch cells, their noise-free channel values and their noisy channel sums.
 
-    amp (N,), theta (N,) beat tone rad/sample, slow (N, n_tx, M) slow-time sequences (after
-    clutter removal), wd (M,) Doppler window, b (2J+1,) range
-    window coefficients, s2 (M,) cell noise power, steer (N, L), slot (L,) TX slot of each
-    channel, tw_r (N,) = exp(-j 2 pi k / N), tw_d (M, M) = exp(-j 2 pi (d - M/2) m / M). Writes the
-    patch cells' power into ``rd``; only range bins below ``k_max`` are looked at.
+    amp (N,), theta (N,) beat tone rad/sample, slow/slow1 (N, n_tx, M) slow-time sequences
+    (after clutter removal), wd (M,) Doppler window (times ``(-1)^m`` when ``tw_d`` is the
+    radix-2 FFT's twiddles), b (2J+1,) range window coefficients, s2 (M,) cell noise power,
+    steer (N, L), slot (L,) TX slot of each channel, tw_r (N,) = exp(-j 2 pi k / N); tw_d either
+    (M, M) = exp(-j 2 pi (d - M/2) m / M) (direct DFT) or (1, M/2) = exp(-j 2 pi k / M) (M a
+    power of two: radix-2 FFT of the window-shifted sequence, the same transform). Adds the
+    patch cells' noisy power into ``rd`` (draws from the generator state ``s``); only range
+    bins below ``k_max`` are looked at.
     """
     n_samples = tw_r.shape[0]
     n_s = amp.shape[0]
@@ -280,34 +331,40 @@ def _signal_kernel(
     n_v = steer.shape[1]
     half = (b.shape[0] - 1) // 2
     nn = n_samples
+    centre = (nn - 1) / 2
     # range response R_i[k] = sum_j b_j G(theta - 2 pi (k - j) / N),
     # G(phi) = (1 - exp(j phi N)) / (1 - exp(j phi)), exp(j phi N) = exp(j theta N);
     # its centred derivative R1_i[k] = dR/dtheta - j (N - 1)/2 R = sum_n w_n j (n - (N-1)/2) ...
-    rr = np.empty((n_s, nn), dtype=np.complex128)
-    rr1 = np.empty((n_s, nn), dtype=np.complex128)
-    pr = np.empty((n_s, nn))
-    pr1 = np.empty((n_s, nn))
-    centre = (nn - 1) / 2
+    # G and dG/dtheta are evaluated once per index k - j (shared by the 2J+1 terms of R)
+    n_g = k_max + 2 * half
+    gg = np.empty(n_g, dtype=np.complex128)
+    gg1 = np.empty(n_g, dtype=np.complex128)
+    rr = np.empty((n_s, k_max), dtype=np.complex128)
+    rr1 = np.empty((n_s, k_max), dtype=np.complex128)
+    pr = np.empty((n_s, k_max))
+    pr1 = np.empty((n_s, k_max))
     for i in range(n_s):
         e_n = np.exp(1j * theta[i] * nn)
         num = 1.0 - e_n
         e = np.exp(1j * theta[i])
+        for t in range(n_g):
+            q = e * tw_r[(t - half) % nn]  # exp(j phi), phi = theta - 2 pi (t - J) / N
+            den = 1.0 - q
+            if abs(den) < 1e-9:
+                gg[t] = nn + 0.0j
+                gg1[t] = 1j * nn * (nn - 1) / 2
+            else:
+                inv = 1.0 / den
+                gg[t] = num * inv
+                # dG/dtheta = (-j N e^{j N theta} (1 - q) + (1 - e^{j N theta}) j q) / (1 - q)^2
+                gg1[t] = (-1j * nn * e_n * den + num * 1j * q) * (inv * inv)
         for k in range(k_max):
             acc = 0.0 + 0.0j
             acc1 = 0.0 + 0.0j
             for jj in range(-half, half + 1):
-                q = e * tw_r[(k - jj) % nn]  # exp(j phi)
-                den = 1.0 - q
-                if abs(den) < 1e-9:
-                    g = nn + 0.0j
-                    g1 = 1j * nn * (nn - 1) / 2
-                else:
-                    inv = 1.0 / den
-                    g = num * inv
-                    # dG/dtheta = (-j N e^{j N theta} (1 - q) + (1 - e^{j N theta}) j q) / (1 - q)^2
-                    g1 = (-1j * nn * e_n * den + num * 1j * q) * (inv * inv)
-                acc += b[jj + half] * g
-                acc1 += b[jj + half] * g1
+                # G at phi = theta - 2 pi (k - jj) / N is gg[k - jj + J]
+                acc += b[jj + half] * gg[k - jj + half]
+                acc1 += b[jj + half] * gg1[k - jj + half]
             rr[i, k] = amp[i] * acc
             rr1[i, k] = amp[i] * (acc1 - 1j * centre * acc)
             pr[i, k] = rr[i, k].real ** 2 + rr[i, k].imag ** 2
@@ -317,27 +374,56 @@ def _signal_kernel(
     dd1 = np.empty((n_s, n_tx, m), dtype=np.complex128)
     pd = np.zeros((n_s, m))
     pd1 = np.zeros((n_s, m))
+    pd_max = np.zeros(n_s)
+    pd1_max = np.zeros(n_s)
     ws = np.empty(m, dtype=np.complex128)
     ws1 = np.empty(m, dtype=np.complex128)
+    radix2 = tw_d.shape[0] == 1
     for i in range(n_s):
-        for s in range(n_tx):
+        for sl in range(n_tx):
             for t in range(m):
-                ws[t] = wd[t] * slow[i, s, t]
-                ws1[t] = wd[t] * slow1[i, s, t]
+                ws[t] = wd[t] * slow[i, sl, t]
+                ws1[t] = wd[t] * slow1[i, sl, t]
+            if radix2:
+                _fft_pow2(ws, tw_d[0])
+                _fft_pow2(ws1, tw_d[0])
+                for d in range(m):
+                    dd[i, sl, d] = ws[d]
+                    dd1[i, sl, d] = ws1[d]
+            else:
+                for d in range(m):
+                    acc = 0.0 + 0.0j
+                    acc1 = 0.0 + 0.0j
+                    for t in range(m):
+                        acc += ws[t] * tw_d[d, t]
+                        acc1 += ws1[t] * tw_d[d, t]
+                    dd[i, sl, d] = acc
+                    dd1[i, sl, d] = acc1
             for d in range(m):
-                acc = 0.0 + 0.0j
-                acc1 = 0.0 + 0.0j
-                for t in range(m):
-                    acc += ws[t] * tw_d[d, t]
-                    acc1 += ws1[t] * tw_d[d, t]
-                dd[i, s, d] = acc
-                dd1[i, s, d] = acc1
-                pd[i, d] = max(pd[i, d], acc.real**2 + acc.imag**2)
-                pd1[i, d] = max(pd1[i, d], acc1.real**2 + acc1.imag**2)
-    cells_k = np.empty(nn * m, dtype=np.int64)
-    cells_d = np.empty(nn * m, dtype=np.int64)
+                a0 = dd[i, sl, d]
+                a1 = dd1[i, sl, d]
+                pd[i, d] = max(pd[i, d], a0.real**2 + a0.imag**2)
+                pd1[i, d] = max(pd1[i, d], a1.real**2 + a1.imag**2)
+        for d in range(m):
+            pd_max[i] = max(pd_max[i], pd[i, d])
+            pd1_max[i] = max(pd1_max[i], pd1[i, d])
+    s2_min = s2[0]
+    for d in range(m):
+        s2_min = min(s2_min, s2[d])
+    lim_min = threshold * s2_min
+    cells_k = np.empty(k_max * m, dtype=np.int64)
+    cells_d = np.empty(k_max * m, dtype=np.int64)
     n_c = 0
     for k in range(k_max):
+        # skip the range bin when no scatterer can reach the smallest limit in any Doppler bin
+        # (pr pd[d] + pr1 pd1[d] <= pr max pd + pr1 max pd1, and lim[d] >= lim_min)
+        maybe = False
+        for i in range(n_s):
+            if pr[i, k] * pd_max[i] + pr1[i, k] * pd1_max[i] > lim_min:
+                maybe = True
+                break
+        if not maybe:
+            continue
         for d in range(m):
             lim = threshold * s2[d]
             for i in range(n_s):
@@ -350,15 +436,18 @@ def _signal_kernel(
     along = np.zeros(n_c, dtype=np.complex128)
     ortho = np.zeros(n_c)
     g = np.empty(n_tx, dtype=np.complex128)
+    # Marsaglia-Tsang constants of Gamma(L - 1)
+    dk = n_v - 1.0 - 1.0 / 3.0
+    ck = 1.0 / np.sqrt(9.0 * dk)
     for c in range(n_c):
         k = cells_k[c]
         d = cells_d[c]
         for i in range(n_s):
             if pr[i, k] * pd[i, d] + pr1[i, k] * pd1[i, d] < 1e-6 * s2[d]:
                 continue  # below -60 dB of the noise: nothing to add
-            for s in range(n_tx):
+            for sl in range(n_tx):
                 # first order in the beat tone's drift: R D + R1 D1
-                g[s] = rr[i, k] * dd[i, s, d] + rr1[i, k] * dd1[i, s, d]
+                g[sl] = rr[i, k] * dd[i, sl, d] + rr1[i, k] * dd1[i, sl, d]
             for v in range(n_v):
                 # X[c, v] = sum_i A_i R_i[k] D_i[slot(v), d] a_i[v]
                 x[c, v] += g[slot[v]] * steer[i, v]
@@ -367,8 +456,9 @@ def _signal_kernel(
             norm2 += x[c, v].real ** 2 + x[c, v].imag ** 2
         if noise:
             sd = np.sqrt(s2[d] / 2)
-            along[c] = sd * (rng.standard_normal() + 1j * rng.standard_normal())
-            ortho[c] = s2[d] * rng.standard_gamma(n_v - 1.0)
+            re = normal(s)
+            along[c] = sd * (re + 1j * normal(s))
+            ortho[c] = s2[d] * gamma_dc(s, dk, ck)
         # P = |(|s| + n_1)|^2 + |n_perp|^2
         z = np.sqrt(norm2) + along[c]
         rd[k, d] = z.real**2 + z.imag**2 + ortho[c]
@@ -377,13 +467,31 @@ def _signal_kernel(
 
 @functools.lru_cache(maxsize=8)
 def _twiddles(n_r: int, n_d: int) -> tuple[np.ndarray, np.ndarray]:
-    """``exp(-j 2 pi k / Nr)`` ``(Nr,)`` and ``exp(-j 2 pi (d - Nd/2) m / Nd)`` ``(Nd, Nd)``.
+    """``exp(-j 2 pi k / Nr)`` ``(Nr,)`` and the Doppler transform's twiddles.
 
     Doppler index ``d`` is zero-velocity centred (bin ``d - Nd // 2``), as in the exact chain.
+    ``Nd`` a power of two: ``(1, Nd/2)`` ``exp(-j 2 pi k / Nd)`` for the radix-2 FFT of the
+    window-shifted sequence (:func:`_doppler_weights`); otherwise ``(Nd, Nd)``
+    ``exp(-j 2 pi (d - Nd/2) m / Nd)`` for the direct DFT.
     """
     k = np.arange(n_r)
     m = np.arange(n_d)
-    return np.exp(-2j * np.pi * k / n_r), np.exp(-2j * np.pi * np.outer(m - n_d // 2, m) / n_d)
+    if _is_pow2(n_d):
+        tw_d = np.exp(-2j * np.pi * np.arange(n_d // 2) / n_d)[None, :]
+    else:
+        tw_d = np.exp(-2j * np.pi * np.outer(m - n_d // 2, m) / n_d)
+    return np.exp(-2j * np.pi * k / n_r), tw_d
+
+
+def _is_pow2(n: int) -> bool:
+    return n >= 2 and n & (n - 1) == 0
+
+
+def _doppler_weights(name: str, n: int) -> np.ndarray:
+    """The Doppler window as :func:`_patches_kernel` wants it (see :func:`_twiddles`)."""
+    if _is_pow2(n):
+        return _doppler_window_shifted(name, n)
+    return window(name, n).astype(np.float64)
 
 
 class Spectrum(NamedTuple):
@@ -403,6 +511,9 @@ class Spectrum(NamedTuple):
         ``(n_cells,)`` complex128: the noise component along ``signal / |signal|``.
     ortho
         ``(n_cells,)`` float64: noise power orthogonal to the signal (V²).
+    state
+        ``(4,)`` uint64: the compiled generator's state after these draws
+        (:mod:`core.simulation.rng_kernels`); :func:`detected_channels` continues from it.
     """
 
     rd_map: np.ndarray
@@ -410,12 +521,13 @@ class Spectrum(NamedTuple):
     signal: np.ndarray
     along: np.ndarray
     ortho: np.ndarray
+    state: np.ndarray
 
 
 def fast_spectrum(
     radar: RadarConfig,
     scatterers: Scatterers,
-    rng: np.random.Generator,
+    rng: np.random.Generator | None,
     *,
     antenna: AntennaGain,
     settings: ProcessingSettings = DEFAULT_PROCESSING,
@@ -428,6 +540,10 @@ def fast_spectrum(
     range limit plus its training window, :func:`cfar_range_bins`); the rest of the map holds
     the mean noise power. None: the whole map (for display).
 
+    The draws come from the compiled generator seeded with four raw draws of ``rng``
+    (:func:`core.simulation.rng_kernels.state_from`): first the noise map row by row, then per
+    patch cell the noise along the signal (real, imaginary) and the orthogonal power.
+
     Circular complex Gaussian noise is invariant under rotations of ``C^L``: in a patch cell
     with signal vector ``s`` the channel sum ``sum_v |s_v + n_v|^2`` has the law of
     ``|(|s| + n_1)|^2 + s2 Gamma(L - 1)`` (``n_1`` the noise along ``s``), so a cell costs one
@@ -437,17 +553,15 @@ def fast_spectrum(
     n_r, n_d, n_v = radar.n_samples, radar.n_loops, radar.n_virtual
     s2 = cell_noise_power_v2(radar, settings)  # (n_d,)
     n_use = n_r if n_range_bins is None else max(0, min(n_r, int(n_range_bins)))
+    state = state_from(rng if noise else None)
+    rd = np.zeros((n_r, n_d), dtype=np.float32)
     if noise:
-        # noise-only cell: sum of L exponentials of mean s2[d] ~ s2[d] Gamma(L)
-        rd = np.empty((n_r, n_d), dtype=np.float32)
-        rd[:n_use] = rng.standard_gamma(float(n_v), (n_use, n_d), dtype=np.float32)
-        rd[:n_use] *= s2.astype(np.float32)[None, :]
-        rd[n_use:] = (n_v * s2).astype(np.float32)[None, :]
-    else:
-        rd = np.zeros((n_r, n_d), dtype=np.float32)
+        _noise_map(state, rd, s2, n_use, n_v)
     if len(scatterers) == 0:
         e = np.zeros(0)
-        return Spectrum(rd, np.zeros((0, 2), dtype=np.int64), np.zeros((0, n_v), complex), e, e)
+        return Spectrum(
+            rd, np.zeros((0, 2), dtype=np.int64), np.zeros((0, n_v), complex), e, e, state
+        )
     power = received_power_w(
         radar, scatterers.range_m, scatterers.azimuth_rad, scatterers.rcs_dbsm, antenna
     )
@@ -459,13 +573,13 @@ def fast_spectrum(
     )
     # theta = 2 pi (2 S R / c) / Fs   (rad per sample)
     theta = _beat_rad_per_sample_per_m(radar) * r_mid
-    k_idx, d_idx, x, along, ortho = _signal_kernel(
-        rng if noise else np.random.default_rng(0),
+    k_idx, d_idx, x, along, ortho = _patches_kernel(
+        state,
         rd,
         amp,
         theta,
         *slow_time_sequences(radar, scatterers, settings),
-        window(settings.doppler_window, n_d).astype(np.float64),
+        _doppler_weights(settings.doppler_window, n_d),
         _cosine_sum_coefficients(settings.range_window, n_r),
         s2,
         steering_vectors(radar, scatterers),
@@ -475,7 +589,7 @@ def fast_spectrum(
         noise,
         n_use,
     )
-    return Spectrum(rd, np.column_stack((k_idx, d_idx)).astype(np.int64), x, along, ortho)
+    return Spectrum(rd, np.column_stack((k_idx, d_idx)).astype(np.int64), x, along, ortho, state)
 
 
 def simulate_frame_fast(
@@ -492,8 +606,8 @@ def simulate_frame_fast(
     """One frame at the ``fast`` level: closed-form spectrum, then the exact chain's detection.
 
     Same signature and output as :func:`core.simulation.simulate_frame`; see the module
-    docstring for the model. ``rng`` draws the noise (a different stream from the exact level's,
-    so the same seed gives statistically equivalent, not identical, frames).
+    docstring for the model. ``rng`` seeds the noise (a different stream from the exact
+    level's, so the same seed gives statistically equivalent, not identical, frames).
     """
     out, maps = _frames_fast(
         radar, [scatterers], [rng], antenna, settings, elevation, noise, keep_rd_map
@@ -505,15 +619,14 @@ def simulate_frame_fast(
     return FrameOutput(point_cloud=out.point_cloud, rd_map_db=rd_db, detections=out.detections)
 
 
-def detected_channels(
-    radar: RadarConfig, spec: Spectrum, det: Detections, rng: np.random.Generator
-) -> np.ndarray:
+def detected_channels(radar: RadarConfig, spec: Spectrum, det: Detections) -> np.ndarray:
     """Per-channel values ``(n_det, n_virtual)`` complex128 of the detected cells.
 
     Patch cell: ``x = s + n_1 u + w`` with ``u = s / |s|`` and ``w`` a uniformly random vector
     orthogonal to ``u`` with ``|w|^2`` the drawn orthogonal power. Noise-only cell: ``P^(1/2)``
     times a uniformly random unit vector of ``C^L`` (``P`` the cell's summed power). Both are the
-    exact conditional laws of i.i.d. circular Gaussian channels given the drawn map.
+    exact conditional laws of i.i.d. circular Gaussian channels given the drawn map. The normal
+    draws (all real parts, then all imaginary parts) continue ``spec.state`` (advanced).
     """
     rd = spec.rd_map
     n_v = radar.n_virtual
@@ -526,7 +639,8 @@ def detected_channels(
     if len(lin):
         pos = np.minimum(np.searchsorted(lin, want), len(lin) - 1)
         j = np.where(lin[pos] == want, pos, -1)
-    z = rng.standard_normal((n_det, n_v)) + 1j * rng.standard_normal((n_det, n_v))
+    zr = fill_normal(spec.state, n_det * n_v).reshape(n_det, n_v)
+    z = zr + 1j * fill_normal(spec.state, n_det * n_v).reshape(n_det, n_v)
     out = np.empty((n_det, n_v), dtype=np.complex128)
     inside = j >= 0
     if np.any(inside):
@@ -599,123 +713,10 @@ def label_points(radar: RadarConfig, pc: PointCloud, scatterers: Scatterers) -> 
     )
 
 
-# ---- the exact chain's two-stage CFAR, compiled ------------------------------------------------
-# The same decisions as core.processing.two_stage_cfar (same thresholds from
-# core.processing.make_cfar, same edge rules, same peak grouping, same output order); it only
-# avoids numpy's per-call overhead on a 256 x 32 map. tests/core/fidelity checks the equality.
-_METHOD_CODE = {"ca": 0, "caso": 1, "cago": 2}
-
-
-@numba.njit(cache=True, nogil=True)
-def _cfar_line(p, n, g, cyclic, method, alpha_both, alpha_one, mask, mu, cs):  # pragma: no cover
-    size = p.shape[0]
-    pad = n + g if cyclic else 0
-    # prefix sums over the (cyclically padded) line: cs[j] = sum of the first j padded cells
-    cs[0] = 0.0
-    for j in range(size + 2 * pad):
-        # p[(j - pad) mod size] without an integer division
-        q = j - pad
-        while q < 0:
-            q += size
-        while q >= size:
-            q -= size
-        cs[j + 1] = cs[j] + p[q]
-    for i in range(size):
-        c = i + pad
-        if cyclic:
-            ok_l = True
-            ok_r = True
-            left = cs[c - g] - cs[c - g - n]
-            right = cs[c + g + 1 + n] - cs[c + g + 1]
-        else:
-            ok_l = i - g - n >= 0
-            ok_r = i + g + n <= size - 1
-            left = cs[max(0, i - g)] - cs[max(0, i - g - n)]
-            right = cs[min(size, i + g + 1 + n)] - cs[min(size, i + g + 1)]
-        m, a = cfar_level(left, right, ok_l, ok_r, n, method, alpha_both, alpha_one)
-        mu[i] = m
-        mask[i] = p[i] > a * m  # False when no training side exists (m is NaN)
-
-
-@numba.njit(cache=True, nogil=True)
-def _two_stage_kernel(
-    rd,
-    profile,
-    lo,
-    hi,
-    a,
-    b,
-    rn,
-    rg,
-    rcyc,
-    rmeth,
-    ralpha,
-    ralpha1,
-    dn,
-    dg,
-    dcyc,
-    dmeth,
-    dalpha,
-    dalpha1,
-    peak,
-):  # pragma: no cover
-    n_r, n_d = rd.shape
-    size = b - a
-    # whitened map: rd / profile[d]; bins the clutter removal empties (profile 0) carry nothing
-    sub = np.empty((size, n_d), dtype=np.float64)
-    for i in range(size):
-        for d in range(n_d):
-            sub[i, d] = 0.0 if profile[d] < 0.01 else rd[a + i, d] / profile[d]
-    mask_r = np.zeros((size, n_d), dtype=np.bool_)
-    noise_r = np.empty((size, n_d), dtype=np.float64)
-    col = np.empty(size, dtype=np.float64)
-    mcol = np.empty(size, dtype=np.bool_)
-    ncol = np.empty(size, dtype=np.float64)
-    cs = np.empty(2 * (size + n_d) + 2 * (rn + rg + dn + dg) + 2, dtype=np.float64)
-    for d in range(n_d):
-        for i in range(size):
-            col[i] = sub[i, d]
-        _cfar_line(col, rn, rg, rcyc, rmeth, ralpha, ralpha1, mcol, ncol, cs)
-        for i in range(size):
-            mask_r[i, d] = mcol[i] and (lo <= a + i <= hi) and profile[d] >= 0.01
-            noise_r[i, d] = ncol[i]
-    out_r = np.empty(size * n_d, dtype=np.int64)
-    out_d = np.empty(size * n_d, dtype=np.int64)
-    out_n = np.empty(size * n_d, dtype=np.float64)
-    n_out = 0
-    row = np.empty(n_d, dtype=np.float64)
-    mrow = np.empty(n_d, dtype=np.bool_)
-    nrow = np.empty(n_d, dtype=np.float64)
-    for i in range(size):
-        any_r = False
-        for d in range(n_d):
-            any_r = any_r or mask_r[i, d]
-        if not any_r:
-            continue
-        for d in range(n_d):
-            row[d] = sub[i, d]
-        _cfar_line(row, dn, dg, dcyc, dmeth, dalpha, dalpha1, mrow, nrow, cs)
-        r = a + i
-        for d in range(n_d):
-            if not (mask_r[i, d] and mrow[d]):
-                continue
-            if peak:
-                keep = True
-                for dr in range(-1, 2):
-                    rr = r + dr
-                    if rr < 0 or rr >= n_r:
-                        continue
-                    for dd in range(-1, 2):
-                        if (dr != 0 or dd != 0) and rd[r, d] < rd[rr, (d + dd) % n_d]:
-                            keep = False
-                if not keep:
-                    continue
-            out_r[n_out] = r
-            out_d[n_out] = d
-            # back to the map's units at the cell under test
-            out_n[n_out] = noise_r[i, d] * profile[d]
-            n_out += 1
-    return out_r[:n_out], out_d[:n_out], out_n[:n_out]
+# ---- the exact chain's two-stage CFAR with the fast level's thresholds -------------------------
+# The library's compiled kernel (core.processing.cfar.two_stage_kernel: same edge rules, peak
+# grouping and output order as core.processing.two_stage_cfar), with thresholds for the fast
+# level's independent cells when asked.
 
 
 def two_stage_cfar_compiled(
@@ -739,7 +740,7 @@ def two_stage_cfar_compiled(
     args = _cfar_arguments(radar, settings, L, rd.shape[0], rd.shape[1], independent_cells)
     if args is None:
         return _no_detections()
-    r, d, noise = _two_stage_kernel(rd, *args)
+    r, d, noise = two_stage_kernel(rd, *args)
     return Detections(
         range_bin=r, doppler_index=d, power=rd[r, d].astype(np.float64), noise_power=noise
     )
@@ -1029,7 +1030,7 @@ class FramesOutput:
 
 
 @numba.njit(cache=True, nogil=True)
-def _detected_channels_kernel(rng, rd, r, d, cells_k, cells_d, x, along, ortho):  # pragma: no cover
+def _detected_channels_kernel(s, rd, r, d, cells_k, cells_d, x, along, ortho):  # pragma: no cover
     """:func:`detected_channels` compiled (same conditional laws, same draw order)."""
     n_det = r.shape[0]
     n_v = x.shape[1]
@@ -1039,10 +1040,10 @@ def _detected_channels_kernel(rng, rd, r, d, cells_k, cells_d, x, along, ortho):
     zi = np.empty((n_det, n_v))
     for i in range(n_det):
         for v in range(n_v):
-            zr[i, v] = rng.standard_normal()
+            zr[i, v] = normal(s)
     for i in range(n_det):
         for v in range(n_v):
-            zi[i, v] = rng.standard_normal()
+            zi[i, v] = normal(s)
     out = np.empty((n_det, n_v), dtype=np.complex128)
     n_c = cells_k.shape[0]
     u = np.empty(n_v, dtype=np.complex128)
@@ -1122,7 +1123,7 @@ def _label_kernel(range_m, vr_m, pos, vel, source, t_mid, res_r, res_v, span):  
 
 @numba.njit(cache=True, nogil=True)
 def _frame_kernel(
-    rng,
+    s,
     rd,
     amp,
     theta,
@@ -1178,8 +1179,8 @@ def _frame_kernel(
     Returns ``(det_r, det_d, f64 (n, 8), source)`` with ``f64`` columns range, azimuth,
     elevation, radial velocity, SNR, x, y, z.
     """
-    cells_k, cells_d, x, along, ortho = _signal_kernel(
-        rng,
+    cells_k, cells_d, x, along, ortho = _patches_kernel(
+        s,
         rd,
         amp,
         theta,
@@ -1197,7 +1198,7 @@ def _frame_kernel(
         n_use,
     )
     if has_cfar:
-        r, d, nz = _two_stage_kernel(
+        r, d, nz = two_stage_kernel(
             rd,
             profile,
             lo,
@@ -1227,7 +1228,7 @@ def _frame_kernel(
     src = np.full(n_det, -2, dtype=np.int32)
     if n_det == 0:
         return r, d, f64, src
-    ch = _detected_channels_kernel(rng, rd, r, d, cells_k, cells_d, x, along, ortho)
+    ch = _detected_channels_kernel(s, rd, r, d, cells_k, cells_d, x, along, ortho)
     r_bin, d_bin, az, el = _points_kernel(
         rd, r, d, ch, n_tx, n_rx, row_ch, row_pos, upper, lower, tw_a, elevation
     )
@@ -1248,6 +1249,67 @@ def _frame_kernel(
     return r, d, f64, src  # fmt: skip
 
 
+@numba.njit(cache=True, nogil=True)
+def _grow(f64, i64, i32, need):  # pragma: no cover
+    """The output buffers with room for at least ``need`` rows (doubling)."""
+    if need <= f64.shape[0]:
+        return f64, i64, i32
+    cap = max(need, 2 * f64.shape[0])
+    f2 = np.empty((cap, f64.shape[1]))
+    i2 = np.empty((cap, i64.shape[1]), dtype=np.int64)
+    j2 = np.empty(cap, dtype=np.int32)
+    f2[: f64.shape[0]] = f64
+    i2[: i64.shape[0]] = i64
+    j2[: i32.shape[0]] = i32
+    return f2, i2, j2
+
+
+@numba.njit(cache=True, nogil=True)
+def _frames_kernel(
+    states, start, elev, maps, keep, amp, theta, slow, slow1, steer, pos, vel, source, noise,
+    n_use, n_v, wd, b, s2, slot, threshold, tw_r, tw_d, has_cfar, profile, lo, hi, a, bb, rn, rg,
+    rcyc, rmeth, ralpha, ralpha1, dn, dg, dcyc, dmeth, dalpha, dalpha1, peak, n_tx, n_rx,
+    row_ch, row_pos, upper, lower, tw_a, res_r, res_v, t_mid, span,
+):  # fmt: skip  # pragma: no cover
+    """Every frame: noise map, then :func:`_frame_kernel`; frame ``f`` draws from ``states[f]``.
+
+    Returns ``(det (n, 2), f64 (n, 8), source (n,), counts (F,))`` concatenated in frame order.
+    """
+    n_f = start.shape[0] - 1
+    counts = np.zeros(n_f, dtype=np.int64)
+    cap = 8 * n_f + 16
+    f64_all = np.empty((cap, 8))
+    det_all = np.empty((cap, 2), dtype=np.int64)
+    src_all = np.empty(cap, dtype=np.int32)
+    n_out = 0
+    for f in range(n_f):
+        s = states[f].copy()
+        rd = maps[f] if keep else maps[0]
+        if noise:
+            _noise_map(s, rd, s2, n_use, n_v)
+        else:
+            rd[:] = 0.0
+        i0, i1 = start[f], start[f + 1]
+        r, d, f64, src = _frame_kernel(
+            s, rd, amp[i0:i1], theta[i0:i1], slow[i0:i1], slow1[i0:i1], steer[i0:i1],
+            pos[i0:i1], vel[i0:i1], source[i0:i1], elev[f], noise, n_use, wd, b, s2, slot,
+            threshold, tw_r, tw_d, has_cfar, profile, lo, hi, a, bb, rn, rg, rcyc, rmeth, ralpha,
+            ralpha1, dn, dg, dcyc, dmeth, dalpha, dalpha1, peak, n_tx, n_rx, row_ch, row_pos,
+            upper, lower, tw_a, res_r, res_v, t_mid, span,
+        )  # fmt: skip
+        n = r.shape[0]
+        f64_all, det_all, src_all = _grow(f64_all, det_all, src_all, n_out + n)
+        for i in range(n):
+            det_all[n_out + i, 0] = r[i]
+            det_all[n_out + i, 1] = d[i]
+            src_all[n_out + i] = src[i]
+            for j in range(8):
+                f64_all[n_out + i, j] = f64[i, j]
+        n_out += n
+        counts[f] = n
+    return det_all[:n_out], f64_all[:n_out], src_all[:n_out], counts
+
+
 def _frames_fast(
     radar: RadarConfig,
     frames: Sequence[Scatterers],
@@ -1260,14 +1322,13 @@ def _frames_fast(
 ):
     """Shared body of :func:`simulate_frames_fast` and :func:`simulate_frame_fast`.
 
-    Returns ``(FramesOutput, rd maps or None)``.
+    Returns ``(FramesOutput, rd maps (F, n_r, n_d) float32 or None)``.
     """
     if len(frames) != len(rngs):
         raise InputError(f"rngs: {len(rngs)} generators for {len(frames)} frames")
     n_f = len(frames)
     n_r, n_d, n_v = radar.n_samples, radar.n_loops, radar.n_virtual
     s2 = cell_noise_power_v2(radar, settings)  # (n_d,)
-    s2_32 = s2.astype(np.float32)
     n_use = n_r if keep_rd_map else max(0, min(n_r, cfar_range_bins(radar, settings)))
     counts = np.fromiter((len(s) for s in frames), dtype=np.int64, count=n_f)
     start = np.zeros(n_f + 1, dtype=np.int64)
@@ -1285,56 +1346,30 @@ def _frames_fast(
     pos = np.ascontiguousarray(every.position_m, dtype=np.float64)
     vel = np.ascontiguousarray(every.velocity_mps, dtype=np.float64)
     source = np.ascontiguousarray(every.source, dtype=np.int32)
+    if elevation is not None:
+        elev = np.full(n_f, bool(elevation))
+    elif not radar.has_elevation:
+        elev = np.zeros(n_f, dtype=bool)
+    else:
+        elev = np.fromiter((needs_elevation(radar, s) for s in frames), dtype=bool, count=n_f)
     cfar = _cfar_arguments(radar, settings, n_v, n_r, n_d, True)
     has_cfar = cfar is not None
     if cfar is None:  # no range bin inside the limits: nothing is tested
         e = np.ones(1)
         cfar = (e, 0, 0, 0, 0, 1, 0, False, 0, 1.0, 1.0, 1, 0, False, 0, 1.0, 1.0, False)
-    consts = (
-        window(settings.doppler_window, n_d).astype(np.float64),
-        _cosine_sum_coefficients(settings.range_window, n_r),
-        s2,
-        np.arange(n_v) // radar.n_rx,
-        PATCH_THRESHOLD,
-        *_twiddles(n_r, n_d),
-        has_cfar,
-        *cfar,
-        radar.n_tx,
-        radar.n_rx,
-        *array_rows(radar),
-        angle_twiddles(radar, settings.angle_fft_size),
-        radar.range_resolution_m,
-        radar.velocity_resolution_mps,
-        t_mid,
-        2 * radar.max_velocity_mps,
-    )
-    quiet = np.random.default_rng(0)
-    out_r, out_d, out_f, out_s, maps = [], [], [], [], []
-    n_out = np.zeros(n_f, dtype=np.int64)
+    states = np.empty((n_f, 4), dtype=np.uint64)
     for f in range(n_f):
-        a, b = start[f], start[f + 1]
-        rng = rngs[f] if noise else quiet
-        if noise:
-            # noise-only cell: sum of L exponentials of mean s2[d] ~ s2[d] Gamma(L)
-            rd = np.empty((n_r, n_d), dtype=np.float32)
-            rd[:n_use] = rng.standard_gamma(float(n_v), (n_use, n_d), dtype=np.float32)
-            rd[:n_use] *= s2_32[None, :]
-            rd[n_use:] = (n_v * s2).astype(np.float32)[None, :]
-        else:
-            rd = np.zeros((n_r, n_d), dtype=np.float32)
-        elev = needs_elevation(radar, frames[f]) if elevation is None else bool(elevation)
-        r, d, f64, src = _frame_kernel(
-            rng, rd, amp[a:b], theta[a:b], slow[a:b], slow1[a:b], steer[a:b],
-            pos[a:b], vel[a:b], source[a:b], elev, bool(noise), n_use, *consts,
-        )  # fmt: skip
-        out_r.append(r)
-        out_d.append(d)
-        out_f.append(f64)
-        out_s.append(src)
-        n_out[f] = len(r)
-        if keep_rd_map:
-            maps.append(rd)
-    f64 = np.concatenate(out_f) if n_f else np.zeros((0, 8))
+        states[f] = state_from(rngs[f] if noise else None)
+    maps = np.empty((n_f if keep_rd_map else 1, n_r, n_d), dtype=np.float32)
+    det, f64, src, n_out = _frames_kernel(
+        states, start, elev, maps, bool(keep_rd_map), amp, theta, slow, slow1, steer, pos, vel,
+        source, bool(noise), n_use, n_v, _doppler_weights(settings.doppler_window, n_d),
+        _cosine_sum_coefficients(settings.range_window, n_r), s2, np.arange(n_v) // radar.n_rx,
+        PATCH_THRESHOLD, *_twiddles(n_r, n_d), has_cfar, *cfar, radar.n_tx, radar.n_rx,
+        *array_rows(radar), angle_twiddles(radar, settings.angle_fft_size),
+        radar.range_resolution_m, radar.velocity_resolution_mps, t_mid,
+        2 * radar.max_velocity_mps,
+    )  # fmt: skip
     pc = PointCloud(
         range_m=f64[:, 0].copy(),
         azimuth_rad=f64[:, 1].copy(),
@@ -1344,12 +1379,10 @@ def _frames_fast(
         x_m=f64[:, 5].copy(),
         y_m=f64[:, 6].copy(),
         z_m=f64[:, 7].copy(),
-        source=np.concatenate(out_s) if n_f else np.zeros(0, dtype=np.int32),
+        source=src.copy(),
     )
-    det = np.zeros((0, 2), dtype=np.int64)
-    if n_f:
-        det = np.column_stack((np.concatenate(out_r), np.concatenate(out_d))).astype(np.int64)
-    return FramesOutput(point_cloud=pc, counts=n_out, detections=det), (maps or None)
+    out = FramesOutput(point_cloud=pc, counts=n_out, detections=det)
+    return out, (maps if keep_rd_map else None)
 
 
 def simulate_frames_fast(

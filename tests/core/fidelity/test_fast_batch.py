@@ -58,7 +58,7 @@ def test_batch_equals_per_frame_bit_for_bit(trajectory) -> None:
 
 
 def test_compiled_frame_equals_the_stage_functions(trajectory) -> None:
-    """Spectrum, CFAR, conditional channel draws, points and labels of the documented
+    """Spectrum, CFAR, conditional channel draws (numpy), points and labels of the documented
     functions, with the same generator: the same detections and labels, values to rounding."""
     radar, frames, antenna, settings = trajectory
     n_use = cfar_range_bins(radar, settings)
@@ -74,7 +74,7 @@ def test_compiled_frame_equals_the_stage_functions(trajectory) -> None:
         det = two_stage_cfar_compiled(spec.rd_map, radar, settings, independent_cells=True)
         det = Detections(range_bin=det.range_bin, doppler_index=det.doppler_index,
                          power=det.power, noise_power=det.noise_power)  # fmt: skip
-        ch = detected_channels(radar, spec, det, rng)
+        ch = detected_channels(radar, spec, det)
         pc = label_points(radar, points_compiled(radar, settings, spec.rd_map, det, ch, False), sc)
         np.testing.assert_array_equal(
             one.detections, np.column_stack((det.range_bin, det.doppler_index))
