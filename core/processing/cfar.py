@@ -355,7 +355,7 @@ def _kernel_args(c: _SidedCfar) -> tuple:
     return (c.n_train, c.n_guard, c.cyclic, _METHOD_CODE[c.method], c.alpha(), c.alpha_one_side())
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(inline="always")
 def cfar_level(left, right, ok_l, ok_r, n, method, a_both, a_one):  # pragma: no cover
     """Noise level and threshold factor of one cell from its training-window sums.
 

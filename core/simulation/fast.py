@@ -84,7 +84,7 @@ from core.simulation.antenna import AntennaGain
 from core.simulation.baseband import steering_vectors
 from core.simulation.frame import FrameOutput, needs_elevation
 from core.simulation.link import noise_power_v2, received_power_w, signal_amplitude_v
-from core.simulation.rng_kernels import fill_normal, gamma_dc, gamma_l, normal, state_from
+from core.simulation.rng_kernels import fill_normal, gamma_l, normal_l, state_from
 from core.simulation.scatterers import Scatterers
 
 #: Per-channel signal power, relative to the cell's noise power, above which a cell gets
@@ -350,11 +350,12 @@ def _patches_kernel(
         for t in range(n_g):
             q = e * tw_r[(t - half) % nn]  # exp(j phi), phi = theta - 2 pi (t - J) / N
             den = 1.0 - q
-            if abs(den) < 1e-9:
+            den2 = den.real * den.real + den.imag * den.imag
+            if den2 < 1e-18:
                 gg[t] = nn + 0.0j
                 gg1[t] = 1j * nn * (nn - 1) / 2
             else:
-                inv = 1.0 / den
+                inv = den.conjugate() * (1.0 / den2)  # 1 / (1 - q)
                 gg[t] = num * inv
                 # dG/dtheta = (-j N e^{j N theta} (1 - q) + (1 - e^{j N theta}) j q) / (1 - q)^2
                 gg1[t] = (-1j * nn * e_n * den + num * 1j * q) * (inv * inv)
@@ -439,6 +440,7 @@ def _patches_kernel(
     # Marsaglia-Tsang constants of Gamma(L - 1)
     dk = n_v - 1.0 - 1.0 / 3.0
     ck = 1.0 / np.sqrt(9.0 * dk)
+    s0, s1, s2_, s3 = s[0], s[1], s[2], s[3]  # the generator state in registers
     for c in range(n_c):
         k = cells_k[c]
         d = cells_d[c]
@@ -456,12 +458,15 @@ def _patches_kernel(
             norm2 += x[c, v].real ** 2 + x[c, v].imag ** 2
         if noise:
             sd = np.sqrt(s2[d] / 2)
-            re = normal(s)
-            along[c] = sd * (re + 1j * normal(s))
-            ortho[c] = s2[d] * gamma_dc(s, dk, ck)
+            re, s0, s1, s2_, s3 = normal_l(s0, s1, s2_, s3)
+            im, s0, s1, s2_, s3 = normal_l(s0, s1, s2_, s3)
+            along[c] = sd * (re + 1j * im)
+            g_o, s0, s1, s2_, s3 = gamma_l(s0, s1, s2_, s3, dk, ck)
+            ortho[c] = s2[d] * g_o
         # P = |(|s| + n_1)|^2 + |n_perp|^2
         z = np.sqrt(norm2) + along[c]
         rd[k, d] = z.real**2 + z.imag**2 + ortho[c]
+    s[0], s[1], s[2], s[3] = s0, s1, s2_, s3
     return cells_k[:n_c], cells_d[:n_c], x, along, ortho
 
 
@@ -1038,12 +1043,14 @@ def _detected_channels_kernel(s, rd, r, d, cells_k, cells_d, x, along, ortho):  
     # z = N(0, 1) + j N(0, 1): all real parts first, then all imaginary parts
     zr = np.empty((n_det, n_v))
     zi = np.empty((n_det, n_v))
+    s0, s1, s2, s3 = s[0], s[1], s[2], s[3]  # the generator state in registers
     for i in range(n_det):
         for v in range(n_v):
-            zr[i, v] = normal(s)
+            zr[i, v], s0, s1, s2, s3 = normal_l(s0, s1, s2, s3)
     for i in range(n_det):
         for v in range(n_v):
-            zi[i, v] = normal(s)
+            zi[i, v], s0, s1, s2, s3 = normal_l(s0, s1, s2, s3)
+    s[0], s[1], s[2], s[3] = s0, s1, s2, s3
     out = np.empty((n_det, n_v), dtype=np.complex128)
     n_c = cells_k.shape[0]
     u = np.empty(n_v, dtype=np.complex128)

@@ -88,7 +88,7 @@ def _rotl(x, k):  # pragma: no cover
 # storing an array state on every draw. The array-state functions below are the same draws.
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(inline="always")
 def xoshiro(s0, s1, s2, s3):  # pragma: no cover
     """One xoshiro256** step: ``(output, s0, s1, s2, s3)`` (uint64)."""
     result = _rotl(s1 * np.uint64(5), 7) * np.uint64(9)
@@ -102,13 +102,13 @@ def xoshiro(s0, s1, s2, s3):  # pragma: no cover
     return result, s0, s1, s2, s3
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(inline="always")
 def _unit(u):  # pragma: no cover
     """U[0, 1) from the upper 53 bits of a 64-bit draw."""
     return float(u >> np.uint64(11)) * (1.0 / 9007199254740992.0)
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(inline="always")
 def normal_l(s0, s1, s2, s3):  # pragma: no cover
     """N(0, 1) by the ziggurat method (see the module docstring): ``(x, s0, s1, s2, s3)``."""
     kn, wn, fn = _KN, _WN, _FN
@@ -136,7 +136,7 @@ def normal_l(s0, s1, s2, s3):  # pragma: no cover
             return x, s0, s1, s2, s3
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(inline="always")
 def gamma_l(s0, s1, s2, s3, d, c):  # pragma: no cover
     """Gamma(k, 1), ``k >= 1``, ``d = k - 1/3``, ``c = 1/sqrt(9 d)`` (Marsaglia-Tsang):
     ``(g, s0, s1, s2, s3)``."""
