@@ -24,6 +24,7 @@ import numpy as np
 
 from core.config import SPEED_OF_LIGHT_MPS, RadarConfig
 from core.simulation.antenna import AntennaGain
+from core.simulation.gaussian import complex_noise
 from core.simulation.link import noise_power_v2, received_power_w, signal_amplitude_v
 from core.simulation.scatterers import Scatterers
 
@@ -143,24 +144,13 @@ def synthesize_signal(radar: RadarConfig, scatterers: Scatterers, antenna: Anten
 def synthesize_noise(radar: RadarConfig, rng: np.random.Generator) -> np.ndarray:
     """Receiver noise cube ``[virtual channel, loop, ADC sample]``, complex64, volts.
 
-    Circular complex Gaussian with ``E|n|^2 = Vnpp^2 / 8``, drawn in polar form (Box-Muller):
-    ``|n|^2 = -E|n|^2 ln(1 - U1)`` is exponential and the phase ``2 pi U2`` uniform, which is
-    exactly a circular complex Gaussian; it is 2x faster here than ``standard_normal``.
+    Circular complex Gaussian with ``E|n|^2 = Vnpp^2 / 8``: real and imaginary parts are
+    independent N(0, E|n|^2 / 2), drawn by the compiled ziggurat of :mod:`core.simulation.gaussian`
+    from a generator seeded by ``rng``. :func:`core.simulation.simulate_frame` adds exactly this
+    noise (same ``rng`` state, same numbers) while it applies the range window.
     """
     shape = (radar.n_virtual, radar.n_loops, radar.n_samples)
-    size = radar.n_virtual * radar.n_loops * radar.n_samples
-    u = rng.random((2, size), dtype=np.float32)
-    # |n| = sqrt(-E|n|^2 ln(1 - U1))
-    mag = np.log1p(-u[0])
-    mag *= np.float32(-noise_power_v2(radar))
-    np.sqrt(mag, out=mag)
-    # phase = 2 pi U2
-    phase = u[1]
-    phase *= np.float32(TWO_PI)
-    out = np.empty((size, 2), dtype=np.float32)
-    np.multiply(mag, np.cos(phase), out=out[:, 0])
-    np.multiply(mag, np.sin(phase), out=out[:, 1])
-    return out.view(np.complex64).reshape(shape)
+    return complex_noise(shape, noise_power_v2(radar), rng)
 
 
 def synthesize_baseband(
