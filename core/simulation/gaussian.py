@@ -31,37 +31,57 @@ import numpy as np
 #: rectangle plus the tail, ``v = r f(r) + sqrt(pi / 2) erfc(r / sqrt 2)``, f(x) = exp(-x^2 / 2)
 ZIGGURAT_R = 3.6541528853610088
 ZIGGURAT_V = 0.004928673233974658
-_M23 = 2.0**23
 _STATE_WORDS = 6
 
 
-def _ziggurat_tables() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """``ki`` (uint32 acceptance limits), ``wi`` (abscissa scale) and ``fi`` (density at the
-    layer edges), float32, for the 256-layer ziggurat with 23-bit abscissae (Marsaglia & Tsang's
-    recurrence: ``x_{i-1} = sqrt(-2 ln(v / x_i + f(x_i)))``, ``f(x) = exp(-x^2 / 2)``)."""
-    ki = np.zeros(256, dtype=np.uint32)
-    wi = np.zeros(256)
-    fi = np.zeros(256)
-    dn = tn = ZIGGURAT_R
-    q = ZIGGURAT_V / np.exp(-0.5 * dn * dn)
-    ki[0] = np.uint32((dn / q) * _M23)
-    wi[0] = q / _M23
-    wi[255] = dn / _M23
+def ziggurat_tables(
+    layers: int = 256, r: float = ZIGGURAT_R, v: float = ZIGGURAT_V, bits: int = 23
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Ziggurat tables for N(0, 1) (Marsaglia & Tsang 2000, ``zigset``).
+
+    Layer ``i`` spans ``[0, x_i]`` under ``f(x) = exp(-x^2 / 2)``; every layer (and the base
+    strip with its tail beyond ``r``) has area ``v``:
+    ``x_{i-1} = sqrt(-2 ln(v / x_i + f(x_i)))``. Abscissae are ``bits``-bit integers.
+
+    Returns
+    -------
+    ki : numpy.ndarray
+        ``(layers,)`` int64 acceptance limits (``|abscissa| < ki[i]`` is inside the rectangle).
+    wi, fi : numpy.ndarray
+        ``(layers,)`` float64 abscissa scale ``x_i / 2^bits`` and density at the layer edges.
+    """
+    scale = 2.0**bits
+    ki = np.zeros(layers, dtype=np.int64)
+    wi = np.zeros(layers)
+    fi = np.zeros(layers)
+    dn = tn = r
+    # q = v / f(r): the base strip's width in units of r
+    q = v / np.exp(-0.5 * dn * dn)
+    ki[0] = int((dn / q) * scale)
+    wi[0] = q / scale
+    wi[-1] = dn / scale
     fi[0] = 1.0
-    fi[255] = np.exp(-0.5 * dn * dn)
-    for i in range(254, 0, -1):
+    fi[-1] = np.exp(-0.5 * dn * dn)
+    for i in range(layers - 2, 0, -1):
         # x_i from x_{i+1}: the layers have equal area v
-        dn = np.sqrt(-2.0 * np.log(ZIGGURAT_V / dn + np.exp(-0.5 * dn * dn)))
-        ki[i + 1] = np.uint32((dn / tn) * _M23)
+        dn = np.sqrt(-2.0 * np.log(v / dn + np.exp(-0.5 * dn * dn)))
+        ki[i + 1] = int((dn / tn) * scale)
         tn = dn
         fi[i] = np.exp(-0.5 * dn * dn)
-        wi[i] = dn / _M23
-    return ki, wi.astype(np.float32), fi.astype(np.float32)
+        wi[i] = dn / scale
+    return ki, wi, fi
 
 
-KI, WI, FI = _ziggurat_tables()
-for _a in (KI, WI, FI):
-    _a.flags.writeable = False
+def _single_precision_tables() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    ki, wi, fi = ziggurat_tables()
+    out = (ki.astype(np.uint32), wi.astype(np.float32), fi.astype(np.float32))
+    for a in out:
+        a.flags.writeable = False
+    return out
+
+
+#: the single-precision tables (23-bit abscissae), as NumPy's ``ki_float``/``wi_float``/``fi_float``
+KI, WI, FI = _single_precision_tables()
 
 _R_F = np.float32(ZIGGURAT_R)
 _INV_R_F = np.float32(1.0 / ZIGGURAT_R)
@@ -74,9 +94,8 @@ def _rotl(x, k):  # pragma: no cover
 
 
 @numba.njit(inline="always")
-def xoshiro_next(s):  # pragma: no cover
-    """Next 64-bit word of xoshiro256++ with the state ``s[0:4]`` (updated in place)."""
-    s0, s1, s2, s3 = s[0], s[1], s[2], s[3]
+def xoshiro_step(s0, s1, s2, s3):  # pragma: no cover
+    """One xoshiro256++ step on a state held in four locals: ``(word, s0, s1, s2, s3)``."""
     out = _rotl(s0 + s3, 23) + s0
     t = s1 << np.uint64(17)
     s2 ^= s0
@@ -85,7 +104,13 @@ def xoshiro_next(s):  # pragma: no cover
     s0 ^= s3
     s2 ^= t
     s3 = _rotl(s3, 45)
-    s[0], s[1], s[2], s[3] = s0, s1, s2, s3
+    return out, s0, s1, s2, s3
+
+
+@numba.njit(inline="always")
+def xoshiro_next(s):  # pragma: no cover
+    """Next 64-bit word of xoshiro256++ with the state ``s[0:4]`` (updated in place)."""
+    out, s[0], s[1], s[2], s[3] = xoshiro_step(s[0], s[1], s[2], s[3])
     return out
 
 
