@@ -12,10 +12,5 @@ Layout of the package:
 - :mod:`app.window` — the main window, playback and persistence.
 """
 
-import os
-
-# The tracker's small-matrix linear algebra gets ~5x slower when OpenBLAS spins threads on a
-# busy machine (measured: 0.15 s vs 0.75 s per re-track); the GUI gains nothing from them.
-# Effective only when app is imported before numpy (radartune gui, python -m app, tests).
-for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
-    os.environ.setdefault(_var, "1")
+# core sets single-threaded BLAS before numpy loads (see core/__init__.py); import it first
+import core  # noqa: F401

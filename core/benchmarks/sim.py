@@ -239,8 +239,48 @@ def run(quick: bool = False) -> dict:
         "plain_points_per_frame": plain_points,
         "exact_person_detected_fraction": person_found,
     }
+    result["stages_ms"] = _stage_profile(radar, settings, antenna, frames[: 50 if quick else 300])
     result["dataset"] = _time_dataset(quick)
     return result
+
+
+def _stage_profile(radar: RadarConfig, settings: ProcessingSettings, antenna, frames) -> dict:
+    """CPU ms per frame of each stage of the exact chain, run one after the other as in
+    :func:`core.simulation.simulate_frame` (the same functions, timed separately)."""
+    import scipy.fft
+
+    from core.processing import doppler_fft, range_doppler_map
+    from core.processing.spectrum import window
+    from core.simulation.baseband import synthesize_signal
+    from core.simulation.frame import frame_from_spectrum, processed_range_bins
+    from core.simulation.gaussian import add_complex_noise
+    from core.simulation.link import noise_power_v2
+
+    rng = np.random.default_rng(3)
+    w = window(settings.range_window, radar.n_samples)
+    power = noise_power_v2(radar)
+    n_bins = processed_range_bins(radar, settings)
+    stages = ("signal", "noise + range window", "range FFT", "Doppler", "range-Doppler map")
+    spent = dict.fromkeys((*stages, "CFAR, angles, points, labels"), 0.0)
+
+    def timed(name, fn, *args, **kwargs):
+        c0 = time.process_time()
+        out = fn(*args, **kwargs)
+        spent[name] += time.process_time() - c0
+        return out
+
+    for f in frames:
+        cube = timed("signal", synthesize_signal, radar, f, antenna)
+        timed("noise + range window", add_complex_noise, cube, power, rng, window=w)
+        rc = timed("range FFT", scipy.fft.fft, cube, axis=-1, overwrite_x=True)
+        dc = timed(
+            "Doppler", doppler_fft, rc[:, :, :n_bins], settings.doppler_window, remove_static=True
+        )
+        rd = timed("range-Doppler map", range_doppler_map, dc)
+        timed(
+            "CFAR, angles, points, labels", frame_from_spectrum, dc, rd, radar, f, settings=settings
+        )
+    return {k: 1e3 * v / len(frames) for k, v in spent.items()}
 
 
 def _load() -> float | None:
@@ -288,6 +328,13 @@ def summary(result: dict) -> str:
         f"plain {result['plain_points_per_frame']:.2f}; person detected in "
         f"{100 * result['exact_person_detected_fraction']:.0f} % of frames",
     ]
+    stages = result.get("stages_ms")
+    if stages:
+        lines.append(
+            "  stages (CPU ms/frame): "
+            + ", ".join(f"{k} {v:.2f}" for k, v in stages.items())
+            + f"; sum {sum(stages.values()):.2f}"
+        )
     ds = result.get("dataset")
     if ds:
         lines.append(

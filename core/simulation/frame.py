@@ -6,6 +6,7 @@ import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
+import scipy.fft
 
 from core.config import DEFAULT_PROCESSING, ProcessingSettings, RadarConfig
 from core.pointcloud import PointCloud
@@ -14,11 +15,13 @@ from core.processing import (
     doppler_fft,
     label_sources,
     range_doppler_map,
-    range_fft,
     two_stage_cfar,
 )
+from core.processing.spectrum import window
 from core.simulation.antenna import AntennaGain
-from core.simulation.baseband import synthesize_noise, synthesize_signal
+from core.simulation.baseband import synthesize_signal
+from core.simulation.gaussian import add_complex_noise
+from core.simulation.link import noise_power_v2
 from core.simulation.scatterers import Scatterers
 
 
@@ -82,9 +85,14 @@ def simulate_frame(
         Add receiver noise (switch off only for noise-free tests).
     """
     cube = synthesize_signal(radar, scatterers, antenna)
+    # the range window is applied while the noise is added (one pass over the cube); the
+    # transform then runs on the windowed cube
+    w = window(settings.range_window, radar.n_samples)
     if noise:
-        cube += synthesize_noise(radar, rng)
-    rc = range_fft(cube, settings.range_window)
+        add_complex_noise(cube, noise_power_v2(radar), rng, window=w)
+    elif settings.range_window != "rect":
+        cube *= w
+    rc = scipy.fft.fft(cube, axis=-1, overwrite_x=True)
     if not keep_rd_map:
         # only the range bins the CFAR looks at (limits plus its training window)
         rc = rc[:, :, : processed_range_bins(radar, settings)]
