@@ -1,4 +1,4 @@
-"""Compiled random draws for the ``fast`` level: xoshiro256**, ziggurat normals, Gamma.
+"""Compiled random draws for the ``fast`` level: xoshiro256++, ziggurat normals, Gamma.
 
 The ``fast`` level draws ~6000 Gamma(12) cells per frame; inside one compiled call per
 trajectory it cannot use a ``numpy.random.Generator`` (numba unboxes one per call, ~20 µs), so it
@@ -6,14 +6,16 @@ draws from its own generator, seeded per frame from four raw 64-bit draws of tha
 generator (:func:`state_from`). The pipeline's per-frame streams (``stage_rng(seed, "noise", f)``)
 still decide every frame.
 
-- :func:`next_u64`: xoshiro256** (Blackman & Vigna 2018), 256-bit state ``(4,)`` uint64.
+- :func:`next_u64`: xoshiro256++ (Blackman & Vigna 2021; the step of
+  :mod:`core.simulation.gaussian`, shared with the exact chain's noise), 256-bit state ``(4,)``
+  uint64.
 - :func:`uniform`: ``U[0, 1)`` with 53 random bits.
 - :func:`normal`: ``N(0, 1)`` by the ziggurat method (Marsaglia & Tsang 2000, 128 layers) with
   the layer index and the value taken from disjoint bits of one 64-bit draw (the original
   32-bit version shares bits between them, Doornik 2005); the tail beyond ``r = 3.4426`` by
   Marsaglia's exponential rejection.
 - :func:`gamma_dc`: ``Gamma(k, 1)``, ``k >= 1``, by Marsaglia & Tsang (2000) with the squeeze
-  ``u < 1 - 0.0331 x^4`` (no logarithm for ~98 % of the draws); ``d = k - 1/3``,
+  ``u < 1 - 0.0331 x^4`` (no logarithm for ~92 % of the Gamma(12) draws); ``d = k - 1/3``,
   ``c = 1/sqrt(9 d)`` are passed in so that a loop over cells computes them once.
 
 The laws are tested in ``tests/core/fidelity/test_rng_kernels.py`` (moments, Kolmogorov-Smirnov
@@ -25,6 +27,8 @@ from __future__ import annotations
 import numba
 import numpy as np
 
+from core.simulation.gaussian import xoshiro_step, ziggurat_tables
+
 #: ziggurat: number of layers and the start of the tail
 _ZIG_LAYERS = 128
 _ZIG_R = 3.442619855899
@@ -32,41 +36,19 @@ _ZIG_V = 9.91256303526217e-3
 
 
 def _ziggurat_tables() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """``kn`` (int64 acceptance bounds on a signed 32-bit value), ``wn``, ``fn`` (float64).
-
-    Marsaglia & Tsang (2000), ``zigset`` for 128 layers: layer ``i`` spans ``x`` up to
-    ``x_i`` with ``f(x) = exp(-x^2/2)``; each layer (and the base with its tail) has area ``v``.
-    """
-    m1 = 2147483648.0  # 2^31
-    kn = np.zeros(_ZIG_LAYERS, dtype=np.int64)
-    wn = np.zeros(_ZIG_LAYERS)
-    fn = np.zeros(_ZIG_LAYERS)
-    dn = tn = _ZIG_R
-    # q = v / f(r): the base strip's width in units of r
-    q = _ZIG_V / np.exp(-0.5 * dn * dn)
-    kn[0] = int((dn / q) * m1)
-    kn[1] = 0
-    wn[0] = q / m1
-    wn[-1] = dn / m1
-    fn[0] = 1.0
-    fn[-1] = np.exp(-0.5 * dn * dn)
-    for i in range(_ZIG_LAYERS - 2, 0, -1):
-        # x_i = sqrt(-2 ln(v / x_{i+1} + f(x_{i+1})))
-        dn = np.sqrt(-2.0 * np.log(_ZIG_V / dn + np.exp(-0.5 * dn * dn)))
-        kn[i + 1] = int((dn / tn) * m1)
-        tn = dn
-        fn[i] = np.exp(-0.5 * dn * dn)
-        wn[i] = dn / m1
-    for a in (kn, wn, fn):
+    """``kn`` (int64 acceptance bounds on a signed 32-bit value), ``wn``, ``fn`` (float64):
+    :func:`core.simulation.gaussian.ziggurat_tables` for 128 layers and 31-bit abscissae."""
+    out = ziggurat_tables(_ZIG_LAYERS, _ZIG_R, _ZIG_V, 31)
+    for a in out:
         a.flags.writeable = False
-    return kn, wn, fn
+    return out
 
 
 _KN, _WN, _FN = _ziggurat_tables()
 
 
 def state_from(rng: np.random.Generator | None) -> np.ndarray:
-    """A 256-bit xoshiro256** state ``(4,)`` uint64 from four raw draws of ``rng``.
+    """A 256-bit xoshiro256++ state ``(4,)`` uint64 from four raw draws of ``rng``.
 
     Never all zero. ``None`` gives a fixed state (noise-free frames).
     """
@@ -78,28 +60,10 @@ def state_from(rng: np.random.Generator | None) -> np.ndarray:
     return s
 
 
-@numba.njit(inline="always")
-def _rotl(x, k):  # pragma: no cover
-    return (x << np.uint64(k)) | (x >> np.uint64(64 - k))
-
-
 # The hot loops keep the 256-bit state in four local variables (registers) and pass it through
-# these functions as ``(value, s0, s1, s2, s3)`` tuples: three times faster than loading and
-# storing an array state on every draw. The array-state functions below are the same draws.
-
-
-@numba.njit(inline="always")
-def xoshiro(s0, s1, s2, s3):  # pragma: no cover
-    """One xoshiro256** step: ``(output, s0, s1, s2, s3)`` (uint64)."""
-    result = _rotl(s1 * np.uint64(5), 7) * np.uint64(9)
-    t = s1 << np.uint64(17)
-    s2 ^= s0
-    s3 ^= s1
-    s1 ^= s2
-    s0 ^= s3
-    s2 ^= t
-    s3 = _rotl(s3, 45)
-    return result, s0, s1, s2, s3
+# these functions as ``(value, s0, s1, s2, s3)`` tuples, inlined: three times faster than loading
+# and storing an array state on every draw. The array-state functions below are the same draws.
+xoshiro = xoshiro_step
 
 
 @numba.njit(inline="always")
@@ -159,7 +123,7 @@ def gamma_l(s0, s1, s2, s3, d, c):  # pragma: no cover
 
 @numba.njit(cache=True, nogil=True)
 def next_u64(s):  # pragma: no cover
-    """Next 64-bit output of xoshiro256** with state ``s`` (4,) uint64 (advanced in place)."""
+    """Next 64-bit output of xoshiro256++ with state ``s`` (4,) uint64 (advanced in place)."""
     u, s[0], s[1], s[2], s[3] = xoshiro(s[0], s[1], s[2], s[3])
     return u
 
