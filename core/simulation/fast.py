@@ -77,8 +77,15 @@ from core.processing import (
     refine_bins,
     window,
 )
-from core.processing.angle import azimuth_row, elevation_pairs
 from core.processing.cfar import _METHOD_CODE, two_stage_kernel, two_stage_pfa
+from core.processing.points import (  # noqa: F401  (angles_of: re-exported for measurement)
+    _points_kernel,
+    angle_twiddles,
+    angles_of,
+    array_rows,
+    detection_rows,
+    point_rows,
+)
 from core.processing.spectrum import clutter_removal_noise_profile, effective_cells
 from core.simulation.antenna import AntennaGain
 from core.simulation.baseband import steering_vectors
@@ -849,120 +856,6 @@ def _no_detections() -> Detections:
     return Detections(range_bin=e, doppler_index=e, power=np.zeros(0), noise_power=np.zeros(0))
 
 
-# ---- the exact chain's point extraction (steps 6-7), compiled ------------------------------------
-# The same maths as core.processing.refine_bins and core.processing.estimate_angles (log-parabolic
-# peak refinement, TDM-MIMO compensation, zero-padded azimuth DFT, elevation from the elevated
-# row); tests/core/fidelity checks the equality.
-@numba.njit(cache=True, nogil=True)
-def _log_parabola(a, b, c):  # pragma: no cover
-    tiny = 2.2250738585072014e-308
-    la = np.log(max(a, tiny))
-    lb = np.log(max(b, tiny))
-    lc = np.log(max(c, tiny))
-    # delta = (a - c) / (2 (a - 2b + c))
-    den = la - 2.0 * lb + lc
-    if den < 0:
-        delta = 0.5 * (la - lc) / den
-        if not np.isfinite(delta):
-            delta = 0.0
-    else:
-        delta = 0.0
-    return min(0.5, max(-0.5, delta))
-
-
-@numba.njit(cache=True, nogil=True)
-def angles_of(
-    x, db, n_tx, n_rx, n_loops, row_ch, row_pos, upper, lower, tw_a, elevation, spec
-):  # pragma: no cover
-    """Azimuth and elevation of one cell's channel values ``x`` (L,), the chain's step 6.
-
-    TDM-MIMO compensation with the (refined) Doppler bin ``db``, zero-padded DFT of the azimuth
-    row, log-parabolic peak refinement, elevation from the elevated pairs. ``spec`` is a work
-    array of ``fft_size``; ``tw_a`` ``(fft_size, n_row)`` the DFT's twiddles
-    ``exp(-j 2 pi (j - N/2) p / N)`` (:func:`angle_twiddles`).
-    """
-    fft_size = tw_a.shape[0]
-    n_v = x.shape[0]
-    # x_v exp(-j 2 pi d k(v) / (Nc Ntx))
-    xc = np.empty(n_v, dtype=np.complex128)
-    for v in range(n_v):
-        xc[v] = x[v] * np.exp(-2j * np.pi * db * (v // n_rx) / (n_loops * n_tx))
-    # spec[j] = |sum_p x_p exp(-j 2 pi (j - N/2) p / N)|^2  (fftshifted)
-    best = 0
-    for j in range(fft_size):
-        acc = 0.0 + 0.0j
-        for q in range(row_ch.shape[0]):
-            acc += xc[row_ch[q]] * tw_a[j, q]
-        spec[j] = acc.real**2 + acc.imag**2
-        if spec[j] > spec[best]:
-            best = j
-    delta = _log_parabola(spec[(best - 1) % fft_size], spec[best], spec[(best + 1) % fft_size])
-    # u = sin(az) cos(el) = 2 (k - N/2 + delta) / N
-    u = 2.0 * (best - fft_size // 2 + delta) / fft_size
-    e = 0.0
-    if elevation and upper.shape[0] > 0:
-        z = 0.0 + 0.0j
-        for q in range(upper.shape[0]):
-            z += xc[upper[q]] * np.conj(xc[lower[q]])
-        # sin(el) = arg(sum x_upper conj(x_lower)) / pi
-        e = np.arcsin(min(1.0, max(-1.0, np.angle(z) / np.pi)))
-    return np.arcsin(min(1.0, max(-1.0, u / np.cos(e)))), e
-
-
-@numba.njit(cache=True, nogil=True)
-def _points_kernel(
-    rd, r, d, x, n_tx, n_rx, row_ch, row_pos, upper, lower, tw_a, elevation
-):  # pragma: no cover
-    n_r, n_d = rd.shape
-    n_det = r.shape[0]
-    r_bin = np.empty(n_det)
-    d_bin = np.empty(n_det)
-    az = np.empty(n_det)
-    el = np.zeros(n_det)
-    spec = np.empty(tw_a.shape[0])
-    for i in range(n_det):
-        ri, di = r[i], d[i]
-        dr = 0.0
-        if 0 < ri < n_r - 1:
-            dr = _log_parabola(
-                np.float64(rd[ri - 1, di]), np.float64(rd[ri, di]), np.float64(rd[ri + 1, di])
-            )
-        dd = _log_parabola(
-            np.float64(rd[ri, (di - 1) % n_d]),
-            np.float64(rd[ri, di]),
-            np.float64(rd[ri, (di + 1) % n_d]),
-        )
-        r_bin[i] = ri + dr
-        db = di - n_d // 2 + dd
-        d_bin[i] = db
-        az[i], el[i] = angles_of(
-            x[i], db, n_tx, n_rx, n_d, row_ch, row_pos, upper, lower, tw_a, elevation, spec
-        )
-    return r_bin, d_bin, az, el
-
-
-@functools.lru_cache(maxsize=16)
-def angle_twiddles(radar: RadarConfig, fft_size: int) -> np.ndarray:
-    """``exp(-j 2 pi (j - N/2) p / N)`` for the azimuth row, ``(fft_size, n_row)`` complex128."""
-    _, row_pos, _, _ = array_rows(radar)
-    j = np.arange(fft_size)[:, None] - fft_size // 2
-    out = np.exp(-2j * np.pi * ((j * row_pos[None, :]) % fft_size) / fft_size)
-    out.flags.writeable = False
-    return out
-
-
-@functools.lru_cache(maxsize=16)
-def array_rows(radar: RadarConfig):
-    row_ch, row_pos = azimuth_row(radar)
-    upper, lower = elevation_pairs(radar)
-    return (
-        row_ch.astype(np.int64),
-        row_pos.astype(np.int64),
-        upper.astype(np.int64),
-        lower.astype(np.int64),
-    )
-
-
 def points_compiled(
     radar: RadarConfig,
     settings: ProcessingSettings,
@@ -1099,36 +992,6 @@ def _detected_channels_kernel(s, rd, r, d, cells_k, cells_d, x, along, ortho):  
 
 
 @numba.njit(cache=True, nogil=True)
-def _label_kernel(range_m, vr_m, pos, vel, source, t_mid, res_r, res_v, span):  # pragma: no cover
-    """:func:`core.processing.label_sources` with reflectors at mid-frame, compiled."""
-    n = range_m.shape[0]
-    n_s = pos.shape[0]
-    out = np.full(n, -2, dtype=np.int32)
-    r_ref = np.empty(n_s)
-    v_ref = np.empty(n_s)
-    for s in range(n_s):
-        p0 = pos[s, 0] + vel[s, 0] * t_mid
-        p1 = pos[s, 1] + vel[s, 1] * t_mid
-        p2 = pos[s, 2] + vel[s, 2] * t_mid
-        r_ref[s] = np.sqrt(p0 * p0 + p1 * p1 + p2 * p2)
-        # v_r = p(t_mid) . v / |p(t_mid)|
-        v_ref[s] = (p0 * vel[s, 0] + p1 * vel[s, 1] + p2 * vel[s, 2]) / r_ref[s]
-    for i in range(n):
-        best = np.inf
-        for s in range(n_s):
-            dr = (range_m[i] - r_ref[s]) / res_r
-            # radial velocities compared modulo 2 v_max (Doppler aliasing)
-            dv = ((vr_m[i] - v_ref[s]) + span / 2) % span - span / 2
-            dv /= res_v
-            if abs(dr) <= 1.0 and abs(dv) <= 1.0:
-                dist = dr * dr + dv * dv
-                if dist < best:
-                    best = dist
-                    out[i] = source[s]
-    return out
-
-
-@numba.njit(cache=True, nogil=True)
 def _frame_kernel(
     s,
     rd,
@@ -1231,28 +1094,13 @@ def _frame_kernel(
         d = np.zeros(0, dtype=np.int64)
         nz = np.zeros(0)
     n_det = r.shape[0]
-    f64 = np.empty((n_det, 8))
-    src = np.full(n_det, -2, dtype=np.int32)
     if n_det == 0:
-        return r, d, f64, src
+        return r, d, np.empty((0, 8)), np.full(0, -2, dtype=np.int32)
     ch = _detected_channels_kernel(s, rd, r, d, cells_k, cells_d, x, along, ortho)
-    r_bin, d_bin, az, el = _points_kernel(
-        rd, r, d, ch, n_tx, n_rx, row_ch, row_pos, upper, lower, tw_a, elevation
-    )
-    for i in range(n_det):
-        rng_m = r_bin[i] * res_r
-        horiz = rng_m * np.cos(el[i])
-        f64[i, 0] = rng_m
-        f64[i, 1] = az[i]
-        f64[i, 2] = el[i]
-        f64[i, 3] = d_bin[i] * res_v
-        # SNR = 10 log10(P / noise estimate)
-        f64[i, 4] = 10 * np.log10(np.float64(rd[r[i], d[i]]) / nz[i])
-        f64[i, 5] = horiz * np.sin(az[i])
-        f64[i, 6] = horiz * np.cos(az[i])
-        f64[i, 7] = rng_m * np.sin(el[i])
-    if pos.shape[0]:
-        src = _label_kernel(f64[:, 0], f64[:, 3], pos, vel, source, t_mid, res_r, res_v, span)
+    f64, src = point_rows(
+        rd, r, d, nz, ch, n_tx, n_rx, row_ch, row_pos, upper, lower, tw_a, elevation, pos, vel,
+        source, t_mid, res_r, res_v, span,
+    )  # fmt: skip
     return r, d, f64, src  # fmt: skip
 
 
@@ -1373,7 +1221,7 @@ def _frames_fast(
         source, bool(noise), n_use, n_v, _doppler_weights(settings.doppler_window, n_d),
         _cosine_sum_coefficients(settings.range_window, n_r), s2, np.arange(n_v) // radar.n_rx,
         PATCH_THRESHOLD, *_twiddles(n_r, n_d), has_cfar, *cfar, radar.n_tx, radar.n_rx,
-        *array_rows(radar), angle_twiddles(radar, settings.angle_fft_size),
+        *detection_rows(radar, bool(elev.any())), angle_twiddles(radar, settings.angle_fft_size),
         radar.range_resolution_m, radar.velocity_resolution_mps, t_mid,
         2 * radar.max_velocity_mps,
     )  # fmt: skip

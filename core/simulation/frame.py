@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
@@ -11,12 +10,11 @@ import scipy.fft
 from core.config import DEFAULT_PROCESSING, ProcessingSettings, RadarConfig
 from core.pointcloud import PointCloud
 from core.processing import (
-    build_point_cloud,
     doppler_fft,
-    label_sources,
     range_doppler_map,
     two_stage_cfar,
 )
+from core.processing.points import labelled_points
 from core.processing.spectrum import window
 from core.simulation.antenna import AntennaGain
 from core.simulation.baseband import synthesize_signal
@@ -131,15 +129,24 @@ def frame_from_spectrum(
     """
     rd = rd_map
     det = two_stage_cfar(rd, radar, settings)
-    pc = build_point_cloud(doppler_cube, rd, det, radar, settings, elevation=elevation)
-    if len(pc) and len(scatterers):
-        # truth at the middle of the frame's chirps
-        t_mid = 0.5 * radar.n_loops * radar.n_tx * radar.chirp_period_s
-        pos = scatterers.position_m + scatterers.velocity_mps * t_mid
-        r_mid = np.linalg.norm(pos, axis=1)
-        vr = np.einsum("ij,ij->i", pos, scatterers.velocity_mps) / r_mid
-        src = label_sources(pc.range_m, pc.radial_velocity_mps, r_mid, vr, scatterers.source, radar)
-        pc = dataclasses.replace(pc, source=src)
+    pc = PointCloud.empty()
+    if len(det):
+        # channel values of the detected cells; refinement, angles, SNR and labels (truth at
+        # the middle of the frame's chirps) in one compiled call (build_point_cloud and
+        # label_sources to floating-point order, tested)
+        channels = np.asarray(doppler_cube)[:, det.range_bin, det.doppler_index].T
+        pc = labelled_points(
+            rd,
+            det,
+            channels,
+            radar,
+            settings,
+            elevation=elevation,
+            reflector_position_m=scatterers.position_m,
+            reflector_velocity_mps=scatterers.velocity_mps,
+            reflector_source=scatterers.source,
+            t_mid_s=0.5 * radar.n_loops * radar.n_tx * radar.chirp_period_s,
+        )
     rd_db = None
     if keep_rd_map:
         rd_db = (10 * np.log10(np.maximum(rd, np.finfo(np.float32).tiny))).astype(np.float32)
