@@ -25,6 +25,13 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         "--out-dir", default="bench/results", help="folder for <name>.json (default: %(default)s)"
     )
     p.add_argument("--quick", action="store_true", help="short run (smoke test)")
+    for model in ("cv", "ca"):
+        p.add_argument(
+            f"--params-{model}",
+            metavar="FILE",
+            help=f"fidelity: {model.upper()} tracker parameters (default: "
+            f"docs/report/best_{model}.json when present, else the defaults)",
+        )
     p.set_defaults(func=run)
 
 
@@ -34,10 +41,18 @@ def run(args: argparse.Namespace) -> int:
     out_dir.mkdir(parents=True, exist_ok=True)
     for name in names:
         module = importlib.import_module(f"core.benchmarks.{name}")
-        result = module.run(quick=args.quick)
+        extra, flags = {}, ""
+        if name == "fidelity":
+            extra = {"params_cv": args.params_cv, "params_ca": args.params_ca}
+            flags = "".join(
+                f" --params-{m} {v}"
+                for m, v in (("cv", args.params_cv), ("ca", args.params_ca))
+                if v
+            )
+        result = module.run(quick=args.quick, **extra)
         result = {
             "benchmark": name,
-            "command": f"radartune bench {name}" + (" --quick" if args.quick else ""),
+            "command": f"radartune bench {name}" + (" --quick" if args.quick else "") + flags,
             "date": dt.datetime.now(dt.UTC).isoformat(timespec="seconds"),
             "machine": {"python": platform.python_version(), "cpu": platform.processor()},
             **result,
