@@ -90,8 +90,16 @@ from core.processing.spectrum import clutter_removal_noise_profile, effective_ce
 from core.simulation.antenna import AntennaGain
 from core.simulation.baseband import steering_vectors
 from core.simulation.frame import FrameOutput, needs_elevation
+from core.simulation.gaussian import FI, KI, WI
 from core.simulation.link import noise_power_v2, received_power_w, signal_amplitude_v
-from core.simulation.rng_kernels import fill_normal, gamma_l, normal_l, state_from
+from core.simulation.rng_kernels import (
+    fill_normal,
+    gamma_f32_l,
+    gamma_l,
+    normal_l,
+    state6,
+    state_from,
+)
 from core.simulation.scatterers import Scatterers
 
 #: Per-channel signal power, relative to the cell's noise power, above which a cell gets
@@ -272,19 +280,24 @@ def _slow_time_kernel(
 
 @numba.njit(cache=True, nogil=True)
 def _noise_map(s, rd, s2, n_use, n_v):  # pragma: no cover
-    """Noise-only map: ``rd[k, d] = s2[d] Gamma(L)`` for ``k < n_use`` (row by row), the mean
-    ``L s2[d]`` beyond (never read by the CFAR). Draws from the state ``s`` (advanced)."""
+    """Noise-only map: ``rd[k, d] = s2[d] Gamma(L)`` (float32) for ``k < n_use`` (row by row),
+    the mean ``L s2[d]`` beyond (never read by the CFAR). Draws from the six-word state ``s``
+    (advanced): NumPy's float32 Gamma algorithm (:func:`~core.simulation.rng_kernels.gamma_f32`),
+    as ``standard_gamma(L, dtype=float32)`` fed the same words."""
     n_r, n_d = rd.shape
-    # Marsaglia-Tsang constants of Gamma(L): d = L - 1/3, c = 1 / sqrt(9 d)
-    dk = n_v - 1.0 / 3.0
-    ck = 1.0 / np.sqrt(9.0 * dk)
-    s0, s1, s2_, s3 = s[0], s[1], s[2], s[3]  # the generator state in registers
+    # Marsaglia-Tsang constants of Gamma(L) in float32: b = L - 1/3, c = 1 / sqrt(9 b)
+    b = np.float32(n_v) - np.float32(1.0 / 3.0)
+    c = np.float32(np.float32(1.0) / np.sqrt(np.float32(9.0) * b))
+    s2_32 = s2.astype(np.float32)
+    ki, wi, fi = KI, WI, FI
+    # the generator state in registers
+    s0, s1, s2_, s3, buf, has = s[0], s[1], s[2], s[3], s[4], s[5] != 0
     for k in range(n_use):
         for d in range(n_d):
-            g, s0, s1, s2_, s3 = gamma_l(s0, s1, s2_, s3, dk, ck)
+            g, s0, s1, s2_, s3, buf, has = gamma_f32_l(s0, s1, s2_, s3, buf, has, b, c, ki, wi, fi)
             # noise-only cell: sum of L exponentials of mean s2[d] ~ s2[d] Gamma(L)
-            rd[k, d] = np.float32(s2[d] * g)
-    s[0], s[1], s[2], s[3] = s0, s1, s2_, s3
+            rd[k, d] = g * s2_32[d]
+    s[0], s[1], s[2], s[3], s[4], s[5] = s0, s1, s2_, s3, buf, np.uint64(has)
     for k in range(n_use, n_r):
         for d in range(n_d):
             rd[k, d] = np.float32(n_v * s2[d])
@@ -565,7 +578,7 @@ def fast_spectrum(
     n_r, n_d, n_v = radar.n_samples, radar.n_loops, radar.n_virtual
     s2 = cell_noise_power_v2(radar, settings)  # (n_d,)
     n_use = n_r if n_range_bins is None else max(0, min(n_r, int(n_range_bins)))
-    state = state_from(rng if noise else None)
+    state = state6(state_from(rng if noise else None))
     rd = np.zeros((n_r, n_d), dtype=np.float32)
     if noise:
         _noise_map(state, rd, s2, n_use, n_v)
@@ -1212,9 +1225,9 @@ def _frames_fast(
     if cfar is None:  # no range bin inside the limits: nothing is tested
         e = np.ones(1)
         cfar = (e, 0, 0, 0, 0, 1, 0, False, 0, 1.0, 1.0, 1, 0, False, 0, 1.0, 1.0, False)
-    states = np.empty((n_f, 4), dtype=np.uint64)
+    states = np.zeros((n_f, 6), dtype=np.uint64)  # core.simulation.gaussian's six words
     for f in range(n_f):
-        states[f] = state_from(rngs[f] if noise else None)
+        states[f, :4] = state_from(rngs[f] if noise else None)
     maps = np.empty((n_f if keep_rd_map else 1, n_r, n_d), dtype=np.float32)
     det, f64, src, n_out = _frames_kernel(
         states, start, elev, maps, bool(keep_rd_map), amp, theta, slow, slow1, steer, pos, vel,
