@@ -46,3 +46,22 @@ def test_verdict_bands() -> None:
     assert verdict(0.85, 1.05) == "undecided"
     assert verdict(1.12, 1.5) == "outside"
     assert verdict(0.5, 0.89) == "outside"
+
+
+def test_bench_tracks_with_the_tuned_parameters_unless_told(tmp_path) -> None:
+    from core.benchmarks.fidelity import TUNED_PARAMS, tracker_parameters
+    from core.errors import InputError
+    from core.tracking import TrackerParams
+
+    params, said = tracker_parameters()
+    for model in ("cv", "ca"):
+        assert TUNED_PARAMS[model].exists()
+        assert params[model] == TrackerParams.load(TUNED_PARAMS[model])
+        assert params[model] != TrackerParams.default(model)
+    assert "docs/report/best_cv.json" in said and "docs/report/best_ca.json" in said
+    own = TrackerParams.default("cv")
+    path = own.save(tmp_path / "cv.json")
+    params, said = tracker_parameters(params_cv=path)
+    assert params["cv"] == own and str(path) in said
+    with pytest.raises(InputError, match="model must be 'ca'"):
+        tracker_parameters(params_ca=path)
