@@ -65,3 +65,17 @@ def test_bench_tracks_with_the_tuned_parameters_unless_told(tmp_path) -> None:
     assert params["cv"] == own and str(path) in said
     with pytest.raises(InputError, match="model must be 'ca'"):
         tracker_parameters(params_ca=path)
+
+
+def test_regular_loss_leaves_out_runs_without_a_confirmed_track() -> None:
+    from core.benchmarks.fidelity import rate_interval, regular_loss
+
+    loss = np.array([[1.0, 2.0, 1000.0], [3.0, 1000.0, 1000.0]])
+    seen = np.array([[True, True, False], [True, False, False]])
+    reg = regular_loss(loss, seen)
+    np.testing.assert_allclose(reg[:2], [2.0, 2.0])
+    assert np.isnan(reg[2])
+    q, lo, hi = rate_interval(2, 840)
+    assert q == pytest.approx(2 / 840) and lo < q < hi
+    # Clopper-Pearson: zero events in n runs -> upper bound 1 - 0.025^(1/n) ~ 3.69 / n
+    assert rate_interval(0, 1000)[2] == pytest.approx(1 - 0.025 ** (1 / 1000), rel=1e-9)
