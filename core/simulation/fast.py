@@ -37,9 +37,12 @@ exact chain then run unchanged.
 
 Entry points: :func:`simulate_frame_fast` (one frame, the GUI's) and
 :func:`simulate_frames_fast` (all frames of a trajectory, the data-set path: per-scatterer inputs
-computed once, then per frame the noise map and one compiled kernel for patches, CFAR, detected
+computed once, then one compiled call for every frame's noise map, patches, CFAR, detected
 channels, points and labels). The first is the second with one frame, so both give the same
-frames for the same per-frame generators.
+frames for the same per-frame generators. The draws come from a compiled generator
+(:mod:`core.simulation.rng_kernels`) seeded per frame with four raw words of that frame's
+generator; the noise map's Gamma(12) is NumPy's float32 algorithm on those words
+(``docs/decisions/fidelity-07``).
 
 Known approximations (measured in ``docs/fidelity.md``): neighbouring cells of the exact chain's
 noise are correlated through the windows (range |rho|^2 = 0.44 for Hann), here they are
