@@ -153,9 +153,18 @@ def main() -> int:
     ds_unbiased = dataclasses.replace(ds, radial_velocity_mps=ds.radial_velocity_mps / VR_BIAS)
     out["vr_bias"] = {"factor": VR_BIAS}
     for m, p in best.items():
+        a, la = _loss(ds, p)
+        b, lb = _loss(ds_unbiased, p)
+        k = int(np.argmax(np.abs(lb - la)))
         out["vr_bias"][m] = {
-            "loss_total_as_simulated": _loss(ds, p)[0],
-            "loss_total_vr_divided_by_factor": _loss(ds_unbiased, p)[0],
+            "loss_total_as_simulated": a,
+            "loss_total_vr_divided_by_factor": b,
+            "largest_change": {
+                "trajectory": k,
+                "class": str(ds.trajectory_class[k]),
+                "loss_as_simulated": float(la[k]),
+                "loss_vr_divided_by_factor": float(lb[k]),
+            },
         }
     print("vr bias:", json.dumps(out["vr_bias"]), flush=True)
 
@@ -169,9 +178,24 @@ def main() -> int:
         "cv_params_cv_model": _q_scan(ds, best["cv"], grid),
         "cv_params_ca_model": _q_scan(ds, _swap(best["cv"], "ca", ca_acc), grid),
     }
+    # diagnostic only, outside eq. (15): does CV want more process noise than q <= 30 allows?
+    beyond = np.geomspace(30.0, 1000.0, 9)
+    out["matched"]["beyond_search_range_note"] = (
+        "diagnostic only: q_coeff in [30, 1000], outside the paper's search range (eq. 15)"
+    )
+    out["matched"]["cv_params_cv_model_beyond"] = _q_scan(ds, best["cv"], beyond)
+    out["matched"]["ca_params_cv_model_beyond"] = _q_scan(ds, _swap(best["ca"], "cv", ()), beyond)
     for k, v in out["matched"].items():
         if isinstance(v, dict):
-            print(f"matched {k}: best q = {v['best_q']:.3g}, L_t = {v['best'] * 1e3:.4f}e-3")
+            print(f"matched {k}: best q = {v['best_q']:.3g}, L_t = {v['best'] * 1e3:.5f}e-3")
+    # paired: CV with CA's other parameters (q re-scanned within the range) against CA's best
+    q_cv = out["matched"]["ca_params_cv_model"]["best_q"]
+    cv_m = dataclasses.replace(_swap(best["ca"], "cv", ()), q_coeff=q_cv)
+    out["matched"]["paired_cv_with_ca_params_vs_ca"] = paired_comparison(
+        _loss(ds, cv_m)[1], bds["ca"].loss, bds["ca"].classes
+    ).to_dict()
+    out["matched"]["breakdown_cv_with_ca_params"] = _breakdown(ds, cv_m)[0]["classes"]
+    print("matched paired:", out["matched"]["paired_cv_with_ca_params_vs_ca"], flush=True)
 
     # 4. paired statistic of the two best parameter sets
     cls = bds["cv"].classes
