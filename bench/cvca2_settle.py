@@ -57,10 +57,55 @@ def _stats(v: list[float]) -> dict:
     }
 
 
+def _figure(out: dict, path: Path) -> None:
+    """Left: best L_t per sampler seed and model on both sets. Middle, right: L(k) of CV against
+    CA per trajectory (best of all seeds), by class, on the training and the independent set."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(1, 3, figsize=(13, 4.2))
+    ax = axes[0]
+    for j, name in enumerate(("best_value", "paper:1")):
+        for i, m in enumerate(("cv", "ca")):
+            v = np.asarray(out["per_model"][m][name]["values"]) * 1e3
+            x = np.full(len(v), 2 * j + i) + np.linspace(-0.15, 0.15, len(v))
+            ax.scatter(x, v, color=f"C{i}", label=m.upper() if j == 0 else None)
+            ax.hlines(np.median(v), 2 * j + i - 0.3, 2 * j + i + 0.3, color=f"C{i}")
+    ax.set_xticks([0.5, 2.5], ["paper:0 (training)", "paper:1 (independent)"])
+    ax.set_yscale("log")
+    ax.set_ylabel("L_t of each seed's best trial (×10⁻³)")
+    ax.set_title("one point per sampler seed; bar: median")
+    ax.legend()
+    for ax, name in zip(axes[1:], ("paper:0", "paper:1"), strict=True):
+        d = out["best_of_all_per_trajectory"][name]
+        cls = np.asarray(d["classes"])
+        a, b = np.asarray(d["cv"]) * 1e3, np.asarray(d["ca"]) * 1e3
+        for i, c in enumerate(sorted(set(cls))):
+            ax.scatter(b[cls == c], a[cls == c], s=14, color=f"C{i}", label=c.upper())
+        lo, hi = min(a.min(), b.min()), max(a.max(), b.max())
+        ax.plot([lo, hi], [lo, hi], "k-", lw=0.8)
+        ax.plot([lo, hi], [1.05 * lo, 1.05 * hi], "k:", lw=0.8)
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set_xlabel("L(k) CA (×10⁻³)")
+        ax.set_ylabel("L(k) CV (×10⁻³)")
+        ax.set_title(f"{name}: best CV vs best CA per trajectory")
+        ax.legend(fontsize=8)
+    fig.tight_layout()
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".png")
+    os.close(fd)
+    fig.savefig(tmp, dpi=110)
+    plt.close(fig)
+    os.replace(tmp, path)
+
+
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--storage", required=True)
     ap.add_argument("--out", required=True)
+    ap.add_argument("--figure", default=None, help="PNG: per-seed bests and per-trajectory L")
     ap.add_argument("--prefix", default="", help="only studies whose name starts with this")
     args = ap.parse_args()
     sets = {
@@ -179,6 +224,8 @@ def main() -> int:
         }
     path = Path(args.out)
     path.parent.mkdir(parents=True, exist_ok=True)
+    if args.figure and by_model["cv"] and by_model["ca"]:
+        _figure(out, Path(args.figure))
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
     with os.fdopen(fd, "w") as f:
         json.dump(out, f, indent=1)
