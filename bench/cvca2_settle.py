@@ -17,6 +17,7 @@ the best of all seeds, on both data sets; and the ratio of the per-model medians
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
 import os
 import re
@@ -36,6 +37,8 @@ from core.pipeline import paper_dataset_file  # noqa: E402
 from core.tracking import TrackerParams, track_dataset  # noqa: E402
 
 EARLY_BUDGET = 300
+#: The chain's radial-velocity scale error (bench/cvca2_diagnose.py, decision sim-01).
+VR_BIAS = 1.0 + 61.366e12 * 255 / (2 * 5.9e6) / 60e9
 
 
 def _best(trials, limit: int | None = None):
@@ -108,9 +111,14 @@ def main() -> int:
     ap.add_argument("--figure", default=None, help="PNG: per-seed bests and per-trajectory L")
     ap.add_argument("--prefix", default="", help="only studies whose name starts with this")
     args = ap.parse_args()
+    ds0 = Dataset.load(paper_dataset_file(0, 35))
     sets = {
-        "paper:0": Dataset.load(paper_dataset_file(0, 35)),
+        "paper:0": ds0,
         "paper:1": Dataset.load(paper_dataset_file(1, 35)),
+        # diagnostic: the training set with the chain's 2.2 % v_r bias divided out
+        "paper:0 vr/bias": dataclasses.replace(
+            ds0, radial_velocity_mps=ds0.radial_velocity_mps / VR_BIAS
+        ),
     }
     classes = {k: d.trajectory_class.astype(str) for k, d in sets.items()}
     studies = [s for s in load_studies(args.storage) if s.name.startswith(args.prefix)]
@@ -150,7 +158,8 @@ def main() -> int:
             f"{s.name}: best {best.value * 1e3:.5f} (first {EARLY_BUDGET}: "
             f"{early.value * 1e3 if early else float('nan'):.5f}) paper:0 "
             f"{row['paper:0']['loss_total'] * 1e3:.5f} paper:1 "
-            f"{row['paper:1']['loss_total'] * 1e3:.5f} x1e-3",
+            f"{row['paper:1']['loss_total'] * 1e3:.5f} vr/bias "
+            f"{row['paper:0 vr/bias']['loss_total'] * 1e3:.5f} x1e-3",
             flush=True,
         )
     out: dict = {"storage": args.storage, "early_budget": EARLY_BUDGET, "studies": rows}
@@ -166,6 +175,7 @@ def main() -> int:
                 [rows[n][f"best_value_first_{EARLY_BUDGET}"] for n in names]
             ),
             "paper:1": _stats([rows[n]["paper:1"]["loss_total"] for n in names]),
+            "paper:0 vr/bias": _stats([rows[n]["paper:0 vr/bias"]["loss_total"] for n in names]),
         }
     if by_model["cv"] and by_model["ca"]:
         pm = out["per_model"]
@@ -177,6 +187,8 @@ def main() -> int:
             ]
             / pm["ca"][f"best_value_first_{EARLY_BUDGET}"]["median"],
             "paper:1": pm["cv"]["paper:1"]["median"] / pm["ca"]["paper:1"]["median"],
+            "paper:0 vr/bias": pm["cv"]["paper:0 vr/bias"]["median"]
+            / pm["ca"]["paper:0 vr/bias"]["median"],
         }
         # every CV study against every CA study: how often is CV within 5 %?
         out["all_pairs"] = {}
