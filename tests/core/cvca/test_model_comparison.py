@@ -143,3 +143,19 @@ def test_paired_comparison_rejects_bad_input() -> None:
         paired_comparison(np.ones(3), np.ones(4))
     with pytest.raises(ValueError, match="positive"):
         paired_comparison(np.array([1.0, 0.0]), np.ones(2))
+
+
+def test_track_with_ids_matches_track_dataset() -> None:
+    from core.model_comparison import track_with_ids
+    from core.tracking import TrackerParams, track_dataset
+    from core.tracking.synthetic import SyntheticScene, synthetic_dataset
+
+    ds = synthetic_dataset(
+        4, n_per_class=1, classes="bd", scene=SyntheticScene(clutter_per_frame=2.0), n_frames=40
+    )
+    p = TrackerParams.default("cv")
+    est, ids = track_with_ids(ds, p)
+    ref = track_dataset(ds, p)
+    np.testing.assert_array_equal(est.has_estimate, ref.has_estimate)
+    np.testing.assert_array_equal(ids >= 0, ref.has_estimate)
+    assert ref.has_estimate.any()
