@@ -291,7 +291,7 @@ def _label_kernel(range_m, vr_m, pos, vel, source, t_mid, res_r, res_v, span):  
     return out
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, error_model="numpy")
 def point_rows(
     rd, r, d, nz, x, n_tx, n_rx, row_ch, row_pos, upper, lower, tw_a, elevation, pos, vel,
     source, t_mid, res_r, res_v, span,
@@ -300,6 +300,7 @@ def point_rows(
 
     Returns ``f64`` ``(n, 8)`` (range, azimuth, elevation, radial velocity, SNR, x, y, z) and
     the labels ``(n,)`` int32 from the reflectors ``pos``/``vel``/``source`` at ``t_mid``.
+    A zero noise estimate (noise-free maps) gives an infinite SNR, as numpy's division does.
     """
     n_det = r.shape[0]
     f64 = np.empty((n_det, 8))

@@ -218,3 +218,10 @@ def test_compiled_points_equal_library_points(elevation) -> None:
     b = points_compiled(RADAR, DEFAULT_PROCESSING, rd, det, x, elevation)
     for name in ("range_m", "radial_velocity_mps", "azimuth_rad", "elevation_rad", "x_m", "y_m"):
         np.testing.assert_allclose(getattr(b, name), getattr(a, name), rtol=1e-9, atol=1e-12)
+
+
+def test_noise_free_frame_runs_and_reports_infinite_snr_where_the_noise_estimate_is_zero() -> None:
+    f = simulate_frame_fast(RADAR, SCENE, None, antenna=ANT, noise=False)
+    assert len(f.point_cloud) >= 3
+    assert set(f.point_cloud.source.tolist()) >= {0, 1, 2}
+    assert not np.any(np.isnan(f.point_cloud.snr_db))
