@@ -161,7 +161,9 @@ def test_sigkill_mid_study_then_resume_loses_nothing(storage: str, request) -> N
     name = f"kill-{request.node.callspec.id}-{os.getpid()}"
     args = ["tune", "--model", "cv", "--trials", "10", "--jobs", "2", "--storage", storage,
             "--study", name, "--objective", "quadratic", "--objective-option", "n_trajectories=5",
-            "--objective-option", "delay_s=0.06", "--no-progress"]  # fmt: skip
+            "--objective-option", "delay_s=0.25", "--no-progress"]  # fmt: skip
+    # 1.25 s a trial: after the third finished trial the two workers stay mid-trial for seconds,
+    # wide enough for the 0.2 s polls below even on a loaded machine (0.3 s trials were missed)
     parent = subprocess.Popen(
         [sys.executable, "-m", "core.cli", *args],
         cwd=ROOT,
@@ -183,6 +185,8 @@ def test_sigkill_mid_study_then_resume_loses_nothing(storage: str, request) -> N
             if len(done) >= 3 and running:
                 victims = {int(t.worker.rsplit(":", 2)[1]) for t in running}
                 break
+            if len(done) >= 10:
+                break  # finished before a poll caught a running trial
         assert victims, "no running trial to kill"
         # the whole machine dies: workers mid-trial, and the parent
         for pid in victims:
