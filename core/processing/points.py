@@ -323,6 +323,16 @@ def point_rows(
     return f64, src
 
 
+def cloud_from_rows(f64: np.ndarray, source: np.ndarray) -> PointCloud:
+    """The :class:`PointCloud` of :func:`point_rows` output: ``f64`` ``(n, 8)`` (range, azimuth,
+    elevation, radial velocity, SNR, x, y, z) and ``source`` ``(n,)`` int32 (copied)."""
+    c = [f64[:, k].copy() for k in range(8)]
+    return PointCloud(
+        range_m=c[0], azimuth_rad=c[1], elevation_rad=c[2], radial_velocity_mps=c[3],
+        snr_db=c[4], x_m=c[5], y_m=c[6], z_m=c[7], source=np.array(source, dtype=np.int32),
+    )  # fmt: skip
+
+
 def labelled_points(
     rd_map: np.ndarray,
     det: Detections,
@@ -367,14 +377,4 @@ def labelled_points(
         pos, vel, source, float(t_mid_s), radar.range_resolution_m,
         radar.velocity_resolution_mps, 2 * radar.max_velocity_mps,
     )  # fmt: skip
-    return PointCloud(
-        range_m=f64[:, 0].copy(),
-        azimuth_rad=f64[:, 1].copy(),
-        elevation_rad=f64[:, 2].copy(),
-        radial_velocity_mps=f64[:, 3].copy(),
-        snr_db=f64[:, 4].copy(),
-        x_m=f64[:, 5].copy(),
-        y_m=f64[:, 6].copy(),
-        z_m=f64[:, 7].copy(),
-        source=src,
-    )
+    return cloud_from_rows(f64, src)

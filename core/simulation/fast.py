@@ -86,6 +86,7 @@ from core.processing.points import (  # noqa: F401  (angles_of: re-exported for 
     angle_twiddles,
     angles_of,
     array_rows,
+    cloud_from_rows,
     detection_rows,
     point_rows,
 )
@@ -1241,17 +1242,7 @@ def _frames_fast(
         radar.range_resolution_m, radar.velocity_resolution_mps, t_mid,
         2 * radar.max_velocity_mps,
     )  # fmt: skip
-    pc = PointCloud(
-        range_m=f64[:, 0].copy(),
-        azimuth_rad=f64[:, 1].copy(),
-        elevation_rad=f64[:, 2].copy(),
-        radial_velocity_mps=f64[:, 3].copy(),
-        snr_db=f64[:, 4].copy(),
-        x_m=f64[:, 5].copy(),
-        y_m=f64[:, 6].copy(),
-        z_m=f64[:, 7].copy(),
-        source=src.copy(),
-    )
+    pc = cloud_from_rows(f64, src)
     out = FramesOutput(point_cloud=pc, counts=n_out, detections=det)
     return out, (maps if keep_rd_map else None)
 
