@@ -232,6 +232,31 @@ def _worker_alive(wid: str) -> bool | None:
     return now is not None and now == ticks
 
 
+def _ask_as(study: Any, worker: str) -> Any:
+    """``study.ask()`` with the worker recorded in the same storage write that creates the trial.
+
+    Set afterwards (``trial.set_user_attr``), a SIGKILL between the two writes left a RUNNING
+    trial without a worker, which resume could not tell from a live one on another host (seen
+    in the SIGKILL test under load). ``create_new_trial`` with a template is the storage API that
+    ``ask`` uses itself; ``optuna.Trial`` then runs the sampler's ``before_trial`` as ``ask`` does.
+    """
+    import optuna
+    from optuna.trial import FrozenTrial, TrialState
+
+    if study.get_trials(deepcopy=False, states=(TrialState.WAITING,)):
+        # an enqueued trial runs first (ask pops it); only these keep the two writes
+        trial = study.ask()
+        trial.set_user_attr("worker", worker)
+        return trial
+    template = FrozenTrial(
+        number=-1, state=TrialState.RUNNING, value=None, datetime_start=dt.datetime.now(),
+        datetime_complete=None, params={}, distributions={}, user_attrs={"worker": worker},
+        system_attrs={}, intermediate_values={}, trial_id=-1,
+    )  # fmt: skip
+    trial_id = study._storage.create_new_trial(study._study_id, template_trial=template)
+    return optuna.Trial(study, trial_id)
+
+
 def fail_stale_trials(study: Any, *, stale_after_s: float = STALE_AFTER_S) -> list[int]:
     """Mark FAIL the RUNNING trials whose worker died; return their numbers.
 
@@ -404,9 +429,8 @@ def run_worker(
             # slots held by RUNNING trials of dead workers are freed, then counted again
             if not fail_stale_trials(study) or count_trials(study) >= n_total:
                 break
-        trial = study.ask()
+        trial = _ask_as(study, me)
         try:
-            trial.set_user_attr("worker", me)
             if count_trials(study, below=trial.number) >= n_total:
                 trial.set_user_attr("surplus", True)
                 study.tell(trial, state=TrialState.FAIL)

@@ -135,3 +135,22 @@ def test_wilcoxon_prunes_and_none_never_does(tmp_path: Path, pruner: str, pruned
             assert set(t.intermediate_values) <= set(range(20))
         else:
             assert t.intermediate_values == {}
+
+
+def test_trial_carries_its_worker_from_the_first_write(tmp_path: Path) -> None:
+    # a worker killed right after creating its trial must leave a trial that resume can fail:
+    # the worker record is part of the write that creates the RUNNING trial
+    import socket
+
+    from optuna.trial import TrialState
+
+    from core.optimization.study import _ask_as, fail_stale_trials
+
+    study = optuna.create_study(storage=f"sqlite:///{tmp_path}/s.db")
+    # a dead worker on this host: pid 2^22 + 1 is above the largest pid Linux allows (2^22)
+    dead = f"{socket.gethostname()}:4194305:1"
+    trial = _ask_as(study, dead)
+    stored = study.get_trials(deepcopy=False)[0]
+    assert stored.state == TrialState.RUNNING and stored.user_attrs["worker"] == dead
+    assert fail_stale_trials(study) == [trial.number]
+    assert study.get_trials(deepcopy=False)[0].state == TrialState.FAIL
