@@ -194,12 +194,24 @@ def _accumulate_normals(f, sigma, w, s, ki, wi, fi):  # pragma: no cover
             row[j] = (row[j] + sig * x) * w[j]
 
 
-def seed_state(rng: np.random.Generator) -> np.ndarray:
-    """A generator state (uint64[6]) seeded from ``rng``; never the all-zero xoshiro state."""
-    s = np.zeros(_STATE_WORDS, dtype=np.uint64)
-    s[:4] = rng.integers(0, 2**64, size=4, dtype=np.uint64, endpoint=False)
-    if not s[:4].any():
+def state_from(rng: np.random.Generator | None) -> np.ndarray:
+    """A 256-bit xoshiro state ``(4,)`` uint64 from four raw 64-bit draws of ``rng``.
+
+    Never all zero. ``None`` gives a fixed state (noise-free frames). Every compiled sampler
+    (this module's, the ``fast`` and ``measurement`` levels') seeds a frame this way.
+    """
+    if rng is None:
+        return np.array([1, 2, 3, 4], dtype=np.uint64)
+    s = rng.bit_generator.random_raw(4)
+    if not s.any():
         s[0] = 1
+    return s
+
+
+def seed_state(rng: np.random.Generator) -> np.ndarray:
+    """A generator state (uint64[6], no buffered half) seeded from ``rng`` (:func:`state_from`)."""
+    s = np.zeros(_STATE_WORDS, dtype=np.uint64)
+    s[:4] = state_from(rng)
     return s
 
 

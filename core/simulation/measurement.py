@@ -83,6 +83,7 @@ from core.simulation.fast import (
     range_responses,
 )
 from core.simulation.frame import FrameOutput, needs_elevation
+from core.simulation.gaussian import state_from
 from core.simulation.link import receiver_voltage_scale
 from core.simulation.scatterers import Scatterers
 
@@ -402,12 +403,7 @@ def frame_seed(rng: np.random.Generator | None) -> np.ndarray:
     ``(4,)`` uint64 (xoshiro256**; never all zero). ``None`` (noise-free frames) gives a fixed
     state. The per-frame and the batch entry points seed each frame this way, so they agree.
     """
-    if rng is None:
-        return np.array([1, 2, 3, 4], dtype=np.uint64)
-    s = rng.bit_generator.random_raw(4)
-    if not s.any():
-        s[0] = 1
-    return s
+    return state_from(rng)
 
 
 def simulate_frames_measurement(

@@ -28,12 +28,13 @@ import numba
 import numpy as np
 
 from core.simulation import gaussian
-from core.simulation.gaussian import (
+from core.simulation.gaussian import (  # noqa: F401  (state_from: re-exported for fast)
     FI,
     KI,
     WI,
     _slow_draw,
     next_u32,
+    state_from,
     xoshiro_step,
     ziggurat_tables,
 )
@@ -54,19 +55,6 @@ def _ziggurat_tables() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 
 
 _KN, _WN, _FN = _ziggurat_tables()
-
-
-def state_from(rng: np.random.Generator | None) -> np.ndarray:
-    """A 256-bit xoshiro256++ state ``(4,)`` uint64 from four raw draws of ``rng``.
-
-    Never all zero. ``None`` gives a fixed state (noise-free frames).
-    """
-    if rng is None:
-        return np.array([1, 2, 3, 4], dtype=np.uint64)
-    s = rng.bit_generator.random_raw(4)
-    if not s.any():
-        s[0] = 1
-    return s
 
 
 # The hot loops keep the 256-bit state in four local variables (registers) and pass it through
