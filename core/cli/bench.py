@@ -57,7 +57,8 @@ def run(args: argparse.Namespace) -> int:
             "machine": {"python": platform.python_version(), "cpu": platform.processor()},
             **result,
         }
-        path = out_dir / f"{name}.json"
+        # a quick run never overwrites the full run's figures
+        path = out_dir / f"{name}{'-quick' if args.quick else ''}.json"
         tmp = path.with_suffix(".json.tmp")
         tmp.write_text(json.dumps(result, indent=2) + "\n")
         tmp.replace(path)

@@ -79,3 +79,53 @@ def test_regular_loss_leaves_out_runs_without_a_confirmed_track() -> None:
     assert q == pytest.approx(2 / 840) and lo < q < hi
     # Clopper-Pearson: zero events in n runs -> upper bound 1 - 0.025^(1/n) ~ 3.69 / n
     assert rate_interval(0, 1000)[2] == pytest.approx(1 - 0.025 ** (1 / 1000), rel=1e-9)
+
+
+def test_split_tail_separates_rare_large_runs_by_the_exact_median() -> None:
+    from core.benchmarks.fidelity import exact_median_loss, split_tail
+
+    # 3 seeds x 3 trajectories; trajectory 2 never confirmed in seed 0
+    ex = np.array([[1.0, 2.0, 9.0], [2.0, 4.0, 5.0], [3.0, 6.0, 7.0]])
+    ex_seen = np.array([[True, True, False], [True, True, True], [True, True, True]])
+    med = exact_median_loss(ex, ex_seen)
+    np.testing.assert_allclose(med, [2.0, 4.0, 6.0])  # the unconfirmed 9.0 is left out
+    level = np.array([[2.0, 41.0, 6.0], [20.0, 3.0, 61.0], [20.1, 5.0, 7.0]])
+    seen = np.ones((3, 3), dtype=bool)
+    bulk, tail = split_tail(level, seen, med, factor=10.0)
+    # tail: strictly above 10x the median (41 > 40, 61 > 60, 20.1 > 20; 20.0 is not)
+    assert tail.tolist() == [[False, True, False], [False, False, True], [True, False, False]]
+    np.testing.assert_allclose(bulk, [11.0, 4.0, 6.5])
+    # a trajectory whose every run is a tail event has no bulk
+    bulk, tail = split_tail(np.full((2, 1), 100.0), np.ones((2, 1), bool), np.array([1.0]))
+    assert np.isnan(bulk[0]) and tail.all()
+    # no exact run with a track: no median, nothing is a tail event, the bulk is the mean
+    med = exact_median_loss(np.ones((2, 1)), np.zeros((2, 1), bool))
+    assert np.isnan(med[0])
+    bulk, tail = split_tail(np.array([[1.0], [3.0]]), np.ones((2, 1), bool), med)
+    assert not tail.any() and bulk[0] == pytest.approx(2.0)
+
+
+def test_rate_ratio_interval_is_exact_and_covers_equal_rates() -> None:
+    from core.benchmarks.fidelity import rate_ratio_interval
+
+    ratio, lo, hi = rate_ratio_interval(20, 1000, 10, 1000)
+    assert ratio == pytest.approx(2.0) and lo < 2.0 < hi
+    # conditional binomial: 20 of 30 events, pi's Clopper-Pearson interval mapped to the ratio
+    from scipy.stats import beta
+
+    pi_lo, pi_hi = beta.ppf(0.025, 20, 11), beta.ppf(0.975, 21, 10)
+    assert lo == pytest.approx(pi_lo / (1 - pi_lo)) and hi == pytest.approx(pi_hi / (1 - pi_hi))
+    # unequal run counts scale the ratio: same rate 1 % on 840 and 1680 runs
+    ratio, lo, hi = rate_ratio_interval(17, 1680, 8, 840)
+    assert ratio == pytest.approx((17 / 1680) / (8 / 840)) and lo < 1.0 < hi
+    assert rate_ratio_interval(0, 10, 0, 10)[1:] == (0.0, float("inf"))
+    # coverage: two samples of one Poisson rate, the interval holds 1 in most repetitions
+    rng = np.random.default_rng(5)
+    hits = sum(
+        lo <= 1.0 <= hi
+        for lo, hi in (
+            rate_ratio_interval(int(rng.poisson(15)), 1680, int(rng.poisson(7.5)), 840)[1:]
+            for _ in range(200)
+        )
+    )
+    assert hits >= 185
