@@ -445,6 +445,116 @@ class _Reflectors:
         source = np.concatenate(src).astype(np.int32)
         return _scatterers(sim, position, velocity, rcs_all, source), n_clutter
 
+    def frames(self, n_frames: int | None = None) -> tuple[list[Any], np.ndarray]:
+        """The scatterers of frames ``0 .. n_frames - 1`` and their clutter counts, at once.
+
+        Bit for bit ``[self.frame(f) for f in range(n_frames)]`` (tested): every frame draws
+        from its own streams in the same order; what follows the draws (persons' RCS, clutter
+        velocities and RCS, assembly, validation) runs once over all frames instead of once per
+        frame, about a third of :meth:`frame`'s cost. The frames are views into shared arrays.
+        """
+        from core import simulation as sim
+
+        scene = self.scene
+        k = self._consts
+        n_f = len(self.truth_t_s) if n_frames is None else int(n_frames)
+        n_p = scene.n_persons
+        if n_f == 0:
+            return [], np.zeros(0, dtype=np.int64)
+        rcs = np.broadcast_to(self.fixed_rcs, (n_f, n_p))
+        if self.run_rcs:
+            # σ_dBsm ~ N(−8, 16), eq. (5), drawn afresh every frame
+            drawn = np.empty((n_f, n_p))
+            for f in range(n_f):
+                drawn[f] = stage_rng(self.seed, "person_rcs", f).normal(
+                    PERSON_RCS_MEAN_DBSM, PERSON_RCS_STD_DB, n_p
+                )
+            rcs = np.where(k.drawn_rcs[None, :], drawn, self.fixed_rcs[None, :])
+        xy, v = self.truth_xy_m[:n_f], self.truth_v_mps[:n_f]
+        active = ~np.isnan(xy[:, :, 0])  # (F, n_p)
+        point = active & ~self.extended[None, :]
+        n_point = point.sum(axis=1)
+        # extended persons: the body model per frame and person (frame order, person order)
+        body_pos, body_vel, body_rcs, body_src = [], [], [], []
+        n_body = np.zeros(n_f, dtype=np.int64)
+        if self.extended.any():
+            for f in range(n_f):
+                for i in np.flatnonzero(active[f] & self.extended):
+                    bp, bv, frac = body_scatterers(
+                        xy[f, i], v[f, i], self.headings[i][f], self.truth_t_s[f]
+                    )
+                    body_pos.append(bp)
+                    body_vel.append(bv)
+                    # σ_part = σ · share (linear power)
+                    body_rcs.append(rcs[f, i] + 10 * np.log10(frac))
+                    body_src.append(np.full(len(bp), i, dtype=np.int32))
+                    n_body[f] += len(bp)
+        n_clutter = np.zeros(n_f, dtype=np.int64)
+        c_pos, c_vr, c_snr = [], [], []
+        if self.run_clutter:
+            for f in range(n_f):
+                c = draw_clutter(
+                    scene.aoi,
+                    scene.clutter_density_per_m2,
+                    scene.radar,
+                    stage_rng(self.seed, "clutter", f),
+                )
+                n_clutter[f] = len(c)
+                c_pos.append(c.position_m)
+                c_vr.append(c.radial_velocity_mps)
+                c_snr.append(c.snr_db)
+        n_static = len(k.static_rcs)
+        per_frame = n_point + n_body + n_clutter + n_static
+        start = np.zeros(n_f + 1, dtype=np.int64)
+        np.cumsum(per_frame, out=start[1:])
+        n = int(start[-1])
+        position = np.zeros((n, 3))
+        velocity = np.zeros((n, 3))
+        rcs_all = np.empty(n)
+        source = np.empty(n, dtype=np.int32)
+        # persons as points: frame f's j-th active point person at start[f] + j
+        ff, ii = np.nonzero(point)
+        at = start[ff] + (np.cumsum(point, axis=1) - 1)[ff, ii]
+        position[at, :2] = xy[ff, ii]
+        velocity[at, :2] = v[ff, ii]
+        rcs_all[at] = rcs[ff, ii]
+        source[at] = ii
+        # then the body parts, the clutter and the static reflectors of each frame
+        frame_of = np.repeat(np.arange(n_f), per_frame)
+        slot = np.arange(n) - start[frame_of]  # position within the frame
+        first = n_point[frame_of]
+        if body_pos:
+            at = np.flatnonzero((slot >= first) & (slot < first + n_body[frame_of]))
+            position[at, :2] = np.concatenate(body_pos)
+            velocity[at, :2] = np.concatenate(body_vel)
+            rcs_all[at] = np.concatenate(body_rcs)
+            source[at] = np.concatenate(body_src)
+        first = first + n_body[frame_of]
+        if n_clutter.any():
+            at = np.flatnonzero((slot >= first) & (slot < first + n_clutter[frame_of]))
+            pos = np.concatenate(c_pos)
+            vr = np.concatenate(c_vr)
+            # v = vr p / |p|  (ClutterDraw.velocity_mps)
+            r = np.hypot(pos[:, 0], pos[:, 1])
+            position[at, :2] = pos
+            velocity[at, :2] = pos / r[:, None] * vr[:, None]
+            rcs_all[at] = self._clutter_rcs_dbsm(pos, np.concatenate(c_snr))
+            source[at] = -1
+        if n_static:
+            at = np.flatnonzero(slot >= first + n_clutter[frame_of])
+            j = slot[at] - (first + n_clutter[frame_of])[at]
+            position[at] = k.static_position[j]
+            rcs_all[at] = k.static_rcs[j]
+            source[at] = k.static_source[j]
+        if not _arrays_ok(position, velocity, rcs_all):
+            # an invalid reflector: the per-frame path raises the validating message
+            return [self.frame(f)[0] for f in range(n_f)], n_clutter
+        out = []
+        for f in range(n_f):
+            s = slice(start[f], start[f + 1])
+            out.append(_checked_scatterers(sim, position[s], velocity[s], rcs_all[s], source[s]))
+        return out, n_clutter
+
     @staticmethod
     def _constants(scene: Scene, fixed_rcs, run_static: bool, settings) -> _FrameConstants:
         """What does not change from frame to frame."""
@@ -494,19 +604,28 @@ class _FrameConstants:
     static_source: np.ndarray  # (S,) int32, -1
 
 
-def _scatterers(sim, position, velocity, rcs_dbsm, source):
-    """``Scatterers`` of arrays checked here in one pass (finite, off the radar); arrays that
-    fail go through the validating constructor, which names the field."""
-    ok = (
+def _arrays_ok(position, velocity, rcs_dbsm) -> bool:
+    """What the ``Scatterers`` constructor checks, in one pass: finite, off the radar."""
+    return bool(
         np.isfinite(position).all()
         and np.isfinite(velocity).all()
         and np.isfinite(rcs_dbsm).all()
         and (len(position) == 0 or np.einsum("ij,ij->i", position, position).min() > 0)
     )
-    if not ok:
+
+
+def _scatterers(sim, position, velocity, rcs_dbsm, source):
+    """``Scatterers`` of arrays checked here in one pass (finite, off the radar); arrays that
+    fail go through the validating constructor, which names the field."""
+    if not _arrays_ok(position, velocity, rcs_dbsm):
         return sim.Scatterers(
             position_m=position, velocity_mps=velocity, rcs_dbsm=rcs_dbsm, source=source
         )
+    return _checked_scatterers(sim, position, velocity, rcs_dbsm, source)
+
+
+def _checked_scatterers(sim, position, velocity, rcs_dbsm, source):
+    """``Scatterers`` of arrays already checked (:func:`_arrays_ok`), without the constructor."""
     s = object.__new__(sim.Scatterers)
     for name, value in (
         ("position_m", position),
@@ -654,11 +773,9 @@ def _simulate_scene_batch(
     settings = processing_settings(scene)
     antenna = sim.AntennaGain.draw(radar, stage_rng(seed, "antenna"))
     reflectors = _Reflectors.build(scene, p, seed, antenna, settings)
-    frames, n_clutter = zip(*(reflectors.frame(f) for f in range(scene.n_frames)))
+    frames, n_clutter = reflectors.frames()
     rngs = [stage_rng(seed, "noise", f) for f in range(scene.n_frames)]
-    out = simulate(
-        radar, list(frames), rngs, antenna=antenna, settings=settings, elevation=p.elevation
-    )
+    out = simulate(radar, frames, rngs, antenna=antenna, settings=settings, elevation=p.elevation)
     if progress is not None:
         progress(scene.n_frames, scene.n_frames)
     return SceneRun(
@@ -669,7 +786,7 @@ def _simulate_scene_batch(
         truth_t_s=reflectors.truth_t_s,
         truth_xy_m=reflectors.truth_xy_m,
         truth_v_mps=reflectors.truth_v_mps,
-        n_clutter=np.array(n_clutter, dtype=np.int64),
+        n_clutter=n_clutter,
         rd_maps_db=None,
         elapsed_s=time.perf_counter() - t0,
     )

@@ -98,3 +98,54 @@ def test_invalid_reflectors_still_get_the_validating_message() -> None:
     refl.frame(2)  # the original is fine
     with pytest.raises(InputError, match="range 0"):
         bad.frame(2)
+
+
+@pytest.mark.parametrize(
+    "name, extended, density",
+    [
+        ("waypoints_static", True, 0.5),  # body model, clutter, static reflectors
+        ("two_persons", False, None),  # two point persons entering and leaving
+        ("paper", False, None),  # a paper trajectory: point person, clutter, drawn RCS
+    ],
+)
+def test_all_frames_at_once_equal_frame_by_frame(name, extended, density) -> None:
+    from core.scene import paper_scenes
+
+    if name == "paper":
+        scene = paper_scenes(0, 4)[3]
+    else:
+        d = Scene.from_json(ROOT / f"resources/scenes/{name}.json").to_dict(resolve_radar=True)
+        if extended:
+            d["persons"][0]["model"] = "extended"
+        if density is not None:
+            d["clutter_density_per_m2"] = density
+        scene = Scene.from_dict(d)
+    refl = _reflectors(scene, seed=3)
+    frames, n_clutter = refl.frames()
+    assert len(frames) == scene.n_frames == len(n_clutter)
+    assert refl.run_clutter == bool(n_clutter.any())
+    kinds = set()
+    for f, s in enumerate(frames):
+        one, nc = refl.frame(f)
+        assert nc == n_clutter[f]
+        for field in ("position_m", "velocity_mps", "rcs_dbsm", "source"):
+            a, b = getattr(s, field), getattr(one, field)
+            assert a.dtype == b.dtype and a.shape == b.shape, (f, field)
+            assert a.tobytes() == b.tobytes(), (f, field)
+        kinds.update(one.source.tolist())
+    assert 0 in kinds and (-1 in kinds) == (refl.run_clutter or refl.run_static)
+    if name == "two_persons":
+        assert 1 in kinds
+    # a prefix is the same frames
+    head, nc = refl.frames(5)
+    assert len(head) == 5 and nc.tolist() == n_clutter[:5].tolist()
+    assert all(a.position_m.tobytes() == b.position_m.tobytes() for a, b in zip(head, frames))
+
+
+def test_all_frames_at_once_keep_the_validating_message() -> None:
+    scene = Scene.from_json(ROOT / "resources/scenes/two_persons.json")
+    refl = _reflectors(scene)
+    bad = dataclasses.replace(refl, truth_xy_m=refl.truth_xy_m.copy())
+    bad.truth_xy_m[2, 0] = 0.0  # a person at the radar
+    with pytest.raises(InputError, match="range 0"):
+        bad.frames()
