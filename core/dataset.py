@@ -125,8 +125,43 @@ class Dataset:
         seed: int = 0,
     ) -> Dataset:
         """Assemble from one point cloud per global frame."""
-        merged = PointCloud.concatenate(clouds)
-        frame = np.repeat(np.arange(len(clouds)), [len(c) for c in clouds]).astype(np.int32)
+        return cls.from_cloud(
+            cloud=PointCloud.concatenate(clouds),
+            counts=np.array([len(c) for c in clouds], dtype=np.int64),
+            trajectory=trajectory,
+            truth_t_s=truth_t_s,
+            truth_xy_m=truth_xy_m,
+            truth_v_mps=truth_v_mps,
+            trajectory_class=trajectory_class,
+            scene_json=scene_json,
+            radar_json=radar_json,
+            fidelity=fidelity,
+            seed=seed,
+        )
+
+    @classmethod
+    def from_cloud(
+        cls,
+        *,
+        cloud: PointCloud,
+        counts: np.ndarray,
+        trajectory: np.ndarray,
+        truth_t_s: np.ndarray,
+        truth_xy_m: np.ndarray,
+        truth_v_mps: np.ndarray,
+        trajectory_class: list[str],
+        scene_json: str,
+        radar_json: str,
+        fidelity: str = "exact",
+        seed: int = 0,
+    ) -> Dataset:
+        """Assemble from the points of every global frame in frame order, ``counts[f]`` of frame
+        ``f`` (what :meth:`from_frames` makes of one cloud per frame, without the split)."""
+        merged = cloud
+        counts = np.asarray(counts, dtype=np.int64)
+        if counts.sum() != len(merged):
+            raise InputError(f"counts: {counts.sum()} points counted, {len(merged)} given")
+        frame = np.repeat(np.arange(len(counts)), counts).astype(np.int32)
         return cls(
             frame=frame,
             **{f: getattr(merged, f).astype(np.float64) for f in POINT_FIELDS},

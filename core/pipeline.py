@@ -869,15 +869,6 @@ def _simulate_task(args: tuple[str, int, str]) -> dict[str, Any]:
     }
 
 
-def _split(cloud: PointCloud, counts: np.ndarray) -> list[PointCloud]:
-    edges = np.concatenate(([0], np.cumsum(counts)))
-    names = ("range_m", "azimuth_rad", "elevation_rad", "radial_velocity_mps", "snr_db")
-    return [
-        PointCloud(**{k: getattr(cloud, k)[a:b] for k in (*names, "x_m", "y_m", "z_m", "source")})
-        for a, b in zip(edges[:-1], edges[1:])
-    ]
-
-
 def build_dataset(
     scenes: Sequence[Scene],
     *,
@@ -969,9 +960,8 @@ def _assemble(
     scenes: Sequence[Scene], results: list[dict[str, Any]], *, fidelity: str, seed: int
 ) -> Dataset:
     n_persons = max(max(s.n_persons for s in scenes), 1)
-    clouds, traj, t, xy, v = [], [], [], [], []
+    traj, t, xy, v = [], [], [], []
     for k, r in enumerate(results):
-        clouds += _split(r["cloud"], r["counts"])
         f = len(r["counts"])
         traj.append(np.full(f, k, dtype=np.int32))
         t.append(r["truth_t_s"])
@@ -986,8 +976,9 @@ def _assemble(
         if len(scenes) == 1
         else json.dumps([s.to_dict() for s in scenes], indent=1)
     )
-    return Dataset.from_frames(
-        clouds=clouds,
+    return Dataset.from_cloud(
+        cloud=PointCloud.concatenate([r["cloud"] for r in results]),
+        counts=np.concatenate([r["counts"] for r in results]),
         trajectory=np.concatenate(traj),
         truth_t_s=np.concatenate(t),
         truth_xy_m=np.concatenate(xy),

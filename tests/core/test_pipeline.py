@@ -228,6 +228,51 @@ def test_dataset_same_seed_identical_other_seed_different(tmp_path: Path) -> Non
     assert len(a.frame) != len(c.frame) or not np.array_equal(a.range_m, c.range_m)
 
 
+def test_dataset_is_the_scenes_runs_frame_by_frame() -> None:
+    """build_dataset assembles the concatenated points directly; the same data set as
+    Dataset.from_frames of every scene's per-frame clouds (the straightforward assembly)."""
+    scenes = small_scenes()[:2]
+    for fidelity in ("exact", "fast"):
+        ds = build_dataset(scenes, seed=4, fidelity=fidelity, jobs=1, use_cache=False)
+        seeds = pipeline.trajectory_seeds(4, len(scenes))
+        runs = [simulate_scene(s, fidelity=fidelity, seed=sd) for s, sd in zip(scenes, seeds)]
+        want = Dataset.from_frames(
+            clouds=[c for r in runs for c in r.clouds],
+            trajectory=np.concatenate([np.full(len(r.clouds), k) for k, r in enumerate(runs)]),
+            truth_t_s=np.concatenate([r.truth_t_s for r in runs]),
+            truth_xy_m=np.concatenate([r.truth_xy_m for r in runs]),
+            truth_v_mps=np.concatenate([r.truth_v_mps for r in runs]),
+            trajectory_class=[s.trajectory_class for s in scenes],
+            scene_json=ds.scene_json,
+            radar_json=ds.radar_json,
+            fidelity=fidelity,
+            seed=4,
+        )
+        assert len(ds.frame) > 0
+        for f in ("frame", *POINT_FIELDS, "source", "trajectory", "truth_t_s", "truth_xy_m"):
+            a, b = getattr(ds, f), getattr(want, f)
+            assert a.dtype == b.dtype and a.tobytes() == b.tobytes(), (fidelity, f)
+    with pytest.raises(InputError, match="counts: 3 points counted, 2 given"):
+        Dataset.from_cloud(
+            cloud=_two_points(),
+            counts=np.array([1, 2]),
+            trajectory=np.zeros(2, np.int32),
+            truth_t_s=np.zeros(2),
+            truth_xy_m=np.zeros((2, 1, 2)),
+            truth_v_mps=np.zeros((2, 1, 2)),
+            trajectory_class=["a"],
+            scene_json="{}",
+            radar_json="{}",
+        )
+
+
+def _two_points():
+    from core.pointcloud import PointCloud
+
+    z = np.zeros(2)
+    return PointCloud(**{f: z for f in POINT_FIELDS}, source=np.zeros(2, dtype=np.int32))
+
+
 def test_dataset_is_cached_by_hash_and_saved_atomically(tmp_path: Path, monkeypatch) -> None:
     scenes = small_scenes()[:1]
     monkeypatch.setenv("RADARTUNE_CACHE", str(tmp_path))
