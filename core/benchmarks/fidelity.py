@@ -503,6 +503,17 @@ def run(quick: bool = False, params_cv=None, params_ca=None) -> dict:
                     ok = np.isfinite(mine) & np.isfinite(rest_reg)
                     yard.append(float(mine[ok].sum() / rest_reg[ok].sum()))
                 trk[model]["exact_seed_regular_ratio_to_others"] = yard
+                # the bulk's yardstick: exact's second half of seeds against its first half,
+                # each half with its own median threshold (as a level against exact)
+                h = len(tot) // 2
+                if h:
+                    med_a = exact_median_loss(loss[:h], seen[:h])
+                    bulk_a, _ = split_tail(loss[:h], seen[:h], med_a)
+                    bulk_b, _ = split_tail(loss[h : 2 * h], seen[h : 2 * h], med_a)
+                    ok = np.isfinite(bulk_a) & np.isfinite(bulk_b)
+                    trk[model]["exact_half_bulk_ratio"] = list(
+                        loss_ratio_interval(bulk_b[ok], bulk_a[ok])
+                    )
 
         def dist(x: np.ndarray) -> dict:
             if not len(x):
@@ -661,6 +672,13 @@ def _loss_table(result: dict) -> str:
                 + ", ".join(f"{x:.2f}" for x in v)
                 + "; regular loss "
                 + ", ".join(f"{x:.2f}" for x in w)
+            )
+    for model in ("cv", "ca"):
+        half = ex[model].get("exact_half_bulk_ratio")
+        if half:
+            yard.append(
+                f"{model.upper()} bulk, `exact`'s second half of seeds against its first half: "
+                f"{half[0]:.3f} ({half[1]:.3f}–{half[2]:.3f})"
             )
     return "\n".join(rows) + ("\n\nYardstick — " + "; ".join(yard) if yard else "")
 
