@@ -272,20 +272,53 @@ def _layout(
         grouping={},
     )
     if settings.peak_grouping:
-        # rho_r(k), k = -2 .. 2 (neighbours' range lags)
-        rho1 = (
-            np.array([0.0, 0.0, 1.0, 0.0, 0.0])
-            if independent
-            else _range_rho(settings.range_window, radar.n_samples, 2)
+        combos = frozenset((c[2], c[3]) for c in classes)
+        lay.grouping.update(
+            _grouping_table(
+                settings.range_window,
+                settings.doppler_window,
+                radar.n_samples,
+                n_d,
+                bool(settings.static_clutter_removal),
+                L,
+                independent,
+                combos,
+            )
         )
-        memo: dict = {}
-        for up, down in {(c[2], c[3]) for c in classes}:
-            for d in range(n_d):
-                if v[d] > 0 and p[d] > 0:
-                    lay.grouping[(d, up, down)] = _grouping_factor(
-                        x, L, d, p, corr_d, rho1, up, down, independent, memo
-                    )
     return lay
+
+
+@functools.lru_cache(maxsize=16)
+def _grouping_table(
+    range_window: str,
+    doppler_window: str,
+    n_samples: int,
+    n_d: int,
+    clutter_removal: bool,
+    L: int,
+    independent: bool,
+    combos: frozenset,
+) -> dict:
+    """``G(x)`` per ``(d, up, down)``: depends on the windows, not on the CFAR (cached)."""
+    p, corr_d = _doppler_covariance(doppler_window, n_d, clutter_removal)
+    if independent:
+        corr_d = np.eye(n_d)
+    # rho_r(k), k = -2 .. 2 (neighbours' range lags)
+    rho1 = (
+        np.array([0.0, 0.0, 1.0, 0.0, 0.0])
+        if independent
+        else _range_rho(range_window, n_samples, 2)
+    )
+    x = _x_grid(L)[0]
+    memo: dict = {}
+    out = {}
+    for up, down in combos:
+        for d in range(n_d):
+            if p[d] > 0:
+                out[(d, up, down)] = _grouping_factor(
+                    x, L, d, p, corr_d, rho1, up, down, independent, memo
+                )
+    return out
 
 
 def _key(a: np.ndarray) -> bytes:
@@ -303,12 +336,26 @@ def _residual_draws(L: int, n_nb: int) -> tuple[np.ndarray, np.ndarray]:
     z_la conj(z_lb)`` (the other channels enter only through it).
     """
     g = np.random.default_rng(GROUPING_SEED)
-    shape = (GROUPING_SAMPLES, L, n_nb)
-    z = (g.standard_normal(shape) + 1j * g.standard_normal(shape)) / np.sqrt(2.0)
-    rest = z[:, 1:, :]
-    w = np.matmul(rest.transpose(0, 2, 1), rest.conj()).reshape(GROUPING_SAMPLES, -1)
+    m = GROUPING_SAMPLES
+    z1 = (g.standard_normal((m, n_nb)) + 1j * g.standard_normal((m, n_nb))) / np.sqrt(2.0)
+    if L - 1 >= n_nb:
+        # W ~ complex Wishart(L - 1, I), Bartlett: W = T T^H, T lower triangular with
+        # |T_ii|^2 ~ Gamma(L - 1 - i) and T_ij ~ CN(0, 1) below the diagonal
+        t = np.zeros((m, n_nb, n_nb), dtype=complex)
+        below = np.tril_indices(n_nb, -1)
+        n_b = below[0].size
+        t[:, below[0], below[1]] = (
+            g.standard_normal((m, n_b)) + 1j * g.standard_normal((m, n_b))
+        ) / np.sqrt(2.0)
+        diag = np.arange(n_nb)
+        t[:, diag, diag] = np.sqrt(g.standard_gamma(L - 1 - diag, size=(m, n_nb)))
+        w = np.matmul(t, t.conj().transpose(0, 2, 1)).reshape(m, -1)
+    else:
+        rest = (
+            g.standard_normal((m, L - 1, n_nb)) + 1j * g.standard_normal((m, L - 1, n_nb))
+        ) / np.sqrt(2.0)
+        w = np.matmul(rest.transpose(0, 2, 1), rest.conj()).reshape(m, -1)
     w2 = np.ascontiguousarray(np.concatenate((w.real, w.imag), axis=1))
-    z1 = np.ascontiguousarray(z[:, 0, :])
     z1.flags.writeable = False
     w2.flags.writeable = False
     return z1, w2

@@ -62,6 +62,7 @@ import numba
 import numpy as np
 import scipy.fft
 from scipy.optimize import brentq
+from scipy.special import betainccinv
 
 from core.config import (
     DEFAULT_PROCESSING,
@@ -80,7 +81,7 @@ from core.processing import (
     refine_bins,
     window,
 )
-from core.processing.cfar import _METHOD_CODE, two_stage_kernel
+from core.processing.cfar import _METHOD_CODE, pfa_caso, threshold_factor, two_stage_kernel
 from core.processing.false_alarms import (
     StageFactors,
     cells_correlated,
@@ -806,16 +807,17 @@ def _cfar_arguments(
         if settings.static_clutter_removal:
             profile = clutter_removal_noise_profile(settings.doppler_window, n_d)
     if independent_cells and cells_correlated(radar, settings):
-        rc, dc = independent_cell_stages(radar, settings, n_channels, n_r)
-        ne_r = ne_d = None
-    rcf, dcf = make_cfar(rc, n_channels, ne_r), make_cfar(dc, n_channels, ne_d)
+        rc, dc, rf, df = _independent_stages(radar, settings, n_channels, n_r)
+    else:
+        rf, df = (
+            _factors(make_cfar(rc, n_channels, ne_r)),
+            _factors(make_cfar(dc, n_channels, ne_d)),
+        )
     return (
         np.ascontiguousarray(profile, dtype=np.float64),
         lo, hi, a, b,
-        rc.n_train, rc.n_guard, rc.cyclic, _METHOD_CODE[rc.method], rcf.alpha(),
-        rcf.alpha_one_side(),
-        dc.n_train, dc.n_guard, dc.cyclic, _METHOD_CODE[dc.method], dcf.alpha(),
-        dcf.alpha_one_side(),
+        rc.n_train, rc.n_guard, rc.cyclic, _METHOD_CODE[rc.method], rf.both, rf.one,
+        dc.n_train, dc.n_guard, dc.cyclic, _METHOD_CODE[dc.method], df.both, df.one,
         settings.peak_grouping,
     )  # fmt: skip
 
@@ -831,7 +833,6 @@ def cfar_range_bins(radar: RadarConfig, settings: ProcessingSettings) -> int:
     return int(min(radar.n_samples, inside[-1] + 1 + margin))
 
 
-@functools.lru_cache(maxsize=16)
 def independent_cell_stages(
     radar: RadarConfig, settings: ProcessingSettings, n_channels: int, n_range_bins: int
 ) -> tuple[CfarSettings, CfarSettings]:
@@ -847,6 +848,14 @@ def independent_cell_stages(
     grouping) gives the same expected detections per noise-only frame for independent cells as
     for the exact chain's cells with its own thresholds. ``n_range_bins``: rows of the map.
     """
+    return _independent_stages(radar, settings, n_channels, n_range_bins)[:2]
+
+
+@functools.lru_cache(maxsize=16)
+def _independent_stages(
+    radar: RadarConfig, settings: ProcessingSettings, n_channels: int, n_range_bins: int
+) -> tuple[CfarSettings, CfarSettings, StageFactors, StageFactors]:
+    """:func:`independent_cell_stages` and their threshold factors (cached)."""
     L = n_channels
     target = noise_detections_per_frame(
         radar, settings, *chain_factors(radar, settings, L), n_channels=L, n_range_bins=n_range_bins
@@ -860,9 +869,12 @@ def independent_cell_stages(
             dataclasses.replace(dc, pfa=min(dc.pfa * k, 0.5)),
         )
 
-    def err(log_kappa: float) -> float:
+    def with_factors(log_kappa: float):
         r, d = stages(log_kappa)
-        fr, fd = (_factors(make_cfar(c, L)) for c in (r, d))
+        return r, d, independent_factors(r, L), independent_factors(d, L)
+
+    def err(log_kappa: float) -> float:
+        fr, fd = with_factors(log_kappa)[2:]
         p = noise_detections_per_frame(
             radar, settings, fr, fd, independent_cells=True, n_channels=L,
             n_range_bins=n_range_bins,
@@ -870,12 +882,49 @@ def independent_cell_stages(
         return float(np.log(p) - np.log(target))
 
     if target <= 0.0:
-        return rc, dc
-    return stages(brentq(err, -6.0, 3.0, xtol=1e-5))
+        return with_factors(0.0)
+    # log rate is smooth and nearly linear in log kappa: secant steps from kappa = 1 (four or
+    # five evaluations to 1e-7 in the rate), bracketing as a fall-back
+    u0, u1 = 0.0, -0.5
+    e0, e1 = err(u0), err(u1)
+    for _ in range(30):
+        if abs(e1) < 1e-7:
+            return with_factors(u1)
+        if e1 == e0:
+            break
+        u0, e0, u1 = u1, e1, float(np.clip(u1 - e1 * (u1 - u0) / (e1 - e0), -6.0, 3.0))
+        e1 = err(u1)
+    return with_factors(brentq(err, -6.0, 3.0, xtol=1e-7))
 
 
 def _factors(c) -> StageFactors:
     return StageFactors(both=c.alpha(), one=c.alpha_one_side())
+
+
+@functools.lru_cache(maxsize=256)
+def independent_factors(c: CfarSettings, n_channels: int) -> StageFactors:
+    """Threshold factors of a stage on independent cells (``make_cfar(c, L)``'s, to 1e-12).
+
+    CASO by a bracketed root search between the one-sided CA factors for ``pfa`` and ``pfa/2``
+    (``Pfa_CA1(T) <= Pfa_SO(T) <= 2 Pfa_CA1(T)``: the smaller side is below either side, and
+    above the noise peak only if one of them is) instead of the library's scan from ``T = e^-8``
+    (one tenth of the evaluations: the threshold search runs a few times per slider move).
+    """
+    L, n, pfa = n_channels, c.n_train, c.pfa
+
+    def t_ca(cells: float, p: float) -> float:
+        # Pfa_CA(T) = 1 - I_{T/(1+T)}(L, N L)  ->  T = b / (1 - b)
+        b = float(betainccinv(L, cells * L, p))
+        return b / (1.0 - b)
+
+    one = n * t_ca(n, pfa)
+    if c.method == "ca":
+        return StageFactors(both=2 * n * t_ca(2 * n, pfa), one=one)
+    if c.method == "cago":
+        return StageFactors(both=threshold_factor("cago", n, pfa, L), one=one)
+    lo, hi = np.log(t_ca(n, pfa)), np.log(t_ca(n, pfa / 2))
+    log_t = brentq(lambda u: np.log(pfa_caso(np.exp(u), n, L)) - np.log(pfa), lo, hi, xtol=1e-13)
+    return StageFactors(both=n * float(np.exp(log_t)), one=one)
 
 
 def chain_factors(
