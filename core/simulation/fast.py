@@ -44,10 +44,20 @@ frames for the same per-frame generators. The draws come from a compiled generat
 generator; the noise map's Gamma(12) is NumPy's float32 algorithm on those words
 (``docs/decisions/fidelity-07``).
 
-Known approximations (measured in ``docs/fidelity.md``): neighbouring cells of the exact chain's
-noise are correlated through the windows (range |rho|^2 = 0.44 for Hann), here they are
-independent; the beat tone's drift over the frame (<= 0.2 range bins at 1.8 m/s) is reduced to
-its phase term.
+CFAR thresholds. Neighbouring cells of the exact chain's noise are correlated through the
+windows (|rho|^2 = 4/9 for Hann), here they are independent. The exact chain's thresholds on
+independent cells would give other noise false alarms, both through the two stages (which share
+the cell under test) and through peak grouping (a noise peak among correlated neighbours is
+less often a local maximum: 12 % of the exact chain's noise detections go, 3 % of independent
+cells'). :func:`independent_cell_stages` scales both stages' ``pfa`` by one factor so that the
+expected noise detections per frame after both stages and peak grouping
+(:func:`core.processing.false_alarms.noise_detections_per_frame`) are the exact chain's
+(``docs/decisions/fidelity-08``). ``rect`` windows leave independent cells: the thresholds are
+then the chain's own.
+
+Known approximations (measured in ``docs/fidelity.md``): the noise cells' correlation is
+modelled only through the thresholds (above); the beat tone's drift over the frame (<= 0.2
+range bins at 1.8 m/s) is reduced to its phase term.
 """
 
 from __future__ import annotations
@@ -767,8 +777,8 @@ def two_stage_cfar_compiled(
     Parameters and returns as there (``rd_map`` ``[range bin, Doppler bin]``, Doppler zero
     velocity centred). ``independent_cells=True`` sets the thresholds for independent cells
     (what the ``fast`` level's noise map has) instead of the window-correlated cells of the
-    exact chain, with the exact chain's two-stage false-alarm rate
-    (:func:`independent_cell_stages`).
+    exact chain, with the exact chain's noise false alarms per frame after both stages and
+    peak grouping (:func:`independent_cell_stages`).
     """
     rd = np.ascontiguousarray(rd_map)
     L = radar.n_virtual if n_channels is None else n_channels
