@@ -88,7 +88,8 @@ def run(quick: bool = False, n_frames: int | None = None) -> dict:
                 exact_counts[name].append(len(two_stage_cfar(rd, radar, settings[name])))
             t_exact += time.perf_counter() - t0
     for name, s in settings.items():
-        fast_level.independent_cell_stages.cache_clear()
+        fast_level._independent_stages.cache_clear()
+        fast_level.independent_factors.cache_clear()
         fast_level._cfar_arguments.cache_clear()
         for cached in (
             "_layout",
