@@ -44,10 +44,20 @@ frames for the same per-frame generators. The draws come from a compiled generat
 generator; the noise map's Gamma(12) is NumPy's float32 algorithm on those words
 (``docs/decisions/fidelity-07``).
 
-Known approximations (measured in ``docs/fidelity.md``): neighbouring cells of the exact chain's
-noise are correlated through the windows (range |rho|^2 = 0.44 for Hann), here they are
-independent; the beat tone's drift over the frame (<= 0.2 range bins at 1.8 m/s) is reduced to
-its phase term.
+CFAR thresholds. Neighbouring cells of the exact chain's noise are correlated through the
+windows (|rho|^2 = 4/9 for Hann), here they are independent. The exact chain's thresholds on
+independent cells would give other noise false alarms, both through the two stages (which share
+the cell under test) and through peak grouping (a noise peak among correlated neighbours is
+less often a local maximum: 12 % of the exact chain's noise detections go, 3 % of independent
+cells'). :func:`independent_cell_stages` scales both stages' ``pfa`` by one factor so that the
+expected noise detections per frame after both stages and peak grouping
+(:func:`core.processing.false_alarms.noise_detections_per_frame`) are the exact chain's
+(``docs/decisions/fidelity-08``). ``rect`` windows leave independent cells: the thresholds are
+then the chain's own.
+
+Known approximations (measured in ``docs/fidelity.md``): the noise cells' correlation is
+modelled only through the thresholds (above); the beat tone's drift over the frame (<= 0.2
+range bins at 1.8 m/s) is reduced to its phase term.
 """
 
 from __future__ import annotations
@@ -62,6 +72,7 @@ import numba
 import numpy as np
 import scipy.fft
 from scipy.optimize import brentq
+from scipy.special import betainccinv
 
 from core.config import (
     DEFAULT_PROCESSING,
@@ -80,7 +91,12 @@ from core.processing import (
     refine_bins,
     window,
 )
-from core.processing.cfar import _METHOD_CODE, two_stage_kernel, two_stage_pfa
+from core.processing.cfar import _METHOD_CODE, pfa_caso, threshold_factor, two_stage_kernel
+from core.processing.false_alarms import (
+    StageFactors,
+    cells_correlated,
+    noise_detections_per_frame,
+)
 from core.processing.points import (  # noqa: F401  (angles_of: re-exported for measurement)
     _points_kernel,
     angle_twiddles,
@@ -761,8 +777,8 @@ def two_stage_cfar_compiled(
     Parameters and returns as there (``rd_map`` ``[range bin, Doppler bin]``, Doppler zero
     velocity centred). ``independent_cells=True`` sets the thresholds for independent cells
     (what the ``fast`` level's noise map has) instead of the window-correlated cells of the
-    exact chain, with the exact chain's two-stage false-alarm rate
-    (:func:`independent_cell_stages`).
+    exact chain, with the exact chain's noise false alarms per frame after both stages and
+    peak grouping (:func:`independent_cell_stages`).
     """
     rd = np.ascontiguousarray(rd_map)
     L = radar.n_virtual if n_channels is None else n_channels
@@ -800,17 +816,18 @@ def _cfar_arguments(
         ne_d = effective_cells_or_none(settings.doppler_window, n_d, dc.n_train)
         if settings.static_clutter_removal:
             profile = clutter_removal_noise_profile(settings.doppler_window, n_d)
-    if independent_cells and (ne_r is not None or ne_d is not None):
-        rc, dc = independent_cell_stages(settings, n_channels, radar.n_samples, n_d)
-        ne_r = ne_d = None
-    rcf, dcf = make_cfar(rc, n_channels, ne_r), make_cfar(dc, n_channels, ne_d)
+    if independent_cells and cells_correlated(radar, settings):
+        rc, dc, rf, df = _independent_stages(radar, settings, n_channels, n_r)
+    else:
+        rf, df = (
+            _factors(make_cfar(rc, n_channels, ne_r)),
+            _factors(make_cfar(dc, n_channels, ne_d)),
+        )
     return (
         np.ascontiguousarray(profile, dtype=np.float64),
         lo, hi, a, b,
-        rc.n_train, rc.n_guard, rc.cyclic, _METHOD_CODE[rc.method], rcf.alpha(),
-        rcf.alpha_one_side(),
-        dc.n_train, dc.n_guard, dc.cyclic, _METHOD_CODE[dc.method], dcf.alpha(),
-        dcf.alpha_one_side(),
+        rc.n_train, rc.n_guard, rc.cyclic, _METHOD_CODE[rc.method], rf.both, rf.one,
+        dc.n_train, dc.n_guard, dc.cyclic, _METHOD_CODE[dc.method], df.both, df.one,
         settings.peak_grouping,
     )  # fmt: skip
 
@@ -826,21 +843,32 @@ def cfar_range_bins(radar: RadarConfig, settings: ProcessingSettings) -> int:
     return int(min(radar.n_samples, inside[-1] + 1 + margin))
 
 
-@functools.lru_cache(maxsize=16)
 def independent_cell_stages(
-    settings: ProcessingSettings, n_channels: int, n_range_bins: int, n_doppler_bins: int
+    radar: RadarConfig, settings: ProcessingSettings, n_channels: int, n_range_bins: int
 ) -> tuple[CfarSettings, CfarSettings]:
-    """CFAR stages for independent cells with the exact chain's two-stage false-alarm rate.
+    """CFAR stages for independent cells with the exact chain's noise false alarms per frame.
 
-    The exact chain's cells are window-correlated and its thresholds account for it. With
-    independent cells (the ``fast`` level's noise map) the same per-stage ``pfa`` gives a
-    different two-stage rate (periodic Hann: 6.1e-5 per cell instead of 3.6e-5), because the
-    stages share the cell under test. Both stages' ``pfa`` are scaled by one factor ``kappa``
-    so that :func:`core.processing.cfar.two_stage_pfa` for independent cells equals the exact
-    chain's.
+    The exact chain's cells are window-correlated and its thresholds account for it; the
+    ``fast`` level's noise map has independent cells. With the same per-stage ``pfa`` the two
+    would differ in their two-stage rate (the stages share the cell under test) and in what peak
+    grouping removes (correlated neighbours are rarely all below a noise peak: 12 % of the exact
+    chain's false alarms go, 3 % of independent cells'). Both stages' ``pfa`` are scaled by one
+    factor ``kappa`` so that the model of
+    :func:`core.processing.false_alarms.noise_detections_per_frame` (both stages and peak
+    grouping) gives the same expected detections per noise-only frame for independent cells as
+    for the exact chain's cells with its own thresholds. ``n_range_bins``: rows of the map.
     """
-    target = two_stage_pfa(
-        settings, n_channels, n_range_bins=n_range_bins, n_doppler_bins=n_doppler_bins
+    return _independent_stages(radar, settings, n_channels, n_range_bins)[:2]
+
+
+@functools.lru_cache(maxsize=16)
+def _independent_stages(
+    radar: RadarConfig, settings: ProcessingSettings, n_channels: int, n_range_bins: int
+) -> tuple[CfarSettings, CfarSettings, StageFactors, StageFactors]:
+    """:func:`independent_cell_stages` and their threshold factors (cached)."""
+    L = n_channels
+    target = noise_detections_per_frame(
+        radar, settings, *chain_factors(radar, settings, L), n_channels=L, n_range_bins=n_range_bins
     )
     rc, dc = settings.range_cfar, settings.doppler_cfar
 
@@ -851,15 +879,74 @@ def independent_cell_stages(
             dataclasses.replace(dc, pfa=min(dc.pfa * k, 0.5)),
         )
 
-    def err(log_kappa: float) -> float:
+    def with_factors(log_kappa: float):
         r, d = stages(log_kappa)
-        indep = dataclasses.replace(settings, range_cfar=r, doppler_cfar=d, cfar_noise_model=False)
-        p = two_stage_pfa(
-            indep, n_channels, n_range_bins=n_range_bins, n_doppler_bins=n_doppler_bins
-        )
+        return r, d, independent_factors(r, L), independent_factors(d, L)
+
+    def err(log_kappa: float) -> float:
+        fr, fd = with_factors(log_kappa)[2:]
+        p = noise_detections_per_frame(
+            radar, settings, fr, fd, independent_cells=True, n_channels=L,
+            n_range_bins=n_range_bins,
+        )  # fmt: skip
         return float(np.log(p) - np.log(target))
 
-    return stages(brentq(err, -6.0, 3.0, xtol=1e-6))
+    if target <= 0.0:
+        return with_factors(0.0)
+    # log rate is smooth and nearly linear in log kappa: secant steps from kappa = 1 (four or
+    # five evaluations to 1e-7 in the rate), bracketing as a fall-back
+    u0, u1 = 0.0, -0.5
+    e0, e1 = err(u0), err(u1)
+    for _ in range(30):
+        if abs(e1) < 1e-7:
+            return with_factors(u1)
+        if e1 == e0:
+            break
+        u0, e0, u1 = u1, e1, float(np.clip(u1 - e1 * (u1 - u0) / (e1 - e0), -6.0, 3.0))
+        e1 = err(u1)
+    return with_factors(brentq(err, -6.0, 3.0, xtol=1e-7))
+
+
+def _factors(c) -> StageFactors:
+    return StageFactors(both=c.alpha(), one=c.alpha_one_side())
+
+
+@functools.lru_cache(maxsize=256)
+def independent_factors(c: CfarSettings, n_channels: int) -> StageFactors:
+    """Threshold factors of a stage on independent cells (``make_cfar(c, L)``'s, to 1e-12).
+
+    CASO by a bracketed root search between the one-sided CA factors for ``pfa`` and ``pfa/2``
+    (``Pfa_CA1(T) <= Pfa_SO(T) <= 2 Pfa_CA1(T)``: the smaller side is below either side, and
+    above the noise peak only if one of them is) instead of the library's scan from ``T = e^-8``
+    (one tenth of the evaluations: the threshold search runs a few times per slider move).
+    """
+    L, n, pfa = n_channels, c.n_train, c.pfa
+
+    def t_ca(cells: float, p: float) -> float:
+        # Pfa_CA(T) = 1 - I_{T/(1+T)}(L, N L)  ->  T = b / (1 - b)
+        b = float(betainccinv(L, cells * L, p))
+        return b / (1.0 - b)
+
+    one = n * t_ca(n, pfa)
+    if c.method == "ca":
+        return StageFactors(both=2 * n * t_ca(2 * n, pfa), one=one)
+    if c.method == "cago":
+        return StageFactors(both=threshold_factor("cago", n, pfa, L), one=one)
+    lo, hi = np.log(t_ca(n, pfa)), np.log(t_ca(n, pfa / 2))
+    log_t = brentq(lambda u: np.log(pfa_caso(np.exp(u), n, L)) - np.log(pfa), lo, hi, xtol=1e-13)
+    return StageFactors(both=n * float(np.exp(log_t)), one=one)
+
+
+def chain_factors(
+    radar: RadarConfig, settings: ProcessingSettings, n_channels: int
+) -> tuple[StageFactors, StageFactors]:
+    """The exact chain's threshold factors (range stage, Doppler stage), as ``two_stage_cfar``."""
+    rc, dc = settings.range_cfar, settings.doppler_cfar
+    ne_r = ne_d = None
+    if settings.cfar_noise_model:
+        ne_r = effective_cells_or_none(settings.range_window, radar.n_samples, rc.n_train)
+        ne_d = effective_cells_or_none(settings.doppler_window, radar.n_loops, dc.n_train)
+    return _factors(make_cfar(rc, n_channels, ne_r)), _factors(make_cfar(dc, n_channels, ne_d))
 
 
 def effective_cells_or_none(window_name: str, n_fft: int, n_train: int) -> float | None:
