@@ -15,7 +15,7 @@ import json
 import platform
 from pathlib import Path
 
-BENCHMARKS = ("sim", "track", "tune", "fidelity", "dataset")
+BENCHMARKS = ("sim", "track", "tune", "fidelity", "dataset", "false_alarms")
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
