@@ -387,63 +387,10 @@ class _Reflectors:
         """Scatterers of frame ``f`` and the number of clutter reflectors among them.
 
         Bit for bit the reflectors of the straightforward construction (persons, body parts,
-        clutter, static reflectors, in this order) with the same per-frame streams; the
-        per-frame cost is kept low (about 0.2 ms) because data sets call it for every frame:
-        link-budget constants come from :attr:`_consts`, the arrays are filled in place and
-        validated with one combined check.
+        clutter, static reflectors, in this order) with the same per-frame streams (tested).
         """
-        from core import simulation as sim
-
-        scene = self.scene
-        k = self._consts
-        xy, v = self.truth_xy_m[f], self.truth_v_mps[f]
-        rcs = self.fixed_rcs
-        if self.run_rcs:
-            # σ_dBsm ~ N(−8, 16), eq. (5), drawn afresh every frame
-            drawn = stage_rng(self.seed, "person_rcs", f).normal(
-                PERSON_RCS_MEAN_DBSM, PERSON_RCS_STD_DB, scene.n_persons
-            )
-            rcs = np.where(k.drawn_rcs, drawn, self.fixed_rcs)
-        active = ~np.isnan(xy[:, 0])
-        # persons: one point scatterer at the trajectory position, z = 0
-        point = np.flatnonzero(active & ~self.extended)
-        pos2, vel2, rcs_list = [xy[point]], [v[point]], [rcs[point]]
-        src = [point.astype(np.int32)]
-        for i in np.flatnonzero(active & self.extended):
-            bp, bv, frac = body_scatterers(xy[i], v[i], self.headings[i][f], self.truth_t_s[f])
-            pos2.append(bp)
-            vel2.append(bv)
-            # σ_part = σ · share (linear power)
-            rcs_list.append(rcs[i] + 10 * np.log10(frac))
-            src.append(np.full(len(bp), i, dtype=np.int32))
-        n_clutter = 0
-        if self.run_clutter:
-            c = draw_clutter(
-                scene.aoi,
-                scene.clutter_density_per_m2,
-                scene.radar,
-                stage_rng(self.seed, "clutter", f),
-            )
-            n_clutter = len(c)
-            if n_clutter:
-                pos2.append(c.position_m)
-                vel2.append(c.velocity_mps)
-                rcs_list.append(self._clutter_rcs_dbsm(c.position_m, c.snr_db))
-                src.append(np.full(n_clutter, -1, dtype=np.int32))
-        moving = np.concatenate(pos2)
-        n_moving = len(moving)
-        n = n_moving + len(k.static_rcs)
-        position = np.zeros((n, 3))
-        velocity = np.zeros((n, 3))
-        position[:n_moving, :2] = moving
-        velocity[:n_moving, :2] = np.concatenate(vel2)
-        position[n_moving:] = k.static_position
-        if len(k.static_rcs):
-            rcs_list.append(k.static_rcs)
-            src.append(k.static_source)
-        rcs_all = np.concatenate(rcs_list).astype(np.float64)
-        source = np.concatenate(src).astype(np.int32)
-        return _scatterers(sim, position, velocity, rcs_all, source), n_clutter
+        out, n_clutter = self._build(np.array([f], dtype=np.int64))
+        return out[0], int(n_clutter[0])
 
     def frames(self, n_frames: int | None = None) -> tuple[list[Any], np.ndarray]:
         """The scatterers of frames ``0 .. n_frames - 1`` and their clutter counts, at once.
@@ -451,13 +398,18 @@ class _Reflectors:
         Bit for bit ``[self.frame(f) for f in range(n_frames)]`` (tested): every frame draws
         from its own streams in the same order; what follows the draws (persons' RCS, clutter
         velocities and RCS, assembly, validation) runs once over all frames instead of once per
-        frame, about a third of :meth:`frame`'s cost. The frames are views into shared arrays.
+        frame. The frames are views into shared arrays.
         """
+        n_f = len(self.truth_t_s) if n_frames is None else int(n_frames)
+        return self._build(np.arange(n_f, dtype=np.int64))
+
+    def _build(self, idx: np.ndarray) -> tuple[list[Any], np.ndarray]:
+        """Scatterers and clutter counts of the frames ``idx`` (see :meth:`frames`)."""
         from core import simulation as sim
 
         scene = self.scene
         k = self._consts
-        n_f = len(self.truth_t_s) if n_frames is None else int(n_frames)
+        n_f = len(idx)
         n_p = scene.n_persons
         if n_f == 0:
             return [], np.zeros(0, dtype=np.int64)
@@ -465,12 +417,12 @@ class _Reflectors:
         if self.run_rcs:
             # σ_dBsm ~ N(−8, 16), eq. (5), drawn afresh every frame
             drawn = np.empty((n_f, n_p))
-            for f in range(n_f):
-                drawn[f] = stage_rng(self.seed, "person_rcs", f).normal(
+            for row, f in enumerate(idx):
+                drawn[row] = stage_rng(self.seed, "person_rcs", int(f)).normal(
                     PERSON_RCS_MEAN_DBSM, PERSON_RCS_STD_DB, n_p
                 )
             rcs = np.where(k.drawn_rcs[None, :], drawn, self.fixed_rcs[None, :])
-        xy, v = self.truth_xy_m[:n_f], self.truth_v_mps[:n_f]
+        xy, v = self.truth_xy_m[idx], self.truth_v_mps[idx]
         active = ~np.isnan(xy[:, :, 0])  # (F, n_p)
         point = active & ~self.extended[None, :]
         n_point = point.sum(axis=1)
@@ -478,28 +430,28 @@ class _Reflectors:
         body_pos, body_vel, body_rcs, body_src = [], [], [], []
         n_body = np.zeros(n_f, dtype=np.int64)
         if self.extended.any():
-            for f in range(n_f):
-                for i in np.flatnonzero(active[f] & self.extended):
+            for row, f in enumerate(idx):
+                for i in np.flatnonzero(active[row] & self.extended):
                     bp, bv, frac = body_scatterers(
-                        xy[f, i], v[f, i], self.headings[i][f], self.truth_t_s[f]
+                        xy[row, i], v[row, i], self.headings[i][f], self.truth_t_s[f]
                     )
                     body_pos.append(bp)
                     body_vel.append(bv)
                     # σ_part = σ · share (linear power)
-                    body_rcs.append(rcs[f, i] + 10 * np.log10(frac))
+                    body_rcs.append(rcs[row, i] + 10 * np.log10(frac))
                     body_src.append(np.full(len(bp), i, dtype=np.int32))
-                    n_body[f] += len(bp)
+                    n_body[row] += len(bp)
         n_clutter = np.zeros(n_f, dtype=np.int64)
         c_pos, c_vr, c_snr = [], [], []
         if self.run_clutter:
-            for f in range(n_f):
+            for row, f in enumerate(idx):
                 c = draw_clutter(
                     scene.aoi,
                     scene.clutter_density_per_m2,
                     scene.radar,
-                    stage_rng(self.seed, "clutter", f),
+                    stage_rng(self.seed, "clutter", int(f)),
                 )
-                n_clutter[f] = len(c)
+                n_clutter[row] = len(c)
                 c_pos.append(c.position_m)
                 c_vr.append(c.radial_velocity_mps)
                 c_snr.append(c.snr_db)
@@ -546,13 +498,13 @@ class _Reflectors:
             position[at] = k.static_position[j]
             rcs_all[at] = k.static_rcs[j]
             source[at] = k.static_source[j]
-        if not _arrays_ok(position, velocity, rcs_all):
-            # an invalid reflector: the per-frame path raises the validating message
-            return [self.frame(f)[0] for f in range(n_f)], n_clutter
+        whole_ok = _arrays_ok(position, velocity, rcs_all)
         out = []
-        for f in range(n_f):
-            s = slice(start[f], start[f + 1])
-            out.append(_checked_scatterers(sim, position[s], velocity[s], rcs_all[s], source[s]))
+        for row in range(n_f):
+            s = slice(start[row], start[row + 1])
+            part = (position[s], velocity[s], rcs_all[s], source[s])
+            # an invalid reflector: the frame's validating constructor names the field
+            out.append(_checked_scatterers(sim, *part) if whole_ok else _scatterers(sim, *part))
         return out, n_clutter
 
     @staticmethod
@@ -691,8 +643,10 @@ def iter_frames(
     antenna = sim.AntennaGain.draw(radar, stage_rng(seed, "antenna"))
     reflectors = _Reflectors.build(scene, p, seed, antenna, settings)
     t_s, xy, v = reflectors.truth_t_s, reflectors.truth_xy_m, reflectors.truth_v_mps
-    for f in frames if frames is not None else range(scene.n_frames):
-        scatterers, n_clutter = reflectors.frame(f)
+    idx = np.asarray(frames if frames is not None else range(scene.n_frames), dtype=np.int64)
+    # every asked frame's reflectors at once (each frame on its own streams, the same bits)
+    every, clutter_counts = reflectors._build(idx)
+    for f, scatterers, n_clutter in zip(idx.tolist(), every, clutter_counts.tolist()):
         out = simulate(
             radar,
             scatterers,
