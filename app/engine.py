@@ -166,12 +166,12 @@ def class_param_names(trajectory_class: str) -> set[str]:
 
 # ---- tracker parameters -------------------------------------------------------------------------
 def param_specs(model: str) -> list[ParamSpec]:
-    """Sliders: the search space of eq. (15) for ``model`` (log flags from core)."""
-    from core.optimization import search_space
+    """Sliders: the search space of eq. (15) for ``model`` (bounds, log flags, labels from core)."""
+    from core.tracking.space import search_space
 
     return [
-        ParamSpec(name=b.name, low=b.low, high=b.high, log=b.log, label=b.label)
-        for b in search_space(model)
+        ParamSpec(name=p.name, low=p.low, high=p.high, log=p.log, label=p.label)
+        for p in search_space(model)
     ]
 
 
@@ -182,32 +182,10 @@ def _tracker_params_class():
 
 
 def default_values(model: str) -> dict[str, float]:
-    """TrackerParams defaults as flat search-space values (clipped into the bounds)."""
-    from core.optimization import flat_params
+    """The table's defaults as flat search-space values (all inside the bounds)."""
+    from core.tracking.space import defaults
 
-    tp = _tracker_params_class()(model=model, p0=_default_p0(model))
-    d = tp.to_dict()
-    specs = {s.name: s for s in param_specs(model)}
-    p0 = list(d["p0"])
-    names = ("p0_00", "p0_11", "p0_22", "p0_33", "p0_44", "p0_55")
-    flat_in = dict(d)
-    for name, spec in specs.items():
-        if name.startswith("p0_"):
-            i = names.index(name)
-            p0[i] = min(max(p0[i], spec.low), spec.high)
-        elif name in flat_in:
-            flat_in[name] = min(max(float(flat_in[name]), spec.low), spec.high)
-    flat_in["p0"] = p0
-    return flat_params(flat_in)
-
-
-def _default_p0(model: str) -> tuple[float, ...]:
-    try:
-        from core.tracking.params import DEFAULT_P0
-
-        return tuple(DEFAULT_P0[model])
-    except (ImportError, KeyError, AttributeError):
-        return (0.3, 0.3, 1.0, 1.0) if model == "cv" else (0.3, 0.3, 1.0, 1.0, 0.5, 0.5)
+    return defaults(model)
 
 
 def default_extra() -> dict:

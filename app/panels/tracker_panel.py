@@ -13,23 +13,6 @@ from core.errors import InputError
 
 SLIDER_STEPS = 1000
 
-LABELS = {
-    "q_coeff": "q (process noise)",
-    "r11": "r11 range σ [m]",
-    "r22": "r22 azimuth σ [rad]",
-    "r33": "r33 velocity σ [m/s]",
-    "p0_00": "p0 x σ [m]",
-    "p0_11": "p0 y σ [m]",
-    "p0_22": "p0 vx σ [m/s]",
-    "p0_33": "p0 vy σ [m/s]",
-    "p0_44": "p0 ax σ [m/s²]",
-    "p0_55": "p0 ay σ [m/s²]",
-    "p_d": "P_D detection",
-    "p_te": "P_te initial ψ",
-    "p11": "p11 survive",
-    "p21": "p21 appear",
-}
-
 
 def to_slider(spec: ParamSpec, value: float) -> int:
     """Value → slider position 0…SLIDER_STEPS (log-linear when ``spec.log``)."""
@@ -60,9 +43,7 @@ class ParamRow(QtCore.QObject):
         self.spec = spec
         self._model = model
         self._on_error = on_error
-        self.label = QtWidgets.QLabel(
-            LABELS.get(spec.name, spec.name) + (" (log)" if spec.log else "")
-        )
+        self.label = QtWidgets.QLabel((spec.label or spec.name) + (" (log)" if spec.log else ""))
         self.slider = QtWidgets.QSlider(QtCore.Qt.Horizontal)
         self.slider.setObjectName(f"slider_{spec.name}")
         self.slider.setRange(0, SLIDER_STEPS)

@@ -27,7 +27,7 @@ from typing import Any, Protocol
 import numpy as np
 
 from core.errors import InputError
-from core.optimization.space import check_model, search_space, tracker_params_dict
+from core.optimization.space import P0_NAMES, check_model, search_space, tracker_params_dict
 
 #: score of a trajectory without any confirmed frame (SPEC §5), m²
 NO_CONFIRMATION_LOSS = 1.0
@@ -91,8 +91,7 @@ class QuadraticLosses:
         if self.delay_s:
             time.sleep(self.delay_s)
         p = dict(params)
-        for i, v in enumerate(p.get("p0", [])):
-            p[f"p0_{i}{i}"] = v
+        p.update(zip(P0_NAMES, p.get("p0", [])))
         d2 = 0.0
         for b in search_space(self.model):
             v = float(p[b.name])

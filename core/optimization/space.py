@@ -1,73 +1,40 @@
-"""The search space of the paper's eq. (15): the one place that maps parameters to ``suggest_*``.
+"""The search space of eq. (15) as Optuna sees it: the one place that calls ``suggest_*``.
 
-Optuna parameter names are the :class:`core.tracking.TrackerParams` JSON keys, with the initial
-state standard deviations ``p0`` spelled ``p0_00`` … ``p0_55`` (the diagonal of P(0|0)).
-The CV model never samples ``p0_44`` and ``p0_55``; the CA model samples all six.
-Ranges spanning a decade or more are sampled on a log scale (SPEC §5).
+The table itself (names, symbols, units, bounds, scales, models, defaults) is
+:data:`core.tracking.space.SEARCH_SPACE`; this module only maps it to Optuna. Optuna parameter
+names are the :class:`core.tracking.TrackerParams` JSON keys, with the initial state standard
+deviations ``p0`` spelled ``p0_00`` … ``p0_55`` (the diagonal of P(0|0)). The CV model never
+samples ``p0_44`` and ``p0_55``; the CA model samples all six. Parameters are suggested in table
+order (changing it changes every seeded study).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import Any, Protocol
 
 from core.errors import InputError
-
-MODELS = ("cv", "ca")
-
-
-@dataclass(frozen=True, slots=True, kw_only=True)
-class Bound:
-    """One optimised parameter: its Optuna name, closed interval and scale."""
-
-    name: str
-    low: float
-    high: float
-    log: bool
-    #: which motion models sample it
-    models: tuple[str, ...] = MODELS
-    #: label for plots and the GUI
-    label: str = ""
-
-    def __post_init__(self) -> None:
-        if not self.low < self.high:
-            raise InputError(f"bound {self.name}: low must be < high, got {self.low}, {self.high}")
-        if self.log and self.low <= 0:
-            raise InputError(f"bound {self.name}: a log scale needs low > 0, got {self.low}")
-
-
-#: eq. (15) of the paper, in the order the paper lists them.
-SEARCH_SPACE: tuple[Bound, ...] = (
-    Bound(name="q_coeff", low=0.1, high=30.0, log=True, label="q_coeff"),
-    Bound(name="r11", low=0.01, high=0.5, log=True, label="r11 (range σ, m)"),
-    Bound(name="r22", low=0.01, high=0.2, log=True, label="r22 (azimuth σ, rad)"),
-    Bound(name="r33", low=0.1, high=3.0, log=True, label="r33 (radial velocity σ, m/s)"),
-    Bound(name="p0_00", low=0.1, high=10.0, log=True, label="p0,00 (x σ, m)"),
-    Bound(name="p0_11", low=0.1, high=10.0, log=True, label="p0,11 (y σ, m)"),
-    Bound(name="p0_22", low=0.01, high=10.0, log=True, label="p0,22 (vx σ, m/s)"),
-    Bound(name="p0_33", low=0.01, high=10.0, log=True, label="p0,33 (vy σ, m/s)"),
-    Bound(name="p0_44", low=0.001, high=10.0, log=True, models=("ca",), label="p0,44 (ax σ)"),
-    Bound(name="p0_55", low=0.001, high=10.0, log=True, models=("ca",), label="p0,55 (ay σ)"),
-    Bound(name="p_d", low=0.8, high=0.99, log=False, label="P_D"),
-    Bound(name="p_te", low=0.2, high=1.0, log=False, label="P_te"),
-    Bound(name="p11", low=0.7, high=1.0, log=False, label="p11"),
-    Bound(name="p21", low=0.0, high=0.4, log=False, label="p21"),
+from core.tracking.space import (
+    MODELS,
+    P0_NAMES,
+    SEARCH_SPACE,
+    STATE_DIM,
+    Parameter,
+    check_model,
+    p0_names,
+    search_space,
 )
 
-P0_NAMES = ("p0_00", "p0_11", "p0_22", "p0_33", "p0_44", "p0_55")
-
-
-def check_model(model: str) -> str:
-    """Return ``model`` if it is a known motion model, else raise :class:`InputError`."""
-    if model not in MODELS:
-        raise InputError(f"model must be one of {', '.join(MODELS)}, got {model!r}")
-    return model
-
-
-def search_space(model: str) -> tuple[Bound, ...]:
-    """The bounds sampled for ``model`` (``"cv"``: 12 parameters, ``"ca"``: 14)."""
-    check_model(model)
-    return tuple(b for b in SEARCH_SPACE if model in b.models)
+__all__ = [
+    "MODELS",
+    "P0_NAMES",
+    "SEARCH_SPACE",
+    "Parameter",
+    "check_model",
+    "flat_params",
+    "search_space",
+    "suggest_params",
+    "tracker_params_dict",
+]
 
 
 class SuggestsFloats(Protocol):
@@ -89,17 +56,15 @@ def tracker_params_dict(flat: dict[str, Any], model: str) -> dict[str, Any]:
     Keys not in the search space (``p_g``, thresholds, clutter density) are left out so that
     they take the TrackerParams defaults.
     """
-    check_model(model)
     names = [b.name for b in search_space(model)]
     missing = [n for n in names if n not in flat]
     if missing:
         raise InputError(f"parameters missing for model {model}: {', '.join(missing)}")
-    n_p0 = 6 if model == "ca" else 4
     out: dict[str, Any] = {"model": model}
     for n in names:
-        if not n.startswith("p0_"):
+        if n not in P0_NAMES:
             out[n] = float(flat[n])
-    out["p0"] = [float(flat[p]) for p in P0_NAMES[:n_p0]]
+    out["p0"] = [float(flat[p]) for p in p0_names(model)]
     return out
 
 
@@ -111,12 +76,12 @@ def flat_params(params: dict[str, Any]) -> dict[str, float]:
     """
     model = check_model(str(params.get("model", "cv")))
     p0 = list(params.get("p0", []))
-    n_p0 = 6 if model == "ca" else 4
+    n_p0 = STATE_DIM[model]
     if len(p0) != n_p0:
         raise InputError(f"p0 must have {n_p0} entries for model {model}, got {len(p0)}")
     flat: dict[str, float] = {}
     for b in search_space(model):
-        if b.name.startswith("p0_"):
+        if b.name in P0_NAMES:
             value = float(p0[P0_NAMES.index(b.name)])
         elif b.name in params:
             value = float(params[b.name])

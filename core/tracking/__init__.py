@@ -1,5 +1,7 @@
 """IPDA people tracker (SPEC §4): one role per module, :mod:`core.tracking.tracker` composes them.
 
+- :mod:`~core.tracking.space` — the optimised parameters: one table (eq. 15) of names, symbols,
+  units, bounds, scales, models and defaults
 - :mod:`~core.tracking.params` — :class:`TrackerParams` (JSON in/out, validation)
 - :mod:`~core.tracking.models` — CV / CA direct discrete-time kinematic models
 - :mod:`~core.tracking.ekf` — h(x), analytic Jacobian, prediction, Joseph form
@@ -14,7 +16,8 @@
 """
 
 from core.tracking.batch import DatasetEstimates, track_dataset
-from core.tracking.params import SEARCH_SPACE, TrackerParams
+from core.tracking.params import TrackerParams
+from core.tracking.space import SEARCH_SPACE
 from core.tracking.tracker import FrameTracks, TrackerResult, run_tracker
 
 __all__ = [

@@ -14,32 +14,12 @@ from dataclasses import dataclass, fields
 from pathlib import Path
 
 from core.errors import InputError
+from core.tracking.space import MODELS, P0_NAMES, STATE_DIM, defaults, p0_names, parameter
 
-MODELS = ("cv", "ca")
-#: State dimension per motion model: CV [x, y, vx, vy], CA [x, y, vx, vy, ax, ay].
-STATE_DIM = {"cv": 4, "ca": 6}
 NONPARAMETRIC = "nonparametric"
 
-#: Search space of the paper's eq. (15) (inclusive bounds). ``p0_ii`` is the i-th entry of p0.
-SEARCH_SPACE: dict[str, tuple[float, float]] = {
-    "q_coeff": (0.1, 30.0),
-    "r11": (0.01, 0.5),
-    "r22": (0.01, 0.2),
-    "r33": (0.1, 3.0),
-    "p0_00": (0.1, 10.0),
-    "p0_11": (0.1, 10.0),
-    "p0_22": (0.01, 10.0),
-    "p0_33": (0.01, 10.0),
-    "p0_44": (0.001, 10.0),
-    "p0_55": (0.001, 10.0),
-    "p_d": (0.8, 0.99),
-    "p_te": (0.2, 1.0),
-    "p11": (0.7, 1.0),
-    "p21": (0.0, 0.4),
-}
-
-#: Default initial standard deviations p0,ii (m, m, m/s, m/s, m/s², m/s²); see docs/tracker.md.
-DEFAULT_P0 = {"cv": (0.3, 0.3, 1.0, 1.0), "ca": (0.3, 0.3, 1.0, 1.0, 0.5, 0.5)}
+#: Default initial standard deviations p0,ii per model, from the table (core/tracking/space.py).
+DEFAULT_P0 = {m: tuple(defaults(m)[n] for n in p0_names(m)) for m in MODELS}
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -51,8 +31,9 @@ class TrackerParams:
     model
         Motion model, ``"cv"`` (state ``[x, y, vx, vy]``) or ``"ca"`` (``[x, y, vx, vy, ax, ay]``).
     q_coeff
-        Process-noise scale: ``Q = q_coeff · Q0`` with the direct discrete-time kinematic ``Q0``
-        (for CV the variance of the acceleration in m²/s⁴).
+        Process-noise scale: ``Q = q_coeff · Q0`` with the direct discrete-time kinematic ``Q0``,
+        in m²/s⁴: for CV the variance of the acceleration, for CA the variance of the acceleration
+        increment over one frame (see :mod:`core.tracking.space`).
     r11, r22, r33
         Measurement noise standard deviations of range (m), azimuth (rad) and radial velocity
         (m/s): ``R = diag(r11², r22², r33²)``.
@@ -77,16 +58,16 @@ class TrackerParams:
     """
 
     model: str = "cv"
-    q_coeff: float = 2.0
-    r11: float = 0.05
-    r22: float = 0.03
-    r33: float = 0.3
+    q_coeff: float = parameter("q_coeff").default
+    r11: float = parameter("r11").default
+    r22: float = parameter("r22").default
+    r33: float = parameter("r33").default
     #: ``None`` takes the model's default (4 entries for CV, 6 for CA).
     p0: tuple[float, ...] | None = None
-    p_d: float = 0.9
-    p_te: float = 0.2
-    p11: float = 0.98
-    p21: float = 0.0
+    p_d: float = parameter("p_d").default
+    p_te: float = parameter("p_te").default
+    p11: float = parameter("p11").default
+    p21: float = parameter("p21").default
     p_g: float = 0.99
     confirm_threshold: float = 0.9
     delete_threshold: float = 0.1
@@ -184,7 +165,7 @@ class TrackerParams:
         data = dict(data)
         p0_keys = sorted(k for k in data if k.startswith("p0_"))
         known = {f.name for f in fields(cls)}
-        valid_p0 = {f"p0_{i}{i}" for i in range(6)}
+        valid_p0 = set(P0_NAMES)
         unknown = sorted(k for k in data if k not in known and k not in valid_p0)
         if unknown:
             raise InputError(f"unknown tracker parameter keys {unknown}", source)
@@ -194,8 +175,7 @@ class TrackerParams:
         if p0_keys:
             if "p0" in data:
                 raise InputError("give either p0 or p0_ii keys, not both", source)
-            n = STATE_DIM[model]
-            want = [f"p0_{i}{i}" for i in range(n)]
+            want = list(p0_names(model))
             if p0_keys != want:
                 raise InputError(
                     f"p0 keys for model {model!r} must be {want}, got {p0_keys}", source

@@ -22,7 +22,8 @@ import numpy as np
 from core.dataset import Dataset
 from core.tracking.batch import dataset_frame_period_s
 from core.tracking.kernel import track_frames
-from core.tracking.params import SEARCH_SPACE, STATE_DIM, TrackerParams
+from core.tracking.params import TrackerParams
+from core.tracking.space import p0_names, search_space
 from core.tracking.synthetic import PAPER_LIKE, synthetic_dataset
 
 __all__ = [
@@ -37,17 +38,14 @@ __all__ = [
 
 
 def corner_names(model: str) -> list[str]:
-    """Names of the optimised parameters of a model (SEARCH_SPACE keys)."""
-    n = STATE_DIM[model]
-    p0 = [f"p0_{i}{i}" for i in range(n)]
-    return ["q_coeff", "r11", "r22", "r33", *p0, "p_d", "p_te", "p11", "p21"]
+    """Names of the optimised parameters of a model, in search-space table order."""
+    return [p.name for p in search_space(model)]
 
 
 def corner_params(model: str, bits: tuple[int, ...], **fixed) -> TrackerParams:
     """The corner selected by ``bits`` (0 lower, 1 upper bound, in :func:`corner_names` order)."""
-    names = corner_names(model)
-    values = {name: SEARCH_SPACE[name][b] for name, b in zip(names, bits)}
-    p0 = tuple(values.pop(f"p0_{i}{i}") for i in range(STATE_DIM[model]))
+    values = {p.name: (p.low, p.high)[b] for p, b in zip(search_space(model), bits)}
+    p0 = tuple(values.pop(name) for name in p0_names(model))
     return TrackerParams(model=model, p0=p0, **values, **fixed)
 
 

@@ -99,3 +99,17 @@ def test_running_loss_ends_at_the_paper_loss(long_scene_frames) -> None:
     assert np.all((full.ospa_m >= 0) & (full.ospa_m <= 1.0))
     psi = full.psi_value[np.isfinite(full.psi_value)]
     assert psi.size and psi.min() >= 0 and psi.max() <= 1
+
+
+@pytest.mark.parametrize("model", ["cv", "ca"])
+def test_sliders_and_their_defaults_are_the_search_space_table(model: str) -> None:
+    from app import engine
+    from core.tracking.space import defaults, search_space
+
+    rows = search_space(model)
+    assert engine.param_specs(model) == [
+        ParamSpec(name=p.name, low=p.low, high=p.high, log=p.log, label=p.label) for p in rows
+    ]
+    for p in rows:  # labels show the unit of every dimensioned parameter
+        assert p.label.startswith(p.symbol) and (not p.unit or p.label.endswith(f"[{p.unit}]"))
+    assert engine.default_values(model) == defaults(model)

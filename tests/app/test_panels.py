@@ -43,6 +43,9 @@ def test_tracker_panel_both_ways(window) -> None:
     assert model.params().clutter_density == "nonparametric"
     model.set_extra(clutter_density=0.01)
     assert not panel.rho_np.isChecked() and panel.rho.value() == pytest.approx(0.01)
+    # labels with units, from the search-space table
+    assert panel.rows["r11"].label.text() == "r11 range σ [m] (log)"
+    assert panel.rows["p_d"].label.text() == "P_D detection probability"
     # reset
     panel.reset_button.click()
     assert model.values == engine.default_values("cv")

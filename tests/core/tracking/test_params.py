@@ -5,7 +5,8 @@ import json
 import pytest
 
 from core.errors import InputError
-from core.tracking.params import SEARCH_SPACE, TrackerParams
+from core.tracking.params import TrackerParams
+from core.tracking.space import SEARCH_SPACE
 
 
 @pytest.mark.parametrize("model", ["cv", "ca"])
@@ -14,7 +15,7 @@ def test_defaults_lie_inside_the_search_space(model):
     flat = p.to_dict()
     for i, v in enumerate(p.p0):
         flat[f"p0_{i}{i}"] = v
-    for name, (lo, hi) in SEARCH_SPACE.items():
+    for name, (lo, hi) in ((b.name, (b.low, b.high)) for b in SEARCH_SPACE):
         if name in flat:
             assert lo <= flat[name] <= hi, name
     assert p.state_dim == len(p.p0) == {"cv": 4, "ca": 6}[model]

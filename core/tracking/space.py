@@ -1,0 +1,169 @@
+"""The tracker's optimised parameters: one table, the paper's eq. (15), everything else derives.
+
+One :class:`Parameter` row per optimised parameter: its name (the TrackerParams JSON key and the
+Optuna parameter name), the paper's symbol, the SI unit, the closed search interval, the sampling
+scale, the motion models that use it and its default. From this table derive
+:class:`core.tracking.TrackerParams`' defaults, the GUI's sliders (labels with units), the Optuna
+``suggest_float`` calls (:mod:`core.optimization.space`), the stability sweep's corners
+(:mod:`core.tracking.stability`) and the flat ⇄ JSON key mapping. No other module lists the
+parameters or their numbers.
+
+Units. ``q_coeff`` scales ``Q = q_coeff · Γ Γᵀ`` (:mod:`core.tracking.models`) and is the variance
+of the scalar process noise per axis, m²/s⁴ for both models: for CV (Γ = [T²/2, T]ᵀ, Bar-Shalom
+§6.3.2) the noise is the acceleration, constant over a frame; for CA (Γ = [T²/2, T, 1]ᵀ, §6.3.3)
+it is the acceleration *increment* over one frame (so not a jerk variance in m²/s⁶; a jerk of
+spectral density S gives roughly S·T per frame). ``r11, r22, r33`` are measurement standard
+deviations of range (m), azimuth (rad) and radial velocity (m/s); ``p0_ii`` are the initial state
+standard deviations in the state's units; the four probabilities have no unit.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from core.errors import InputError
+
+__all__ = [
+    "MODELS",
+    "STATE_DIM",
+    "Parameter",
+    "SEARCH_SPACE",
+    "P0_NAMES",
+    "check_model",
+    "parameter",
+    "search_space",
+    "p0_names",
+    "defaults",
+]
+
+#: Motion models: constant velocity and constant acceleration.
+MODELS = ("cv", "ca")
+#: State dimension per motion model: CV [x, y, vx, vy], CA [x, y, vx, vy, ax, ay].
+STATE_DIM = {"cv": 4, "ca": 6}
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Parameter:
+    """One optimised tracker parameter (one row of eq. 15).
+
+    Attributes
+    ----------
+    name
+        TrackerParams JSON key and Optuna parameter name; the initial standard deviations are
+        ``p0_ii`` (entry ``i`` of the ``p0`` list).
+    symbol
+        As the paper writes it (plain text: ``r11``, ``p0,00``, ``P_D``).
+    meaning
+        A few words for labels (``range σ``).
+    unit
+        SI unit (``""`` for probabilities).
+    low, high
+        Closed search interval of eq. (15).
+    log
+        Sampled on a log scale (the interval spans a decade or more).
+    models
+        The motion models that use it.
+    default
+        The default value (docs/decisions/tracker-03), inside ``[low, high]``.
+    """
+
+    name: str
+    symbol: str
+    meaning: str
+    unit: str
+    low: float
+    high: float
+    log: bool
+    models: tuple[str, ...] = MODELS
+    default: float
+
+    def __post_init__(self) -> None:
+        if not self.low < self.high:
+            raise InputError(f"{self.name}: low must be < high, got {self.low}, {self.high}")
+        if self.log and self.low <= 0:
+            raise InputError(f"{self.name}: a log scale needs low > 0, got {self.low}")
+        if not self.models or not set(self.models) <= set(MODELS):
+            raise InputError(f"{self.name}: models must be some of {MODELS}, got {self.models}")
+        if not (math.isfinite(self.default) and self.low <= self.default <= self.high):
+            raise InputError(
+                f"{self.name}: default must lie in [{self.low}, {self.high}], got {self.default}"
+            )
+
+    @property
+    def label(self) -> str:
+        """``symbol meaning [unit]`` for sliders, tables and plots."""
+        text = f"{self.symbol} {self.meaning}"
+        return f"{text} [{self.unit}]" if self.unit else text
+
+
+#: eq. (15) of the paper, in the order the paper lists them (the Optuna suggest order: keep it).
+# fmt: off
+SEARCH_SPACE: tuple[Parameter, ...] = (
+    # q_coeff: CV acceleration variance, CA per-frame acceleration-increment variance (see above)
+    Parameter(name="q_coeff", symbol="q_coeff", meaning="process noise", unit="m²/s⁴",
+              low=0.1, high=30.0, log=True, default=2.0),
+    Parameter(name="r11", symbol="r11", meaning="range σ", unit="m",
+              low=0.01, high=0.5, log=True, default=0.05),
+    Parameter(name="r22", symbol="r22", meaning="azimuth σ", unit="rad",
+              low=0.01, high=0.2, log=True, default=0.03),
+    Parameter(name="r33", symbol="r33", meaning="radial velocity σ", unit="m/s",
+              low=0.1, high=3.0, log=True, default=0.3),
+    Parameter(name="p0_00", symbol="p0,00", meaning="initial x σ", unit="m",
+              low=0.1, high=10.0, log=True, default=0.3),
+    Parameter(name="p0_11", symbol="p0,11", meaning="initial y σ", unit="m",
+              low=0.1, high=10.0, log=True, default=0.3),
+    Parameter(name="p0_22", symbol="p0,22", meaning="initial vx σ", unit="m/s",
+              low=0.01, high=10.0, log=True, default=1.0),
+    Parameter(name="p0_33", symbol="p0,33", meaning="initial vy σ", unit="m/s",
+              low=0.01, high=10.0, log=True, default=1.0),
+    Parameter(name="p0_44", symbol="p0,44", meaning="initial ax σ", unit="m/s²",
+              low=0.001, high=10.0, log=True, models=("ca",), default=0.5),
+    Parameter(name="p0_55", symbol="p0,55", meaning="initial ay σ", unit="m/s²",
+              low=0.001, high=10.0, log=True, models=("ca",), default=0.5),
+    Parameter(name="p_d", symbol="P_D", meaning="detection probability", unit="",
+              low=0.8, high=0.99, log=False, default=0.9),
+    Parameter(name="p_te", symbol="P_te", meaning="initial existence ψ", unit="",
+              low=0.2, high=1.0, log=False, default=0.2),
+    Parameter(name="p11", symbol="p11", meaning="existence survival", unit="",
+              low=0.7, high=1.0, log=False, default=0.98),
+    Parameter(name="p21", symbol="p21", meaning="existence appearance", unit="",
+              low=0.0, high=0.4, log=False, default=0.0),
+)
+# fmt: on
+
+_BY_NAME = {p.name: p for p in SEARCH_SPACE}
+
+#: The initial standard deviations, in state order (``p0_ii`` is entry ``i`` of ``p0``).
+P0_NAMES: tuple[str, ...] = tuple(p.name for p in SEARCH_SPACE if p.name.startswith("p0_"))
+
+
+def check_model(model: str) -> str:
+    """Return ``model`` if it is a known motion model, else raise :class:`InputError`."""
+    if model not in MODELS:
+        raise InputError(f"model must be one of {', '.join(MODELS)}, got {model!r}")
+    return model
+
+
+def parameter(name: str) -> Parameter:
+    """The row of ``name``; :class:`InputError` naming it if it is not optimised."""
+    try:
+        return _BY_NAME[name]
+    except KeyError:
+        raise InputError(f"{name!r} is not an optimised tracker parameter") from None
+
+
+def search_space(model: str) -> tuple[Parameter, ...]:
+    """The rows ``model`` uses, in table order (CV: 12, CA: 14)."""
+    check_model(model)
+    return tuple(p for p in SEARCH_SPACE if model in p.models)
+
+
+def p0_names(model: str) -> tuple[str, ...]:
+    """``p0_ii`` names of ``model``, in state order (one per state component)."""
+    return tuple(p.name for p in search_space(model) if p.name in P0_NAMES)
+
+
+def defaults(model: str) -> dict[str, float]:
+    """Default value of every parameter ``model`` uses, by name (flat: ``p0_ii`` keys)."""
+    return {p.name: p.default for p in search_space(model)}
