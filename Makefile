@@ -4,7 +4,7 @@ VENV   ?= .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
 
-.PHONY: run test lint contracts format stability bench clean
+.PHONY: run test lint contracts typecheck format stability bench clean
 
 $(STAMP): pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -23,11 +23,15 @@ lint: $(STAMP)
 contracts: $(STAMP)
 	$(BIN)/lint-imports
 
+# mypy on core/ as configured in pyproject.toml [tool.mypy] (incremental: .mypy_cache)
+typecheck: $(STAMP)
+	$(BIN)/mypy
+
 format: $(STAMP)
 	$(BIN)/ruff format .
 	$(BIN)/ruff check --fix .
 
-test: lint contracts
+test: lint contracts typecheck
 	QT_QPA_PLATFORM=offscreen $(BIN)/python -m pytest
 
 stability: $(STAMP)
@@ -37,4 +41,4 @@ bench: $(STAMP)
 	$(BIN)/radartune bench all
 
 clean:
-	rm -rf $(VENV) .pytest_cache .ruff_cache .import_linter_cache .grimp_cache
+	rm -rf $(VENV) .pytest_cache .ruff_cache .import_linter_cache .grimp_cache .mypy_cache
