@@ -15,11 +15,13 @@ import json
 import platform
 from pathlib import Path
 
-BENCHMARKS = ("sim", "track", "tune", "fidelity", "dataset", "false_alarms")
+BENCHMARKS = ("sim", "track", "tune", "fidelity", "dataset", "false_alarms", "cvca")
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
-    p = sub.add_parser("bench", help="measure speed (and error against run time)")
+    p = sub.add_parser(
+        "bench", help="measure speed (and error against run time); cvca: CV against CA"
+    )
     p.add_argument("name", choices=(*BENCHMARKS, "all"))
     p.add_argument(
         "--out-dir", default="bench/results", help="folder for <name>.json (default: %(default)s)"
