@@ -16,13 +16,16 @@ import platform
 from pathlib import Path
 
 BENCHMARKS = ("sim", "track", "tune", "fidelity", "dataset", "false_alarms", "cvca")
+#: not part of ``all``: hours of studies (16 x 1000 trials)
+LONG = ("cvca_seeds",)
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
-        "bench", help="measure speed (and error against run time); cvca: CV against CA"
+        "bench",
+        help="measure speed (and error against run time); cvca, cvca_seeds: CV against CA",
     )
-    p.add_argument("name", choices=(*BENCHMARKS, "all"))
+    p.add_argument("name", choices=(*BENCHMARKS, *LONG, "all"))
     p.add_argument(
         "--out-dir", default="bench/results", help="folder for <name>.json (default: %(default)s)"
     )
