@@ -6,6 +6,7 @@ The layer contracts (which package may import which) are import-linter contracts
 
 from __future__ import annotations
 
+import ast
 import pkgutil
 import subprocess
 import sys
@@ -154,3 +155,44 @@ def test_no_import_cycle_in_core_or_app(cycles: list[frozenset[str]]) -> None:
 def test_known_cycles_still_exist(cycles: list[frozenset[str]]) -> None:
     fixed = [name for c, name in KNOWN_CYCLES.items() if c not in cycles]
     assert fixed == [], f"fixed, remove from KNOWN_CYCLES: {fixed}"
+
+
+# Private names (`_x`) imported from another module; each is being removed. A fixed entry
+# fails `test_known_private_imports_still_exist`, so the entry goes with the fix.
+KNOWN_PRIVATE_IMPORTS: dict[tuple[str, str, str], str] = {
+    # branch `tracking`: the model comparison moves into core/evaluation/ without it
+    ("core/model_comparison.py", "core.tracking.batch", "_prepare"): "branch tracking",
+    # the sim benchmark's plain CFAR reuses the chain's effective training-cell count
+    # not yet addressed: names the fast level and its kernels share with processing/simulation
+    ("core/benchmarks/sim.py", "core.processing.cfar", "_effective"): "to be made public",
+    ("core/simulation/fast.py", "core.processing.cfar", "_METHOD_CODE"): "to be made public",
+    ("core/simulation/fast.py", "core.processing.points", "_points_kernel"): "to be made public",
+    ("core/simulation/rng_kernels.py", "core.simulation.gaussian", "_slow_draw"): "idem",
+}
+
+
+def private_imports() -> set[tuple[str, str, str]]:
+    """(file, module, name) of every `from core|app... import _name` in core/ and app/."""
+    found = set()
+    for top in ("core", "app"):
+        for path in sorted((ROOT / top).rglob("*.py")):
+            for node in ast.walk(ast.parse(path.read_text(), str(path))):
+                if not isinstance(node, ast.ImportFrom) or node.level or not node.module:
+                    continue
+                if node.module.split(".")[0] not in ("core", "app"):
+                    continue
+                for alias in node.names:
+                    if alias.name.startswith("_") and not alias.name.startswith("__"):
+                        rel = path.relative_to(ROOT).as_posix()
+                        found.add((rel, node.module, alias.name))
+    return found
+
+
+def test_no_private_name_imported_across_modules() -> None:
+    new = sorted(private_imports() - set(KNOWN_PRIVATE_IMPORTS))
+    assert new == [], f"private names imported from another module: {new}"
+
+
+def test_known_private_imports_still_exist() -> None:
+    fixed = sorted(set(KNOWN_PRIVATE_IMPORTS) - private_imports())
+    assert fixed == [], f"fixed, remove from KNOWN_PRIVATE_IMPORTS: {fixed}"
