@@ -8,6 +8,9 @@
 - ``L_t`` of both models (eq. 14) and the paired comparison over the trajectories
   (:func:`core.model_comparison.paired_comparison`: ratio of the totals with a class-stratified
   bootstrap interval, wins, Wilcoxon);
+- the motion model isolated: CA's parameters with the CV model (the acceleration entries of
+  p0 dropped) and q_coeff re-scanned (:data:`Q_GRID` and CA's own q), the best against CA's
+  own, paired (decision cvca2-01, item 4);
 - per class, each model's loss split into transient, manoeuvre and steady frames
   (:func:`core.model_comparison.loss_breakdown`), with N_c, the first confirmed frame and the
   mean along-track error;
@@ -21,11 +24,12 @@ recheck.json), the loss breakdown of ``bench/cvca2_diagnose.py`` (docs/report/cv
 and ``bench/cvca_cross_eval.py`` (docs/report/extended-person/cross_evaluation.json).
 
 ``--quick``: the first five trajectories (one per class) of paper:0, simulated without the
-cache, and the default CV and CA parameters; seconds once numba's cache is warm.
+cache, the default CV and CA parameters, 5 values of q; seconds once numba's cache is warm.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import time
 from dataclasses import dataclass
@@ -35,10 +39,10 @@ from typing import Any
 import numpy as np
 
 from core.dataset import Dataset
-from core.evaluation import evaluate, person_point_spread
+from core.evaluation import evaluate, person_point_spread, trajectory_losses
 from core.model_comparison import loss_breakdown, paired_comparison, track_with_ids
 from core.pipeline import paper_dataset
-from core.tracking import TrackerParams
+from core.tracking import TrackerParams, track_dataset
 
 #: Committed CV/CA parameter pairs: name -> (CV file, CA file); ``polish:<model>`` is the
 #: ``params`` entry of docs/report/cv-vs-ca/polish.json.
@@ -64,6 +68,9 @@ POLISH_FILE = "docs/report/cv-vs-ca/polish.json"
 #: (label, seed, person model) of the data sets of the full run
 DATASETS = (("paper:0", 0, "point"), ("paper:1", 1, "point"), ("paper:0:extended", 0, "extended"))
 QUICK_TRAJECTORIES = 5
+#: q_coeff values of the matched comparison: log-spaced over eq. (15)'s range [0.1, 30]
+Q_GRID = tuple(np.geomspace(0.1, 30.0, 25).tolist())
+QUICK_Q_GRID = tuple(np.geomspace(0.1, 30.0, 5).tolist())
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -107,8 +114,39 @@ def track_model(dataset: Dataset, params: TrackerParams) -> ModelRun:
     )
 
 
-def compare(dataset: Dataset, params_cv: TrackerParams, params_ca: TrackerParams) -> dict:
-    """Both parameter sets on one data set and their paired comparison (JSON-ready)."""
+def matched(
+    dataset: Dataset, params_ca: TrackerParams, loss_ca: np.ndarray, q_grid: tuple[float, ...]
+) -> dict:
+    """CA's parameters with the CV motion model, q_coeff re-scanned, against CA's own losses.
+
+    The grid is ``q_grid`` plus CA's own q_coeff; everything but the motion model, the
+    acceleration entries of p0 and q_coeff is CA's. Losses in m².
+    """
+    cv = dataclasses.replace(params_ca, model="cv", p0=tuple(params_ca.p0 or ())[:4])
+    grid = sorted({*q_grid, params_ca.q_coeff})
+    per_q = [
+        trajectory_losses(dataset, track_dataset(dataset, dataclasses.replace(cv, q_coeff=q)))
+        for q in grid
+    ]
+    totals = [float(v.mean()) for v in per_q]
+    i = int(np.argmin(totals))
+    classes = np.asarray(dataset.trajectory_class).astype(str)
+    return {
+        "q_grid": grid,
+        "loss_total": totals,
+        "best_q": grid[i],
+        "best_x1e3": 1e3 * totals[i],
+        "paired_with_ca": paired_comparison(per_q[i], loss_ca, classes).to_dict(),
+    }
+
+
+def compare(
+    dataset: Dataset,
+    params_cv: TrackerParams,
+    params_ca: TrackerParams,
+    q_grid: tuple[float, ...] = Q_GRID,
+) -> dict:
+    """Both parameter sets on one data set, their paired comparison and the matched one."""
     runs = {"cv": track_model(dataset, params_cv), "ca": track_model(dataset, params_ca)}
     classes = np.asarray(dataset.trajectory_class).astype(str)
     pc = paired_comparison(runs["cv"].loss, runs["ca"].loss, classes)
@@ -116,6 +154,7 @@ def compare(dataset: Dataset, params_cv: TrackerParams, params_ca: TrackerParams
         "cv_x1e3": 1e3 * runs["cv"].loss_total,
         "ca_x1e3": 1e3 * runs["ca"].loss_total,
         "paired": pc.to_dict(),
+        "matched_cv_with_ca_params": matched(dataset, params_ca, runs["ca"].loss, q_grid),
         "trajectory_loss": {m: r.loss.tolist() for m, r in runs.items()},
         "breakdown": {m: r.breakdown for m, r in runs.items()},
     }
@@ -138,12 +177,16 @@ def pairs(quick: bool = False) -> dict[str, tuple[TrackerParams, TrackerParams]]
     return available_pairs()
 
 
-def table(sets: dict[str, Dataset], params: dict[str, tuple[TrackerParams, TrackerParams]]) -> dict:
+def table(
+    sets: dict[str, Dataset],
+    params: dict[str, tuple[TrackerParams, TrackerParams]],
+    q_grid: tuple[float, ...] = Q_GRID,
+) -> dict:
     """Every pair on every data set (:func:`compare`), and each data set's point spread."""
     rows = []
     for label, ds in sets.items():
         for name, (p_cv, p_ca) in params.items():
-            rows.append({"dataset": label, "parameters": name, **compare(ds, p_cv, p_ca)})
+            rows.append({"dataset": label, "parameters": name, **compare(ds, p_cv, p_ca, q_grid)})
     return {
         "datasets": {
             label: {
@@ -166,17 +209,18 @@ def run(quick: bool = False) -> dict:
     t0 = time.perf_counter()
     sets = datasets(quick)
     t1 = time.perf_counter()
-    out = table(sets, pairs(quick))
+    out = table(sets, pairs(quick), QUICK_Q_GRID if quick else Q_GRID)
     return {**out, "datasets_s": t1 - t0, "tracking_s": time.perf_counter() - t1}
 
 
 def summary(result: dict) -> str:
     lines = ["CV against CA, L_t x1e-3 (eq. 14), paired over the trajectories:"]
     for r in result["rows"]:
-        p = r["paired"]
+        p, m = r["paired"], r["matched_cv_with_ca_params"]
         lines.append(
             f"  {r['dataset']:<18} {r['parameters'][:40]:<40} CV {r['cv_x1e3']:8.4f}  "
             f"CA {r['ca_x1e3']:8.4f}  CV/CA {p['ratio']:.2f} [{p['ci_low']:.2f}, "
-            f"{p['ci_high']:.2f}]  wins {p['wins_a']}/{p['wins_b']}"
+            f"{p['ci_high']:.2f}]  wins {p['wins_a']}/{p['wins_b']}  CV with CA's parameters "
+            f"{m['best_x1e3']:8.4f} (q {m['best_q']:.3g})"
         )
     return "\n".join(lines)

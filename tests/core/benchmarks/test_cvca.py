@@ -25,7 +25,7 @@ def result() -> dict:
     sets = cvca.datasets(quick=True)
     params = cvca.pairs(quick=True)
     cv = params["defaults"][0]
-    return cvca.table(sets, {**params, "cv against itself": (cv, cv)})
+    return cvca.table(sets, {**params, "cv against itself": (cv, cv)}, cvca.QUICK_Q_GRID)
 
 
 def _rows(result: dict, parameters: str) -> list[dict]:
@@ -77,6 +77,21 @@ def test_a_model_against_itself_is_a_tie(result: dict) -> None:
     (defaults,) = _rows(result, "defaults")
     # the same CV run as in the defaults pair: tracking is deterministic
     assert row["trajectory_loss"]["cv"] == defaults["trajectory_loss"]["cv"]
+
+
+def test_matched_comparison_scans_q_around_the_other_parameters(result: dict) -> None:
+    for row in result["rows"]:
+        m = row["matched_cv_with_ca_params"]
+        assert m["best_x1e3"] == pytest.approx(1e3 * min(m["loss_total"]), rel=1e-12)
+        assert m["best_q"] == m["q_grid"][int(np.argmin(m["loss_total"]))]
+        ratio = m["best_x1e3"] / row["ca_x1e3"]
+        assert m["paired_with_ca"]["ratio"] == pytest.approx(ratio, rel=1e-9)
+    # swapping a CV parameter set to CV changes nothing: at its own q it scores its own L_t
+    (row,) = _rows(result, "cv against itself")
+    m = row["matched_cv_with_ca_params"]
+    own = m["q_grid"].index(TrackerParams(model="cv").q_coeff)
+    assert m["loss_total"][own] == pytest.approx(row["cv_x1e3"] / 1e3, rel=1e-12)
+    assert m["best_x1e3"] <= row["cv_x1e3"]
 
 
 def test_result_is_json_and_summary_has_a_line_per_row(result: dict) -> None:
