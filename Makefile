@@ -4,7 +4,7 @@ VENV   ?= .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
 
-.PHONY: run test lint format stability bench clean
+.PHONY: run test lint contracts typecheck format stability bench clean
 
 $(STAMP): pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -19,11 +19,19 @@ lint: $(STAMP)
 	$(BIN)/ruff check .
 	$(BIN)/ruff format --check .
 
+# layer contracts of pyproject.toml [tool.importlinter]: which package may import which
+contracts: $(STAMP)
+	$(BIN)/lint-imports
+
+# mypy on core/ as configured in pyproject.toml [tool.mypy] (incremental: .mypy_cache)
+typecheck: $(STAMP)
+	$(BIN)/mypy
+
 format: $(STAMP)
 	$(BIN)/ruff format .
 	$(BIN)/ruff check --fix .
 
-test: lint
+test: lint contracts typecheck
 	QT_QPA_PLATFORM=offscreen $(BIN)/python -m pytest
 
 stability: $(STAMP)
@@ -33,4 +41,4 @@ bench: $(STAMP)
 	$(BIN)/radartune bench all
 
 clean:
-	rm -rf $(VENV) .pytest_cache .ruff_cache
+	rm -rf $(VENV) .pytest_cache .ruff_cache .import_linter_cache .grimp_cache .mypy_cache

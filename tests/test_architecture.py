@@ -1,11 +1,20 @@
-"""Architecture rules: ``core`` never imports Qt."""
+"""Architecture rules: ``core`` never imports Qt; no import cycle in ``core`` or ``app``.
+
+The layer contracts (which package may import which) are import-linter contracts in
+``pyproject.toml``, checked by ``lint-imports`` in ``make test``.
+"""
 
 from __future__ import annotations
 
+import ast
 import pkgutil
 import subprocess
 import sys
+from collections.abc import Iterable, Mapping
 from pathlib import Path
+
+import grimp
+import pytest
 
 import core
 
@@ -48,3 +57,142 @@ def test_no_qt_import_statement_in_core_sources() -> None:
             if s.startswith(("import ", "from ")) and any(q in s.split()[1] for q in QT_MODULES):
                 offenders.append(f"{path.relative_to(ROOT)}: {s}")
     assert offenders == []
+
+
+# Import cycles that exist today and are being removed; each entry is the exact set of modules
+# of one cycle (strongly connected component). A listed cycle that no longer exists fails
+# `test_known_cycles_still_exist`, so the entry is removed with the fix.
+KNOWN_CYCLES: dict[frozenset[str], str] = {
+    # branch `app`: the GUI's arguments move to the app; the CLI finds the app lazily
+    frozenset({"core.cli.gui", "app.main"}): "core/cli/gui.py <-> app/main.py",
+    # branch `tracking`: result types, constants and the input validator get their own module
+    frozenset({"core.tracking.tracker", "core.tracking.kernel"}): "tracker.py <-> kernel.py",
+}
+
+
+def import_cycles(imports: Mapping[str, Iterable[str]]) -> list[frozenset[str]]:
+    """Every import cycle: the strongly connected components with more than one module, and
+    single modules that import themselves (Tarjan's algorithm, iterative)."""
+    index: dict[str, int] = {}
+    low: dict[str, int] = {}
+    stack: list[str] = []
+    on_stack: set[str] = set()
+    cycles: list[frozenset[str]] = []
+    for root in sorted(imports):
+        if root in index:
+            continue
+        work = [(root, iter(sorted(imports.get(root, ()))))]
+        index[root] = low[root] = len(index)
+        stack.append(root)
+        on_stack.add(root)
+        while work:
+            v, children = work[-1]
+            w = next(children, None)
+            if w is not None:
+                if w not in index:
+                    index[w] = low[w] = len(index)
+                    stack.append(w)
+                    on_stack.add(w)
+                    work.append((w, iter(sorted(imports.get(w, ())))))
+                elif w in on_stack:
+                    low[v] = min(low[v], index[w])
+                continue
+            work.pop()
+            if work:
+                low[work[-1][0]] = min(low[work[-1][0]], low[v])
+            if low[v] == index[v]:
+                component = set()
+                while True:
+                    w = stack.pop()
+                    on_stack.discard(w)
+                    component.add(w)
+                    if w == v:
+                        break
+                if len(component) > 1 or v in imports.get(v, ()):
+                    cycles.append(frozenset(component))
+    return cycles
+
+
+def project_imports() -> dict[str, set[str]]:
+    """Module -> modules of core and app it imports (at load or inside a function)."""
+    graph = grimp.build_graph("core", "app", cache_dir=None)
+    return {m: set(graph.find_modules_directly_imported_by(m)) for m in graph.modules}
+
+
+@pytest.fixture(scope="module")
+def cycles() -> list[frozenset[str]]:
+    return import_cycles(project_imports())
+
+
+def test_cycle_finder_finds_cycles_and_only_cycles() -> None:
+    imports = {
+        "a": {"b"},
+        "b": {"c"},
+        "c": {"a", "d"},  # a -> b -> c -> a
+        "d": {"e"},
+        "e": set(),  # d -> e: no cycle
+        "f": {"f"},  # a module importing itself
+        "g": {"h"},
+        "h": {"g"},  # g <-> h
+    }
+    assert sorted(map(sorted, import_cycles(imports))) == [["a", "b", "c"], ["f"], ["g", "h"]]
+    assert import_cycles({"a": {"b"}, "b": {"c"}, "c": set()}) == []
+
+
+def test_graph_sees_lazy_imports_and_namespace_free_packages() -> None:
+    imports = project_imports()
+    # a function-level import is an import too (core/cli/worker.py imports the study only
+    # inside its `run`); app/views must be a package for the contracts to see it
+    assert "core.optimization.study" in imports["core.cli.worker"]
+    assert "app.data" in imports["app.views.top_view"]
+
+
+def test_no_import_cycle_in_core_or_app(cycles: list[frozenset[str]]) -> None:
+    new = [sorted(c) for c in cycles if c not in KNOWN_CYCLES]
+    assert new == [], f"import cycles: {new}"
+
+
+def test_known_cycles_still_exist(cycles: list[frozenset[str]]) -> None:
+    fixed = [name for c, name in KNOWN_CYCLES.items() if c not in cycles]
+    assert fixed == [], f"fixed, remove from KNOWN_CYCLES: {fixed}"
+
+
+# Private names (`_x`) imported from another module; each is being removed. A fixed entry
+# fails `test_known_private_imports_still_exist`, so the entry goes with the fix.
+KNOWN_PRIVATE_IMPORTS: dict[tuple[str, str, str], str] = {
+    # branch `tracking`: the model comparison moves into core/evaluation/ without it
+    ("core/model_comparison.py", "core.tracking.batch", "_prepare"): "branch tracking",
+    # the sim benchmark's plain CFAR reuses the chain's effective training-cell count
+    # not yet addressed: names the fast level and its kernels share with processing/simulation
+    ("core/benchmarks/sim.py", "core.processing.cfar", "_effective"): "to be made public",
+    ("core/simulation/fast.py", "core.processing.cfar", "_METHOD_CODE"): "to be made public",
+    ("core/simulation/fast.py", "core.processing.points", "_points_kernel"): "to be made public",
+    ("core/simulation/rng_kernels.py", "core.simulation.gaussian", "_slow_draw"): "idem",
+}
+
+
+def private_imports() -> set[tuple[str, str, str]]:
+    """(file, module, name) of every `from core|app... import _name` in core/ and app/."""
+    found = set()
+    for top in ("core", "app"):
+        for path in sorted((ROOT / top).rglob("*.py")):
+            for node in ast.walk(ast.parse(path.read_text(), str(path))):
+                if not isinstance(node, ast.ImportFrom) or node.level or not node.module:
+                    continue
+                if node.module.split(".")[0] not in ("core", "app"):
+                    continue
+                for alias in node.names:
+                    if alias.name.startswith("_") and not alias.name.startswith("__"):
+                        rel = path.relative_to(ROOT).as_posix()
+                        found.add((rel, node.module, alias.name))
+    return found
+
+
+def test_no_private_name_imported_across_modules() -> None:
+    new = sorted(private_imports() - set(KNOWN_PRIVATE_IMPORTS))
+    assert new == [], f"private names imported from another module: {new}"
+
+
+def test_known_private_imports_still_exist() -> None:
+    fixed = sorted(set(KNOWN_PRIVATE_IMPORTS) - private_imports())
+    assert fixed == [], f"fixed, remove from KNOWN_PRIVATE_IMPORTS: {fixed}"

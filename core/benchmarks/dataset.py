@@ -14,6 +14,8 @@ from __future__ import annotations
 
 import os
 import time
+from collections.abc import Callable
+from typing import TypeVar
 
 import numpy as np
 
@@ -21,8 +23,10 @@ from core.pipeline import build_dataset, plan, simulate_scene
 from core.pointcloud import POINT_FIELDS
 from core.scene import class_scene
 
+T = TypeVar("T")
 
-def _time(fn) -> tuple[float, object]:
+
+def _time(fn: Callable[[], T]) -> tuple[float, T]:
     t0 = time.perf_counter()
     out = fn()
     return time.perf_counter() - t0, out

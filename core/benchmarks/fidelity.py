@@ -29,6 +29,7 @@ from __future__ import annotations
 import json
 import time
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -262,7 +263,7 @@ def run(quick: bool = False, params_cv=None, params_ca=None) -> dict:
     levels = list(FIDELITY_LEVELS)
     n_seeds = {name: seeds.get(name, 2) for name in levels}
     runs = [(name, s) for s in range(max(n_seeds.values())) for name in levels if s < n_seeds[name]]
-    acc = {
+    acc: dict[tuple[str, int], dict[str, Any]] = {
         run: {"cpu_s": 0.0, "frames": 0, "parts": [], "err": [], "snr": [], "hit": []}
         for run in runs
     }
@@ -270,7 +271,7 @@ def run(quick: bool = False, params_cv=None, params_ca=None) -> dict:
     stat_runs = {(name, 0) for name in levels} | {("exact", 1)}
     # the per-frame entry point of levels that have a batch one (the GUI's path), seed 0
     per_frame = {name: {"cpu_s": 0.0, "frames": 0} for name in levels if _batch_simulator(name)}
-    truth = {"xy": [], "v": [], "t": [], "traj": [], "cls": []}
+    truth: dict[str, list[Any]] = {"xy": [], "v": [], "t": [], "traj": [], "cls": []}
     setup_s = {}
     for k, scene in enumerate(scenes):
         frames, antenna, settings, elevation, refl = _frames(scene, scene.seed)
@@ -348,7 +349,7 @@ def run(quick: bool = False, params_cv=None, params_ca=None) -> dict:
         truth["cls"].append(scene.trajectory_class)
 
     # data sets and tracking: the same parameters on every level's point clouds
-    tracking = {}
+    tracking: dict[tuple[tuple[str, int], str], dict[str, Any]] = {}
     for run in runs:
         a = acc[run]
         merged = PointCloud.concatenate([m for m, _ in a["parts"]])

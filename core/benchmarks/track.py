@@ -43,7 +43,13 @@ def _first_trajectories(ds, k: int):
 
     f_end = int(ds.trajectory_offsets[k])
     p_end = int(ds.frame_offsets[f_end])
-    per_point = ("frame", "range_m", "azimuth_rad", "elevation_rad", "radial_velocity_mps")
+    per_point: tuple[str, ...] = (
+        "frame",
+        "range_m",
+        "azimuth_rad",
+        "elevation_rad",
+        "radial_velocity_mps",
+    )
     per_point += ("snr_db", "x_m", "y_m", "z_m", "source")
     per_frame = ("trajectory", "truth_t_s", "truth_xy_m", "truth_v_mps")
     return replace(

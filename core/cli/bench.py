@@ -15,12 +15,17 @@ import json
 import platform
 from pathlib import Path
 
-BENCHMARKS = ("sim", "track", "tune", "fidelity", "dataset", "false_alarms")
+BENCHMARKS = ("sim", "track", "tune", "fidelity", "dataset", "false_alarms", "cvca")
+#: not part of ``all``: hours of studies (16 x 1000 trials)
+LONG = ("cvca_seeds",)
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
-    p = sub.add_parser("bench", help="measure speed (and error against run time)")
-    p.add_argument("name", choices=(*BENCHMARKS, "all"))
+    p = sub.add_parser(
+        "bench",
+        help="measure speed (and error against run time); cvca, cvca_seeds: CV against CA",
+    )
+    p.add_argument("name", choices=(*BENCHMARKS, *LONG, "all"))
     p.add_argument(
         "--out-dir", default="bench/results", help="folder for <name>.json (default: %(default)s)"
     )

@@ -4,6 +4,10 @@ from __future__ import annotations
 
 import argparse
 import json
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from core.config import RadarConfig
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
@@ -15,7 +19,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(func=run)
 
 
-def describe(radar) -> dict:
+def describe(radar: RadarConfig) -> dict[str, Any]:
     """Fields and derived values of ``radar`` as one flat JSON-ready dict."""
     return {"name": radar.name, **radar.to_dict(), **radar.derived()}
 

@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Container, Sequence
+from collections.abc import Collection, Sequence
 from dataclasses import dataclass, field
 from typing import Any, Protocol
 
@@ -173,7 +173,7 @@ def evaluate(
     *,
     trial: Reports | None = None,
     pruner: str = "asha",
-    prune_steps: Container[int] | None = None,
+    prune_steps: Collection[int] | None = None,
 ) -> TrialResult:
     """L_t of ``params`` (eq. 14), reporting to ``trial`` after every trajectory.
 

@@ -197,7 +197,9 @@ def pick_maneuvering(dataset: Any, classes: Sequence[str] = ("c", "d", "e")) -> 
     return out
 
 
-def plot_tracks(dataset: Any, estimates: dict[str, Any], trajectories: Sequence[int], path: Path):
+def plot_tracks(
+    dataset: Any, estimates: dict[str, Any], trajectories: Sequence[int], path: Path
+) -> None:
     """Truth and the CV / CA estimates (confirmed frames) of some trajectories, radar at origin."""
     import matplotlib
 
