@@ -222,8 +222,8 @@ def _frames(scene, seed):
     p = pipeline.plan(scene)
     antenna = sim.AntennaGain.draw(scene.radar, pipeline.stage_rng(seed, "antenna"))
     settings = pipeline.processing_settings(scene)
-    # the pipeline's reflector builder (private: the bench needs the frames without simulating)
-    refl = pipeline._Reflectors.build(scene, p, seed, antenna, settings)
+    # the pipeline's reflector builder (the bench needs the frames without simulating)
+    refl = pipeline.Reflectors.build(scene, p, seed, antenna, settings)
     frames = refl.frames()[0]
     return frames, antenna, settings, p.elevation, refl
 

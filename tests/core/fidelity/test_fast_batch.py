@@ -28,7 +28,7 @@ def trajectory():
     scene = paper_scenes(0, 1)[0]
     antenna = AntennaGain.draw(scene.radar, pipeline.stage_rng(scene.seed, "antenna"))
     settings = pipeline.processing_settings(scene)
-    refl = pipeline._Reflectors.build(scene, pipeline.plan(scene), scene.seed, antenna, settings)
+    refl = pipeline.Reflectors.build(scene, pipeline.plan(scene), scene.seed, antenna, settings)
     frames = [refl.frame(f)[0] for f in range(40)]
     frames[7] = Scatterers.empty()  # a frame without reflectors
     return scene.radar, frames, antenna, settings
