@@ -229,15 +229,10 @@ def _frames(scene, seed):
 
 
 def _batch_simulator(name: str):
-    """The level's all-frames entry point (``core.pipeline.BATCH_SIMULATORS``) or None."""
-    import importlib
+    """The level's all-frames entry point (``core.simulation.LEVELS``) or None."""
+    from core.simulation import LEVELS
 
-    from core import pipeline
-
-    if name not in pipeline.BATCH_SIMULATORS:
-        return None
-    module, fn = pipeline.BATCH_SIMULATORS[name].split(":")
-    return getattr(importlib.import_module(module), fn)
+    return LEVELS[name].simulate_frames
 
 
 def run(quick: bool = False, params_cv=None, params_ca=None) -> dict:
@@ -562,7 +557,7 @@ def run(quick: bool = False, params_cv=None, params_ca=None) -> dict:
         "bootstrap": f"{N_BOOTSTRAP} paired resamples of the {len(scenes)} trajectories",
         "tracker_parameters": params_said,
         "timing": "process CPU time of the simulator call only (for a level with a batch entry "
-        "point, core.pipeline.BATCH_SIMULATORS: the one call for all frames of a trajectory, "
+        "point, LEVELS[...].simulate_frames: the one call for all frames of a trajectory, "
         "as the data-set path runs it; its per-frame call, the GUI's path, is listed too), "
         "levels interleaved per trajectory, after a warm-up call (set-up time listed "
         "separately); the pipeline's per-frame generators and reflectors are built outside "

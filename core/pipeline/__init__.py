@@ -32,25 +32,20 @@ from core.pipeline.frames import (
     simulate_scene,
 )
 from core.pipeline.plan import (
-    BATCH_SIMULATORS,
     CONSUMERS,
-    SIMULATORS,
     Plan,
     Stage,
     plan,
     processing_settings,
     scene_clutter_density,
     simulator,
-    simulator_path,
 )
 from core.pipeline.reflectors import Reflectors, frame_scatterers
 from core.pipeline.streams import stage_rng
 
 __all__ = [
-    "BATCH_SIMULATORS",
     "CACHE_VERSION",
     "CONSUMERS",
-    "SIMULATORS",
     "FrameResult",
     "Plan",
     "ProgressCallback",
@@ -70,7 +65,6 @@ __all__ = [
     "scene_clutter_density",
     "simulate_scene",
     "simulator",
-    "simulator_path",
     "stage_rng",
     "trajectory_seeds",
 ]

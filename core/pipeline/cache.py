@@ -18,7 +18,6 @@ from core.config import RadarConfig
 from core.dataset import Dataset
 from core.errors import InputError
 from core.pipeline.frames import ProgressCallback, simulate_scene
-from core.pipeline.plan import simulator_path
 from core.pointcloud import PointCloud
 from core.scene import Scene, paper_scenes
 
@@ -129,9 +128,11 @@ def build_dataset(
     use_cache
         Read and write ``<cache_dir>/datasets/<key>.npz`` (key: :func:`dataset_key`).
     """
+    from core.simulation.levels import fidelity_level
+
     if not scenes:
         raise InputError("a data set needs at least one scene")
-    simulator_path(fidelity)
+    fidelity_level(fidelity)  # InputError for an unknown level
     radar: RadarConfig = scenes[0].radar
     if any(s.radar != radar for s in scenes):
         raise InputError("all scenes of a data set must use the same radar configuration")

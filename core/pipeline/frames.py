@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import importlib
 import json
 import time
 from collections.abc import Callable, Iterator, Sequence
@@ -12,7 +11,7 @@ import numpy as np
 
 from core.dataset import Dataset
 from core.errors import InputError
-from core.pipeline.plan import BATCH_SIMULATORS, Plan, plan, processing_settings, simulator
+from core.pipeline.plan import Plan, plan, processing_settings, simulator
 from core.pipeline.reflectors import Reflectors
 from core.pipeline.streams import stage_rng
 from core.pointcloud import PointCloud
@@ -155,7 +154,9 @@ def simulate_scene(
     t0 = time.perf_counter()
     p = the_plan or plan(scene, keep_rd_maps=keep_rd_maps, fidelity=fidelity)
     seed = scene.seed if seed is None else int(seed)
-    batch = p.fidelity in BATCH_SIMULATORS and scene.n_frames > 0
+    from core.simulation.levels import fidelity_level
+
+    batch = fidelity_level(p.fidelity).simulate_frames is not None and scene.n_frames > 0
     if batch and not p.keep_rd_maps and p.consumer != "study":
         return _simulate_scene_batch(scene, p, seed, progress, t0)
     clouds, maps, n_clutter = [], [], []
@@ -189,8 +190,7 @@ def _simulate_scene_batch(
     and noise generator as :func:`iter_frames` builds them, then one call for all frames."""
     from core import simulation as sim
 
-    module, name = BATCH_SIMULATORS[p.fidelity].split(":")
-    simulate = getattr(importlib.import_module(module), name)
+    simulate = sim.fidelity_level(p.fidelity).simulate_frames
     radar = scene.radar
     settings = processing_settings(scene)
     antenna = sim.AntennaGain.draw(radar, stage_rng(seed, "antenna"))

@@ -11,31 +11,16 @@ tracker assumes for it.
 from __future__ import annotations
 
 import dataclasses
-import importlib
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING
 
 from core.config import DEFAULT_PROCESSING, ProcessingSettings
 from core.errors import InputError
 from core.scene import Scene, expected_clutter_count
 
-#: Frame simulators by fidelity level: name -> "module:function", all with the signature of
-#: ``core.simulation.simulate_frame``. Adding a level is one line.
-SIMULATORS: dict[str, str] = {
-    "exact": "core.simulation:simulate_frame",
-    "fast": "core.simulation:simulate_frame_fast",
-    "measurement": "core.simulation:simulate_frame_measurement",
-}
-
-#: Levels that can also simulate all frames of a scene in one call (the data-set path):
-#: name -> "module:function" with the signature of
-#: ``core.simulation.measurement.simulate_frames_measurement``. They must give the same frames
-#: as the per-frame simulator with the same per-frame generators (tested).
-BATCH_SIMULATORS: dict[str, str] = {
-    "fast": "core.simulation.fast:simulate_frames_fast",
-    "measurement": "core.simulation.measurement:simulate_frames_measurement",
-}
+if TYPE_CHECKING:
+    from core.simulation.levels import FrameSimulator
 
 # ---- the plan ----------------------------------------------------------------------------------
 
@@ -106,14 +91,17 @@ def plan(
     keep_rd_maps
         Keep the range-Doppler map of every frame (the GUI asks; a study does not).
     fidelity
-        Simulator level (a key of :data:`SIMULATORS`).
+        Simulator level (a key of :data:`core.simulation.LEVELS`).
     consumer
         ``"simulate"`` (CLI, data sets), ``"gui"`` (keeps range-Doppler maps) or ``"study"``
         (an optimisation trial: tracks cached point clouds, simulates nothing).
     force
         Stage names to run even where the plan would skip them (for tests and comparisons).
     """
-    simulator_path(fidelity)
+    # the registry is imported here, not at load: ``import core.pipeline`` stays light
+    from core.simulation.levels import fidelity_level
+
+    fidelity_level(fidelity)  # InputError for an unknown level
     if consumer not in CONSUMERS:
         raise InputError(f"consumer must be one of {list(CONSUMERS)}, got {consumer!r}")
     keep = keep_rd_maps or consumer == "gui"
@@ -221,20 +209,11 @@ def plan(
     return Plan(stages=stages, fidelity=fidelity, consumer=consumer)
 
 
-def simulator_path(fidelity: str) -> str:
-    """``"module:function"`` of a level's frame simulator (InputError for an unknown level)."""
-    try:
-        return SIMULATORS[fidelity]
-    except KeyError:
-        raise InputError(
-            f"fidelity must be one of {sorted(SIMULATORS)}, got fidelity={fidelity!r}"
-        ) from None
+def simulator(fidelity: str = "exact") -> FrameSimulator:
+    """The frame simulator of a fidelity level (:data:`core.simulation.LEVELS`)."""
+    from core.simulation.levels import fidelity_level
 
-
-def simulator(fidelity: str = "exact") -> Callable[..., Any]:
-    """The frame simulator of a fidelity level (signature of ``simulate_frame``)."""
-    module, name = simulator_path(fidelity).split(":")
-    return getattr(importlib.import_module(module), name)
+    return fidelity_level(fidelity).simulate_frame
 
 
 def processing_settings(scene: Scene) -> ProcessingSettings:

@@ -10,7 +10,7 @@ from core import pipeline
 from core.pointcloud import POINT_FIELDS
 from core.processing import Detections
 from core.scene import paper_scenes
-from core.simulation import AntennaGain, Scatterers
+from core.simulation import LEVELS, AntennaGain, Scatterers
 from core.simulation.fast import (
     cfar_range_bins,
     detected_channels,
@@ -89,7 +89,7 @@ def test_compiled_frame_equals_the_stage_functions(trajectory) -> None:
 
 def test_pipeline_uses_the_batch_path_with_the_per_frame_frames() -> None:
     scene = paper_scenes(0, 1)[0]
-    assert pipeline.BATCH_SIMULATORS["fast"].endswith(":simulate_frames_fast")
+    assert LEVELS["fast"].simulate_frames is simulate_frames_fast
     run = pipeline.simulate_scene(scene, fidelity="fast", seed=9)
     frames = list(pipeline.iter_frames(scene, fidelity="fast", seed=9, frames=range(12)))
     for fr in frames:
