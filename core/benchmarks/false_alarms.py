@@ -90,7 +90,7 @@ def run(quick: bool = False, n_frames: int | None = None) -> dict:
     for name, s in settings.items():
         fast_level._independent_stages.cache_clear()
         fast_level.independent_factors.cache_clear()
-        fast_level._cfar_arguments.cache_clear()
+        fast_level.cfar_arguments.cache_clear()
         for cached in (
             "_layout",
             "_grouping_table",
@@ -100,7 +100,7 @@ def run(quick: bool = False, n_frames: int | None = None) -> dict:
         ):
             getattr(false_alarms, cached).cache_clear()
         t0 = time.perf_counter()
-        fast_level._cfar_arguments(radar, s, L, radar.n_samples, radar.n_loops, True)
+        fast_level.cfar_arguments(radar, s, L, radar.n_samples, radar.n_loops, True)
         t_thresholds = time.perf_counter() - t0
         out = fast_level.simulate_frames_fast(
             radar,

@@ -91,22 +91,30 @@ from core.processing import (
     refine_bins,
     window,
 )
-from core.processing.cfar import _METHOD_CODE, pfa_caso, threshold_factor, two_stage_kernel
+from core.processing.cfar import (
+    CfarStageArgs,
+    TwoStageCfarArgs,
+    effective_cells_or_none,
+    pfa_caso,
+    stage_args,
+    threshold_factor,
+    two_stage_kernel,
+)
 from core.processing.false_alarms import (
     StageFactors,
     cells_correlated,
     noise_detections_per_frame,
 )
 from core.processing.points import (  # noqa: F401  (angles_of: re-exported for measurement)
-    _points_kernel,
     angle_twiddles,
     angles_of,
     array_rows,
     cloud_from_rows,
     detection_rows,
     point_rows,
+    points_kernel,
 )
-from core.processing.spectrum import clutter_removal_noise_profile, effective_cells
+from core.processing.spectrum import clutter_removal_noise_profile
 from core.simulation.antenna import AntennaGain
 from core.simulation.baseband import steering_vectors
 from core.simulation.frame import FrameOutput, needs_elevation
@@ -782,25 +790,27 @@ def two_stage_cfar_compiled(
     """
     rd = np.ascontiguousarray(rd_map)
     L = radar.n_virtual if n_channels is None else n_channels
-    args = _cfar_arguments(radar, settings, L, rd.shape[0], rd.shape[1], independent_cells)
+    args = cfar_arguments(radar, settings, L, rd.shape[0], rd.shape[1], independent_cells)
     if args is None:
         return _no_detections()
-    r, d, noise = two_stage_kernel(rd, *args)
+    r, d, noise = two_stage_kernel(rd, args)
     return Detections(
         range_bin=r, doppler_index=d, power=rd[r, d].astype(np.float64), noise_power=noise
     )
 
 
 @functools.lru_cache(maxsize=64)
-def _cfar_arguments(
+def cfar_arguments(
     radar: RadarConfig,
     settings: ProcessingSettings,
     n_channels: int,
     n_r: int,
     n_d: int,
     independent_cells: bool,
-):
-    """Whitening profile, range limits, training windows and thresholds (cached)."""
+) -> TwoStageCfarArgs | None:
+    """Whitening profile, range limits, training windows and thresholds (cached); ``None`` when
+    no range bin lies inside the limits. ``independent_cells``: the thresholds for independent
+    cells (:func:`independent_cell_stages`) where the chain's cells are correlated."""
     k = np.arange(n_r) * radar.range_resolution_m
     in_range = (k >= settings.min_range_m) & (k <= settings.max_range_m)
     if not in_range.any():
@@ -823,13 +833,16 @@ def _cfar_arguments(
             _factors(make_cfar(rc, n_channels, ne_r)),
             _factors(make_cfar(dc, n_channels, ne_d)),
         )
-    return (
-        np.ascontiguousarray(profile, dtype=np.float64),
-        lo, hi, a, b,
-        rc.n_train, rc.n_guard, rc.cyclic, _METHOD_CODE[rc.method], rf.both, rf.one,
-        dc.n_train, dc.n_guard, dc.cyclic, _METHOD_CODE[dc.method], df.both, df.one,
-        settings.peak_grouping,
-    )  # fmt: skip
+    return TwoStageCfarArgs(
+        profile=np.ascontiguousarray(profile, dtype=np.float64),
+        lo=lo,
+        hi=hi,
+        a=a,
+        b=b,
+        range_stage=stage_args(rc.n_train, rc.n_guard, rc.cyclic, rc.method, rf.both, rf.one),
+        doppler_stage=stage_args(dc.n_train, dc.n_guard, dc.cyclic, dc.method, df.both, df.one),
+        peak_grouping=settings.peak_grouping,
+    )
 
 
 @functools.lru_cache(maxsize=16)
@@ -949,12 +962,6 @@ def chain_factors(
     return _factors(make_cfar(rc, n_channels, ne_r)), _factors(make_cfar(dc, n_channels, ne_d))
 
 
-def effective_cells_or_none(window_name: str, n_fft: int, n_train: int) -> float | None:
-    """Effective independent cells of ``n_train`` window-correlated ones (None: independent)."""
-    ne = effective_cells(window_name, n_fft, n_train)
-    return None if abs(ne - n_train) < 1e-9 else ne
-
-
 def _no_detections() -> Detections:
     e = np.zeros(0, dtype=np.int64)
     return Detections(range_bin=e, doppler_index=e, power=np.zeros(0), noise_power=np.zeros(0))
@@ -969,7 +976,7 @@ def points_compiled(
     elevation: bool,
 ) -> PointCloud:
     """:func:`points_from_channels`, compiled: the same point cloud (``source`` = -2)."""
-    r_bin, d_bin, az, el = _points_kernel(
+    r_bin, d_bin, az, el = points_kernel(
         rd,
         det.range_bin,
         det.doppler_index,
@@ -1095,104 +1102,106 @@ def _detected_channels_kernel(s, rd, r, d, cells_k, cells_d, x, along, ortho):  
     return out
 
 
+class SpectrumTables(NamedTuple):
+    """What the compiled frame kernel draws a frame's noise map and patches with."""
+
+    n_use: int  # range bins drawn (the CFAR's reach; all of them when the map is kept)
+    n_v: int  # virtual channels L
+    wd: np.ndarray  # (n_d,) Doppler window as _patches_kernel wants it (_doppler_weights)
+    b: np.ndarray  # (2J+1,) range window's cosine-sum coefficients
+    s2: np.ndarray  # (n_d,) per-channel cell noise power, V²
+    slot: np.ndarray  # (L,) TX slot of each virtual channel
+    threshold: float  # patch threshold relative to s2 (PATCH_THRESHOLD)
+    tw_r: np.ndarray  # (n_r,) range twiddles
+    tw_d: np.ndarray  # Doppler twiddles (see _twiddles)
+
+
+class PointTables(NamedTuple):
+    """What the compiled frame kernel turns detections into labelled points with."""
+
+    n_tx: int
+    n_rx: int
+    row_ch: np.ndarray  # azimuth row: channels
+    row_pos: np.ndarray  # azimuth row: positions (half wavelengths)
+    upper: np.ndarray  # elevation pairs: upper channels (empty without elevation)
+    lower: np.ndarray  # elevation pairs: lower channels
+    tw_a: np.ndarray  # angle FFT twiddles
+    res_r: float  # range resolution, m
+    res_v: float  # velocity resolution, m/s
+    t_mid: float  # the frame's middle, s (labels)
+    span: float  # unambiguous velocity span 2 v_max, m/s (labels)
+
+
+def spectrum_tables(
+    radar: RadarConfig, settings: ProcessingSettings, keep_rd_map: bool
+) -> SpectrumTables:
+    """The :class:`SpectrumTables` of a radar and settings."""
+    n_r, n_d, n_v = radar.n_samples, radar.n_loops, radar.n_virtual
+    tw_r, tw_d = _twiddles(n_r, n_d)
+    return SpectrumTables(
+        n_use=n_r if keep_rd_map else max(0, min(n_r, cfar_range_bins(radar, settings))),
+        n_v=n_v,
+        wd=_doppler_weights(settings.doppler_window, n_d),
+        b=_cosine_sum_coefficients(settings.range_window, n_r),
+        s2=cell_noise_power_v2(radar, settings),
+        slot=np.arange(n_v) // radar.n_rx,
+        threshold=PATCH_THRESHOLD,
+        tw_r=tw_r,
+        tw_d=tw_d,
+    )
+
+
+def point_tables(
+    radar: RadarConfig, settings: ProcessingSettings, elevation: bool, t_mid: float
+) -> PointTables:
+    """The :class:`PointTables` of a radar and settings (elevation pairs only if asked)."""
+    row_ch, row_pos, upper, lower = detection_rows(radar, elevation)
+    return PointTables(
+        n_tx=radar.n_tx,
+        n_rx=radar.n_rx,
+        row_ch=row_ch,
+        row_pos=row_pos,
+        upper=upper,
+        lower=lower,
+        tw_a=angle_twiddles(radar, settings.angle_fft_size),
+        res_r=radar.range_resolution_m,
+        res_v=radar.velocity_resolution_mps,
+        t_mid=t_mid,
+        span=2 * radar.max_velocity_mps,
+    )
+
+
+#: Stand-in CFAR arguments when no range bin lies inside the limits (``has_cfar`` False).
+_NO_CFAR = TwoStageCfarArgs(
+    profile=np.ones(1),
+    lo=0,
+    hi=0,
+    a=0,
+    b=0,
+    range_stage=CfarStageArgs(1, 0, False, 0, 1.0, 1.0),
+    doppler_stage=CfarStageArgs(1, 0, False, 0, 1.0, 1.0),
+    peak_grouping=False,
+)
+
+
 @numba.njit(cache=True, nogil=True)
 def _frame_kernel(
-    s,
-    rd,
-    amp,
-    theta,
-    slow,
-    slow1,
-    steer,
-    pos,
-    vel,
-    source,
-    elevation,
-    noise,
-    n_use,
-    wd,
-    b,
-    s2,
-    slot,
-    threshold,
-    tw_r,
-    tw_d,
-    has_cfar,
-    profile,
-    lo,
-    hi,
-    a,
-    bb,
-    rn,
-    rg,
-    rcyc,
-    rmeth,
-    ralpha,
-    ralpha1,
-    dn,
-    dg,
-    dcyc,
-    dmeth,
-    dalpha,
-    dalpha1,
-    peak,
-    n_tx,
-    n_rx,
-    row_ch,
-    row_pos,
-    upper,
-    lower,
-    tw_a,
-    res_r,
-    res_v,
-    t_mid,
-    span,
-):  # pragma: no cover
+    s, rd, amp, theta, slow, slow1, steer, pos, vel, source, elevation, noise, spec, has_cfar,
+    cfar, pts,
+):  # fmt: skip  # pragma: no cover
     """One frame after its noise map: patches, CFAR, detected channels, points, labels.
 
-    Returns ``(det_r, det_d, f64 (n, 8), source)`` with ``f64`` columns range, azimuth,
-    elevation, radial velocity, SNR, x, y, z.
+    ``amp`` … ``source``: the frame's reflectors (see :func:`_patches_kernel`); ``spec``:
+    :class:`SpectrumTables`; ``cfar``: :class:`~core.processing.cfar.TwoStageCfarArgs` (used
+    when ``has_cfar``); ``pts``: :class:`PointTables`. Returns ``(det_r, det_d, f64 (n, 8),
+    source)`` with ``f64`` columns range, azimuth, elevation, radial velocity, SNR, x, y, z.
     """
     cells_k, cells_d, x, along, ortho = _patches_kernel(
-        s,
-        rd,
-        amp,
-        theta,
-        slow,
-        slow1,
-        wd,
-        b,
-        s2,
-        steer,
-        slot,
-        threshold,
-        tw_r,
-        tw_d,
-        noise,
-        n_use,
-    )
+        s, rd, amp, theta, slow, slow1, spec.wd, spec.b, spec.s2, steer, spec.slot,
+        spec.threshold, spec.tw_r, spec.tw_d, noise, spec.n_use,
+    )  # fmt: skip
     if has_cfar:
-        r, d, nz = two_stage_kernel(
-            rd,
-            profile,
-            lo,
-            hi,
-            a,
-            bb,
-            rn,
-            rg,
-            rcyc,
-            rmeth,
-            ralpha,
-            ralpha1,
-            dn,
-            dg,
-            dcyc,
-            dmeth,
-            dalpha,
-            dalpha1,
-            peak,
-        )
+        r, d, nz = two_stage_kernel(rd, cfar)
     else:
         r = np.zeros(0, dtype=np.int64)
         d = np.zeros(0, dtype=np.int64)
@@ -1202,8 +1211,8 @@ def _frame_kernel(
         return r, d, np.empty((0, 8)), np.full(0, -2, dtype=np.int32)
     ch = _detected_channels_kernel(s, rd, r, d, cells_k, cells_d, x, along, ortho)
     f64, src = point_rows(
-        rd, r, d, nz, ch, n_tx, n_rx, row_ch, row_pos, upper, lower, tw_a, elevation, pos, vel,
-        source, t_mid, res_r, res_v, span,
+        rd, r, d, nz, ch, pts.n_tx, pts.n_rx, pts.row_ch, pts.row_pos, pts.upper, pts.lower,
+        pts.tw_a, elevation, pos, vel, source, pts.t_mid, pts.res_r, pts.res_v, pts.span,
     )  # fmt: skip
     return r, d, f64, src  # fmt: skip
 
@@ -1226,11 +1235,10 @@ def _grow(f64, i64, i32, need):  # pragma: no cover
 @numba.njit(cache=True, nogil=True)
 def _frames_kernel(
     states, start, elev, maps, keep, amp, theta, slow, slow1, steer, pos, vel, source, noise,
-    n_use, n_v, wd, b, s2, slot, threshold, tw_r, tw_d, has_cfar, profile, lo, hi, a, bb, rn, rg,
-    rcyc, rmeth, ralpha, ralpha1, dn, dg, dcyc, dmeth, dalpha, dalpha1, peak, n_tx, n_rx,
-    row_ch, row_pos, upper, lower, tw_a, res_r, res_v, t_mid, span,
+    spec, has_cfar, cfar, pts,
 ):  # fmt: skip  # pragma: no cover
-    """Every frame: noise map, then :func:`_frame_kernel`; frame ``f`` draws from ``states[f]``.
+    """Every frame: noise map, then :func:`_frame_kernel`; frame ``f`` draws from ``states[f]``
+    and has the reflectors ``start[f]:start[f+1]`` (arguments as there).
 
     Returns ``(det (n, 2), f64 (n, 8), source (n,), counts (F,))`` concatenated in frame order.
     """
@@ -1245,16 +1253,13 @@ def _frames_kernel(
         s = states[f].copy()
         rd = maps[f] if keep else maps[0]
         if noise:
-            _noise_map(s, rd, s2, n_use, n_v)
+            _noise_map(s, rd, spec.s2, spec.n_use, spec.n_v)
         else:
             rd[:] = 0.0
         i0, i1 = start[f], start[f + 1]
         r, d, f64, src = _frame_kernel(
             s, rd, amp[i0:i1], theta[i0:i1], slow[i0:i1], slow1[i0:i1], steer[i0:i1],
-            pos[i0:i1], vel[i0:i1], source[i0:i1], elev[f], noise, n_use, wd, b, s2, slot,
-            threshold, tw_r, tw_d, has_cfar, profile, lo, hi, a, bb, rn, rg, rcyc, rmeth, ralpha,
-            ralpha1, dn, dg, dcyc, dmeth, dalpha, dalpha1, peak, n_tx, n_rx, row_ch, row_pos,
-            upper, lower, tw_a, res_r, res_v, t_mid, span,
+            pos[i0:i1], vel[i0:i1], source[i0:i1], elev[f], noise, spec, has_cfar, cfar, pts,
         )  # fmt: skip
         n = r.shape[0]
         f64_all, det_all, src_all = _grow(f64_all, det_all, src_all, n_out + n)
@@ -1287,8 +1292,6 @@ def _frames_fast(
         raise InputError(f"rngs: {len(rngs)} generators for {len(frames)} frames")
     n_f = len(frames)
     n_r, n_d, n_v = radar.n_samples, radar.n_loops, radar.n_virtual
-    s2 = cell_noise_power_v2(radar, settings)  # (n_d,)
-    n_use = n_r if keep_rd_map else max(0, min(n_r, cfar_range_bins(radar, settings)))
     counts = np.fromiter((len(s) for s in frames), dtype=np.int64, count=n_f)
     start = np.zeros(n_f + 1, dtype=np.int64)
     np.cumsum(counts, out=start[1:])
@@ -1311,23 +1314,16 @@ def _frames_fast(
         elev = np.zeros(n_f, dtype=bool)
     else:
         elev = np.fromiter((needs_elevation(radar, s) for s in frames), dtype=bool, count=n_f)
-    cfar = _cfar_arguments(radar, settings, n_v, n_r, n_d, True)
-    has_cfar = cfar is not None
-    if cfar is None:  # no range bin inside the limits: nothing is tested
-        e = np.ones(1)
-        cfar = (e, 0, 0, 0, 0, 1, 0, False, 0, 1.0, 1.0, 1, 0, False, 0, 1.0, 1.0, False)
+    cfar = cfar_arguments(radar, settings, n_v, n_r, n_d, True)
+    has_cfar = cfar is not None  # None: no range bin inside the limits, nothing is tested
     states = np.zeros((n_f, 6), dtype=np.uint64)  # core.simulation.gaussian's six words
     for f in range(n_f):
         states[f, :4] = state_from(rngs[f] if noise else None)
     maps = np.empty((n_f if keep_rd_map else 1, n_r, n_d), dtype=np.float32)
     det, f64, src, n_out = _frames_kernel(
         states, start, elev, maps, bool(keep_rd_map), amp, theta, slow, slow1, steer, pos, vel,
-        source, bool(noise), n_use, n_v, _doppler_weights(settings.doppler_window, n_d),
-        _cosine_sum_coefficients(settings.range_window, n_r), s2, np.arange(n_v) // radar.n_rx,
-        PATCH_THRESHOLD, *_twiddles(n_r, n_d), has_cfar, *cfar, radar.n_tx, radar.n_rx,
-        *detection_rows(radar, bool(elev.any())), angle_twiddles(radar, settings.angle_fft_size),
-        radar.range_resolution_m, radar.velocity_resolution_mps, t_mid,
-        2 * radar.max_velocity_mps,
+        source, bool(noise), spectrum_tables(radar, settings, bool(keep_rd_map)), has_cfar,
+        cfar if has_cfar else _NO_CFAR, point_tables(radar, settings, bool(elev.any()), t_mid),
     )  # fmt: skip
     pc = cloud_from_rows(f64, src)
     out = FramesOutput(point_cloud=pc, counts=n_out, detections=det)
