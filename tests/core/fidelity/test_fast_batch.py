@@ -12,15 +12,14 @@ from core.processing import Detections
 from core.scene import paper_scenes
 from core.simulation import LEVELS, AntennaGain, Scatterers
 from core.simulation.fast import (
-    cfar_range_bins,
     detected_channels,
     fast_spectrum,
     label_points,
     points_compiled,
     simulate_frame_fast,
     simulate_frames_fast,
-    two_stage_cfar_compiled,
 )
+from core.simulation.fast_cfar import cfar_range_bins, two_stage_cfar_compiled
 
 
 @pytest.fixture(scope="module")

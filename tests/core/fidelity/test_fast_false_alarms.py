@@ -20,7 +20,8 @@ from core.config import ProcessingSettings, RadarConfig
 from core.processing import doppler_fft, range_doppler_map, range_fft, spectrum, two_stage_cfar
 from core.processing.false_alarms import StageFactors, noise_detections_per_frame
 from core.simulation import AntennaGain, synthesize_noise
-from core.simulation.fast import cfar_arguments, chain_factors, simulate_frames_fast
+from core.simulation.fast import simulate_frames_fast
+from core.simulation.fast_cfar import cfar_arguments, chain_factors
 from core.simulation.scatterers import Scatterers
 
 RADAR = RadarConfig()

@@ -17,7 +17,7 @@ from core.processing.false_alarms import (
     noise_detections_per_frame,
     weighted_gamma_cdf,
 )
-from core.simulation.fast import cfar_arguments, chain_factors
+from core.simulation.fast_cfar import cfar_arguments, chain_factors
 
 RADAR = RadarConfig()
 L = 12
