@@ -80,16 +80,11 @@ from core.pointcloud import SOURCE_OTHER, PointCloud
 from core.processing import estimate_angles, make_cfar
 from core.processing.angle import log_parabolic_offset
 from core.processing.cfar import METHOD_CODE, effective_cells_or_none
+from core.processing.points import angle_twiddles, angles_of, array_rows
 from core.processing.spectrum import window
 from core.simulation.antenna import AntennaGain
-from core.simulation.fast import (
-    FramesOutput,
-    angle_twiddles,
-    angles_of,
-    array_rows,
-    cell_noise_power_v2,
-    range_responses,
-)
+from core.simulation.fast import FramesOutput
+from core.simulation.fast_model import cell_noise_power_v2, range_responses
 from core.simulation.frame import FrameOutput, needs_elevation
 from core.simulation.gaussian import state_from
 from core.simulation.link import receiver_voltage_scale
