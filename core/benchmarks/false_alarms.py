@@ -29,7 +29,7 @@ from core.config import ProcessingSettings
 from core.processing import doppler_fft, false_alarms, range_doppler_map, range_fft, two_stage_cfar
 from core.processing.false_alarms import noise_detections_per_frame
 from core.scene import paper_scenes
-from core.simulation import AntennaGain, synthesize_noise
+from core.simulation import AntennaGain, fast_cfar, synthesize_noise
 from core.simulation import fast as fast_level
 from core.simulation.scatterers import Scatterers
 
@@ -88,9 +88,9 @@ def run(quick: bool = False, n_frames: int | None = None) -> dict:
                 exact_counts[name].append(len(two_stage_cfar(rd, radar, settings[name])))
             t_exact += time.perf_counter() - t0
     for name, s in settings.items():
-        fast_level._independent_stages.cache_clear()
-        fast_level.independent_factors.cache_clear()
-        fast_level._cfar_arguments.cache_clear()
+        fast_cfar._independent_stages.cache_clear()
+        fast_cfar.independent_factors.cache_clear()
+        fast_cfar.cfar_arguments.cache_clear()
         for cached in (
             "_layout",
             "_grouping_table",
@@ -100,7 +100,7 @@ def run(quick: bool = False, n_frames: int | None = None) -> dict:
         ):
             getattr(false_alarms, cached).cache_clear()
         t0 = time.perf_counter()
-        fast_level._cfar_arguments(radar, s, L, radar.n_samples, radar.n_loops, True)
+        fast_cfar.cfar_arguments(radar, s, L, radar.n_samples, radar.n_loops, True)
         t_thresholds = time.perf_counter() - t0
         out = fast_level.simulate_frames_fast(
             radar,
@@ -110,7 +110,7 @@ def run(quick: bool = False, n_frames: int | None = None) -> dict:
             settings=s,
             elevation=False,
         )
-        f = fast_level.chain_factors(radar, s, L)
+        f = fast_cfar.chain_factors(radar, s, L)
         m_exact, se_exact = _mean_se(exact_counts[name])
         m_fast, se_fast = _mean_se(out.counts)
         rows[name] = {

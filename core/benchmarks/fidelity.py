@@ -223,22 +223,17 @@ def _frames(scene, seed):
     p = pipeline.plan(scene)
     antenna = sim.AntennaGain.draw(scene.radar, pipeline.stage_rng(seed, "antenna"))
     settings = pipeline.processing_settings(scene)
-    # the pipeline's reflector builder (private: the bench needs the frames without simulating)
-    refl = pipeline._Reflectors.build(scene, p, seed, antenna, settings)
+    # the pipeline's reflector builder (the bench needs the frames without simulating)
+    refl = pipeline.Reflectors.build(scene, p, seed, antenna, settings)
     frames = refl.frames()[0]
     return frames, antenna, settings, p.elevation, refl
 
 
 def _batch_simulator(name: str):
-    """The level's all-frames entry point (``core.pipeline.BATCH_SIMULATORS``) or None."""
-    import importlib
+    """The level's all-frames entry point (``core.simulation.LEVELS``) or None."""
+    from core.simulation import LEVELS
 
-    from core import pipeline
-
-    if name not in pipeline.BATCH_SIMULATORS:
-        return None
-    module, fn = pipeline.BATCH_SIMULATORS[name].split(":")
-    return getattr(importlib.import_module(module), fn)
+    return LEVELS[name].simulate_frames
 
 
 def run(quick: bool = False, params_cv=None, params_ca=None) -> dict:
@@ -563,7 +558,7 @@ def run(quick: bool = False, params_cv=None, params_ca=None) -> dict:
         "bootstrap": f"{N_BOOTSTRAP} paired resamples of the {len(scenes)} trajectories",
         "tracker_parameters": params_said,
         "timing": "process CPU time of the simulator call only (for a level with a batch entry "
-        "point, core.pipeline.BATCH_SIMULATORS: the one call for all frames of a trajectory, "
+        "point, LEVELS[...].simulate_frames: the one call for all frames of a trajectory, "
         "as the data-set path runs it; its per-frame call, the GUI's path, is listed too), "
         "levels interleaved per trajectory, after a warm-up call (set-up time listed "
         "separately); the pipeline's per-frame generators and reflectors are built outside "

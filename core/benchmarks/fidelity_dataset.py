@@ -17,12 +17,13 @@ import time
 
 def run(n_trajectories: int = 5, repeats: int = 2) -> dict:
     """Frames per second of ``build_dataset(jobs=1, use_cache=False)`` per level."""
-    from core.pipeline import SIMULATORS, build_dataset
+    from core.pipeline import build_dataset
     from core.scene import paper_scenes
+    from core.simulation import LEVELS
 
     scenes = paper_scenes(0, n_trajectories)
     frames = sum(s.n_frames for s in scenes)
-    levels = list(SIMULATORS)
+    levels = list(LEVELS)
     for name in levels:  # compilation, tables, false-alarm pool
         build_dataset(scenes[:1], fidelity=name, jobs=1, use_cache=False)
     best = {name: float("inf") for name in levels}

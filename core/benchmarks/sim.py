@@ -127,14 +127,14 @@ def plain_frame(radar: RadarConfig, scatterers, rng: np.random.Generator, antenn
     x = np.fft.fftshift(np.fft.fft(x * w_d[None, :, None], axis=1), axes=1)  # [v, doppler, range]
     rd = np.sum(np.abs(x) ** 2, axis=0).T  # [range, doppler]
     # CFAR: the same thresholds and noise model as the exact chain, plain sliding sums
-    from core.processing.cfar import _effective
+    from core.processing.cfar import effective_cells_or_none
     from core.processing.spectrum import clutter_removal_noise_profile
 
     prof = clutter_removal_noise_profile("hann", n_l)
     white = rd / prof
     rc, dc = settings.range_cfar, settings.doppler_cfar
-    cr = make_cfar(rc, n_v, _effective("hann", n_s, rc.n_train))
-    cd = make_cfar(dc, n_v, _effective("hann", n_l, dc.n_train))
+    cr = make_cfar(rc, n_v, effective_cells_or_none("hann", n_s, rc.n_train))
+    cd = make_cfar(dc, n_v, effective_cells_or_none("hann", n_l, dc.n_train))
     left, right = _plain_cfar_sums(white, rc.n_train, rc.n_guard, 0, False)
     both = ~np.isnan(left) & ~np.isnan(right)
     mu_r = np.where(both, np.minimum(left, right), np.where(np.isnan(left), right, left))

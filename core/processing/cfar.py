@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import functools
 from dataclasses import dataclass
-from typing import Protocol
+from typing import NamedTuple, Protocol
 
 import numba
 import numpy as np
@@ -322,6 +322,13 @@ def _local_maxima_kernel(rd, r, d):  # pragma: no cover
 
 
 @functools.lru_cache(maxsize=64)
+def effective_cells_or_none(window_name: str, n_fft: int, n_train: int) -> float | None:
+    """Effective independent cells of ``n_train`` window-correlated ones (None: independent)."""
+    ne = effective_cells(window_name, n_fft, n_train)
+    return None if abs(ne - n_train) < 1e-9 else ne
+
+
+@functools.lru_cache(maxsize=64)
 def _cfar_plan(radar: RadarConfig, settings: ProcessingSettings, n_r: int, n_d: int, L: int):
     """What two_stage_cfar needs besides the map (range limits, whitening, thresholds)."""
     k = np.arange(n_r) * radar.range_resolution_m
@@ -333,8 +340,8 @@ def _cfar_plan(radar: RadarConfig, settings: ProcessingSettings, n_r: int, n_d: 
     ne_r = ne_d = None
     profile = np.ones(n_d)
     if settings.cfar_noise_model:
-        ne_r = _effective(settings.range_window, radar.n_samples, rc.n_train)
-        ne_d = _effective(settings.doppler_window, n_d, dc.n_train)
+        ne_r = effective_cells_or_none(settings.range_window, radar.n_samples, rc.n_train)
+        ne_d = effective_cells_or_none(settings.doppler_window, n_d, dc.n_train)
         if settings.static_clutter_removal:
             # whitening profile; bins below 0.01 (rectangular window: zero Doppler) are dead
             profile = np.ascontiguousarray(
@@ -344,15 +351,56 @@ def _cfar_plan(radar: RadarConfig, settings: ProcessingSettings, n_r: int, n_d: 
     # the range stage needs training cells beyond the limits: run it on a margin around them
     margin = rc.n_train + rc.n_guard
     a, b = max(0, lo - margin), min(n_r, hi + 1 + margin)
-    args = (*_kernel_args(make_cfar(rc, L, ne_r)), *_kernel_args(make_cfar(dc, L, ne_d)))
-    return lo, hi, a, b, profile, args
+    return TwoStageCfarArgs(
+        profile=profile,
+        lo=lo,
+        hi=hi,
+        a=a,
+        b=b,
+        range_stage=cfar_stage_args(make_cfar(rc, L, ne_r)),
+        doppler_stage=cfar_stage_args(make_cfar(dc, L, ne_d)),
+        peak_grouping=settings.peak_grouping,
+    )
 
 
-_METHOD_CODE = {"ca": 0, "caso": 1, "cago": 2}
+#: The compiled kernels' code of each CFAR estimator.
+METHOD_CODE = {"ca": 0, "caso": 1, "cago": 2}
 
 
-def _kernel_args(c: _SidedCfar) -> tuple:
-    return (c.n_train, c.n_guard, c.cyclic, _METHOD_CODE[c.method], c.alpha(), c.alpha_one_side())
+class CfarStageArgs(NamedTuple):
+    """One CFAR stage as the compiled kernels read it."""
+
+    n_train: int  # training cells per side
+    n_guard: int  # guard cells per side
+    cyclic: bool  # the axis wraps around (Doppler)
+    method: int  # METHOD_CODE of the estimator
+    alpha_both: float  # threshold factor, both sides complete
+    alpha_one: float  # threshold factor, one side alone (at a non-cyclic edge)
+
+
+class TwoStageCfarArgs(NamedTuple):
+    """Everything :func:`two_stage_kernel` needs besides the map (one value, written once)."""
+
+    profile: np.ndarray  # (n_d,) whitening profile; bins below 0.01 are dead
+    lo: int  # first range bin tested
+    hi: int  # last range bin tested
+    a: int  # first range bin the range stage reads (lo minus guard and training)
+    b: int  # one past the last range bin it reads
+    range_stage: CfarStageArgs
+    doppler_stage: CfarStageArgs
+    peak_grouping: bool
+
+
+def cfar_stage_args(c: _SidedCfar) -> CfarStageArgs:
+    """The compiled kernels' view of a configured stage."""
+    return stage_args(c.n_train, c.n_guard, c.cyclic, c.method, c.alpha(), c.alpha_one_side())
+
+
+def stage_args(
+    n_train: int, n_guard: int, cyclic: bool, method: str, alpha_both: float, alpha_one: float
+) -> CfarStageArgs:
+    """:class:`CfarStageArgs` of a stage with the method by name (``"ca"``, ``"caso"``, ...)."""
+    return CfarStageArgs(n_train, n_guard, cyclic, METHOD_CODE[method], alpha_both, alpha_one)
 
 
 @numba.njit(inline="always")
@@ -398,10 +446,7 @@ def _cfar_line(p, n, g, cyclic, method, a_both, a_one, mask, noise):  # pragma: 
 
 
 @numba.njit(cache=True, nogil=True)
-def two_stage_kernel(
-    rd, profile, lo, hi, a, b, n_r, g_r, cyc_r, m_r, ab_r, ao_r, n_d, g_d, cyc_d, m_d_code, ab_d,
-    ao_d, peak,
-):  # fmt: skip  # pragma: no cover
+def two_stage_kernel(rd, cfar):  # pragma: no cover
     """Both CFAR stages and peak grouping on ``rd`` ``[range bin, Doppler bin]`` in one pass.
 
     The map is whitened (``rd / profile[d]``; bins with ``profile < 0.01``, emptied by clutter
@@ -412,8 +457,13 @@ def two_stage_kernel(
     ``peak`` a detection must be a local maximum of ``rd`` (>= its 8 neighbours, range edges
     open, Doppler cyclic). Returns range bins, Doppler indices and the range stage's noise
     estimate in the map's units, row by row. The same arithmetic, operation for operation, as
-    composing :class:`CaCfar`/:class:`CasoCfar`/:class:`CagoCfar` (tested).
+    composing :class:`CaCfar`/:class:`CasoCfar`/:class:`CagoCfar` (tested). ``cfar``: a
+    :class:`TwoStageCfarArgs`.
     """
+    profile, lo, hi, a, b = cfar.profile, cfar.lo, cfar.hi, cfar.a, cfar.b
+    n_r, g_r, cyc_r, m_r, ab_r, ao_r = cfar.range_stage
+    n_d, g_d, cyc_d, m_d_code, ab_d, ao_d = cfar.doppler_stage
+    peak = cfar.peak_grouping
     n_rows, n_cols = rd.shape
     size = b - a
     dead = np.empty(n_cols, dtype=np.bool_)
@@ -528,22 +578,15 @@ def two_stage_cfar(
     plan = _cfar_plan(radar, settings, n_r, n_d, L)
     if plan is None:
         return _empty_detections()
-    lo, hi, a, b, profile, kernel_args = plan
     # whitening, both stages and peak grouping in one compiled pass (same arithmetic as
     # CaCfar/CasoCfar/CagoCfar.detect composed, then _local_maxima)
-    r, d, noise = two_stage_kernel(rd, profile, lo, hi, a, b, *kernel_args, settings.peak_grouping)
+    r, d, noise = two_stage_kernel(rd, plan)
     return Detections(
         range_bin=r,
         doppler_index=d,
         power=rd[r, d].astype(np.float64),
         noise_power=noise,
     )
-
-
-@functools.lru_cache(maxsize=64)
-def _effective(window_name: str, n_fft: int, n_train: int) -> float | None:
-    ne = effective_cells(window_name, n_fft, n_train)
-    return None if abs(ne - n_train) < 1e-9 else ne
 
 
 def _training_cdf(cfar: _SidedCfar, x: np.ndarray) -> np.ndarray:
@@ -576,8 +619,12 @@ def two_stage_pfa(
     L = n_channels
     ne_r = ne_d = None
     if settings.cfar_noise_model:
-        ne_r = _effective(settings.range_window, n_range_bins, settings.range_cfar.n_train)
-        ne_d = _effective(settings.doppler_window, n_doppler_bins, settings.doppler_cfar.n_train)
+        ne_r = effective_cells_or_none(
+            settings.range_window, n_range_bins, settings.range_cfar.n_train
+        )
+        ne_d = effective_cells_or_none(
+            settings.doppler_window, n_doppler_bins, settings.doppler_cfar.n_train
+        )
     cr = make_cfar(settings.range_cfar, L, ne_r)
     cd = make_cfar(settings.doppler_cfar, L, ne_d)
 

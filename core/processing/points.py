@@ -191,7 +191,7 @@ def angles_of(
 
 
 @numba.njit(cache=True, nogil=True)
-def _points_kernel(
+def points_kernel(
     rd, r, d, x, n_tx, n_rx, row_ch, row_pos, upper, lower, tw_a, elevation
 ):  # pragma: no cover
     n_r, n_d = rd.shape
@@ -304,7 +304,7 @@ def point_rows(
     """
     n_det = r.shape[0]
     f64 = np.empty((n_det, 8))
-    r_bin, d_bin, az, el = _points_kernel(
+    r_bin, d_bin, az, el = points_kernel(
         rd, r, d, x, n_tx, n_rx, row_ch, row_pos, upper, lower, tw_a, elevation
     )
     for i in range(n_det):

@@ -10,6 +10,13 @@ from core.simulation.baseband import (
 )
 from core.simulation.fast import simulate_frame_fast
 from core.simulation.frame import FrameOutput, needs_elevation, simulate_frame
+from core.simulation.levels import (
+    LEVELS,
+    FidelityLevel,
+    FrameSimulator,
+    FramesSimulator,
+    fidelity_level,
+)
 from core.simulation.link import (
     draw_person_rcs_dbsm,
     noise_power_v2,
@@ -23,21 +30,21 @@ from core.simulation.link import (
 from core.simulation.measurement import simulate_frame_measurement
 from core.simulation.scatterers import Scatterers
 
-# fidelity levels (docs/fidelity.md): every simulator has the signature of simulate_frame
-#: Frame simulators by fidelity level, cheapest last; ``exact`` is the reference.
-FIDELITY_LEVELS = {
-    "exact": simulate_frame,
-    "fast": simulate_frame_fast,
-    "measurement": simulate_frame_measurement,
-}
+#: Frame simulators by fidelity level (derived from :data:`LEVELS`), cheapest last.
+FIDELITY_LEVELS = {name: level.simulate_frame for name, level in LEVELS.items()}
 
 __all__ = [
     "FIDELITY_LEVELS",
+    "LEVELS",
     "AntennaGain",
+    "FidelityLevel",
+    "FrameSimulator",
+    "FramesSimulator",
     "FrameOutput",
     "Scatterers",
     "chirp_ranges_m",
     "draw_person_rcs_dbsm",
+    "fidelity_level",
     "needs_elevation",
     "noise_power_v2",
     "post_processing_snr_db",

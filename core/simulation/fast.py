@@ -49,11 +49,18 @@ windows (|rho|^2 = 4/9 for Hann), here they are independent. The exact chain's t
 independent cells would give other noise false alarms, both through the two stages (which share
 the cell under test) and through peak grouping (a noise peak among correlated neighbours is
 less often a local maximum: 12 % of the exact chain's noise detections go, 3 % of independent
-cells'). :func:`independent_cell_stages` scales both stages' ``pfa`` by one factor so that the
-expected noise detections per frame after both stages and peak grouping
-(:func:`core.processing.false_alarms.noise_detections_per_frame`) are the exact chain's
-(``docs/decisions/fidelity-08``). ``rect`` windows leave independent cells: the thresholds are
-then the chain's own.
+cells'). :func:`core.simulation.fast_cfar.independent_cell_stages` scales both stages'
+``pfa`` by one factor so that the expected noise detections per frame after both stages and
+peak grouping (:func:`core.processing.false_alarms.noise_detections_per_frame`) are the exact
+chain's (``docs/decisions/fidelity-08``). ``rect`` windows leave independent cells: the
+thresholds are then the chain's own.
+
+Layout: the closed-form model and its compiled kernels (responses, noise map, patches) are in
+:mod:`core.simulation.fast_model`, the CFAR thresholds in :mod:`core.simulation.fast_cfar`. This
+module (about 700 lines) holds the two entry points with their compiled batch path
+(:func:`_frames_kernel` → :func:`_frame_kernel`) next to the per-frame reference functions it
+must equal draw for draw (:func:`fast_spectrum`, :func:`detected_channels`,
+:func:`points_from_channels`; tested bit for bit).
 
 Known approximations (measured in ``docs/fidelity.md``): the noise cells' correlation is
 modelled only through the thresholds (above); the beat tone's drift over the frame (<= 0.2
@@ -62,22 +69,15 @@ range bins at 1.8 m/s) is reduced to its phase term.
 
 from __future__ import annotations
 
-import dataclasses
-import functools
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import NamedTuple
 
 import numba
 import numpy as np
-import scipy.fft
-from scipy.optimize import brentq
-from scipy.special import betainccinv
 
 from core.config import (
     DEFAULT_PROCESSING,
-    SPEED_OF_LIGHT_MPS,
-    CfarSettings,
     ProcessingSettings,
     RadarConfig,
 )
@@ -87,456 +87,44 @@ from core.processing import (
     Detections,
     estimate_angles,
     label_sources,
-    make_cfar,
     refine_bins,
-    window,
 )
-from core.processing.cfar import _METHOD_CODE, pfa_caso, threshold_factor, two_stage_kernel
-from core.processing.false_alarms import (
-    StageFactors,
-    cells_correlated,
-    noise_detections_per_frame,
+from core.processing.cfar import (
+    CfarStageArgs,
+    TwoStageCfarArgs,
+    two_stage_kernel,
 )
-from core.processing.points import (  # noqa: F401  (angles_of: re-exported for measurement)
-    _points_kernel,
+from core.processing.points import (
     angle_twiddles,
-    angles_of,
     array_rows,
     cloud_from_rows,
     detection_rows,
     point_rows,
+    points_kernel,
 )
-from core.processing.spectrum import clutter_removal_noise_profile, effective_cells
 from core.simulation.antenna import AntennaGain
 from core.simulation.baseband import steering_vectors
+from core.simulation.fast_cfar import cfar_arguments, cfar_range_bins
+from core.simulation.fast_model import (
+    PATCH_THRESHOLD,
+    beat_rad_per_sample_per_m,
+    cell_noise_power_v2,
+    cosine_sum_coefficients,
+    doppler_weights,
+    noise_map,
+    patches_kernel,
+    slow_time_sequences,
+    twiddles,
+)
 from core.simulation.frame import FrameOutput, needs_elevation
-from core.simulation.gaussian import FI, KI, WI
-from core.simulation.link import noise_power_v2, received_power_w, signal_amplitude_v
+from core.simulation.link import received_power_w, signal_amplitude_v
 from core.simulation.rng_kernels import (
     fill_normal,
-    gamma_f32_l,
-    gamma_l,
     normal_l,
     state6,
     state_from,
 )
 from core.simulation.scatterers import Scatterers
-
-#: Per-channel signal power, relative to the cell's noise power, above which a cell gets
-#: per-channel noise and the coherent signal (-30 dB: the signal changes the cell's mean power
-#: by less than 0.1 % elsewhere).
-PATCH_THRESHOLD = 1e-3
-
-
-@functools.lru_cache(maxsize=32)
-def _doppler_window_shifted(name: str, n: int) -> np.ndarray:
-    """Doppler window with the fftshift folded in (``w[m] (-1)^m`` for even ``n``), complex128."""
-    w = window(name, n).astype(np.float64)
-    if n % 2 == 0:
-        w = w * np.where(np.arange(n) % 2 == 0, 1.0, -1.0)
-    return w
-
-
-@functools.lru_cache(maxsize=32)
-def cell_noise_power_v2(radar: RadarConfig, settings: ProcessingSettings) -> np.ndarray:
-    """Noise power per virtual channel and range-Doppler cell after both FFTs, ``(n_loops,)`` V².
-
-    ``s2[d] = sigma^2 sum w_r^2 (sum w_d^2 - |W_d(d)|^2 / Nc)`` with static clutter removal,
-    ``sigma^2 sum w_r^2 sum w_d^2`` without; index ``d`` is zero-velocity centred. The same for
-    every range bin.
-    """
-    wr = window(settings.range_window, radar.n_samples).astype(np.float64)
-    wd = window(settings.doppler_window, radar.n_loops).astype(np.float64)
-    n = radar.n_loops
-    gain_d = np.full(n, np.sum(wd**2))
-    if settings.static_clutter_removal:
-        # W_d(d) = sum_m w_m exp(-j 2 pi (d - n/2) m / n)
-        big_w = (
-            np.fft.fftshift(np.fft.fft(wd))
-            if n % 2
-            else np.fft.fft(_doppler_window_shifted(settings.doppler_window, n))
-        )
-        # s2[d] / (sigma^2 sum w_r^2) = sum w_d^2 - |W_d(d)|^2 / Nc
-        gain_d = gain_d - np.abs(big_w) ** 2 / n
-    out = noise_power_v2(radar) * np.sum(wr**2) * gain_d
-    out.flags.writeable = False
-    return out
-
-
-def range_responses(radar: RadarConfig, range_m: np.ndarray, settings: ProcessingSettings):
-    """Range window's response to each scatterer's beat tone, ``(N, n_samples)`` complex128.
-
-    ``R[k] = sum_n w_r[n] exp(j theta n) exp(-j 2 pi k n / Nadc)``,
-    ``theta = 2 pi (2 S R / c) / Fs``.
-    """
-    n = np.arange(radar.n_samples)
-    # theta = 2 pi (2 S R / c) / Fs   (rad per sample)
-    theta = (
-        2
-        * np.pi
-        * 2
-        * radar.slope_hz_per_s
-        * np.asarray(range_m)
-        / (SPEED_OF_LIGHT_MPS * radar.sample_rate_hz)
-    )
-    wr = window(settings.range_window, radar.n_samples).astype(np.float64)
-    tone = wr[None, :] * np.exp(1j * ((theta[:, None] * n[None, :]) % (2 * np.pi)))
-    return scipy.fft.fft(tone, axis=-1)
-
-
-def slow_time_sequences(
-    radar: RadarConfig, scatterers: Scatterers, settings: ProcessingSettings
-) -> tuple[np.ndarray, np.ndarray]:
-    """Slow-time sequences ``y`` and ``delta y`` per scatterer and TX slot, ``(N, n_tx, n_loops)``.
-
-    ``y_c = exp(j (4 pi R(t_c) / lambda + delta_c (Nadc - 1) / 2))`` and ``delta_c y_c`` with
-    ``delta_c = theta' (R(t_c) - R(t_mid))`` the beat tone's drift (rad/sample) at chirp ``c``;
-    both after static clutter removal when the settings ask for it.
-    """
-    return _slow_time_kernel(
-        np.ascontiguousarray(scatterers.position_m, dtype=np.float64),
-        np.ascontiguousarray(scatterers.velocity_mps, dtype=np.float64),
-        radar.n_tx,
-        radar.n_loops,
-        radar.chirp_period_s,
-        4 * np.pi / radar.wavelength_m,
-        _beat_rad_per_sample_per_m(radar),
-        radar.n_samples,
-        settings.static_clutter_removal,
-    )
-
-
-def _beat_rad_per_sample_per_m(radar: RadarConfig) -> float:
-    """``theta' = 2 pi (2 S / c) / Fs``: beat tone phase per ADC sample per metre of range."""
-    return 2 * np.pi * 2 * radar.slope_hz_per_s / (SPEED_OF_LIGHT_MPS * radar.sample_rate_hz)
-
-
-def doppler_responses(
-    radar: RadarConfig, scatterers: Scatterers, settings: ProcessingSettings
-) -> np.ndarray:
-    """Slow-time response of each scatterer per TX slot, ``(N, n_tx, n_loops)`` complex128.
-
-    Index ``d`` is zero-velocity centred. Includes the TDM slot delay, static clutter removal
-    and the beat tone's phase drift with the range (see the module docstring).
-    """
-    y = slow_time_sequences(radar, scatterers, settings)[0]
-    w = _doppler_window_shifted(settings.doppler_window, radar.n_loops)
-    out = scipy.fft.fft(y * w, axis=-1)
-    if radar.n_loops % 2:
-        out = np.fft.fftshift(out, axes=-1)
-    return out
-
-
-@functools.lru_cache(maxsize=32)
-def _cosine_sum_coefficients(name: str, n: int) -> np.ndarray:
-    """``b_j`` (j = -J..J) with ``w[n] = sum_j b_j exp(j 2 pi j n / N)``, complex128 ``(2J+1,)``.
-
-    The library's windows are periodic cosine sums (rect, Hann, Hamming, Blackman), so the
-    window's DFT ``W`` has only these few non-zero coefficients: ``b_j = W[j] / N``.
-    """
-    w = window(name, n).astype(np.float64)
-    big_w = np.fft.fft(w) / n
-    half = 0
-    for j in range(1, n // 2):
-        if abs(big_w[j]) > 1e-6 * abs(big_w[0]):
-            half = j
-    b = np.array([big_w[j % n] for j in range(-half, half + 1)])
-    # the closed form below is exact only for cosine sums: check that nothing else is left
-    rebuilt = np.real(
-        np.sum(
-            b[:, None]
-            * np.exp(2j * np.pi * np.outer(np.arange(-half, half + 1), np.arange(n)) / n),
-            axis=0,
-        )
-    )
-    if half > 4 or np.max(np.abs(rebuilt - w)) > 1e-5:
-        raise ValueError(f"window {name!r} is not a short cosine sum")
-    return b
-
-
-@numba.njit(cache=True, nogil=True)
-def _slow_time_kernel(
-    pos, vel, n_tx, n_loops, t_chirp, k_phase, k_beat, n_samples, clutter_removal
-):  # pragma: no cover
-    """Slow-time sequences ``y`` and ``delta y``, each ``(N, n_tx, n_loops)``.
-
-    See :func:`slow_time_sequences`.
-    """
-    n_s = pos.shape[0]
-    n_ch = n_tx * n_loops
-    y = np.empty((n_s, n_tx, n_loops), dtype=np.complex128)
-    y1 = np.empty((n_s, n_tx, n_loops), dtype=np.complex128)
-    centre = (n_samples - 1) / 2
-    for i in range(n_s):
-        t_mid = (n_ch // 2) * t_chirp
-        r_mid = np.sqrt(
-            (pos[i, 0] + vel[i, 0] * t_mid) ** 2
-            + (pos[i, 1] + vel[i, 1] * t_mid) ** 2
-            + (pos[i, 2] + vel[i, 2] * t_mid) ** 2
-        )
-        for c in range(n_ch):
-            t = c * t_chirp
-            # R(t_c) = |p + v t_c|
-            r = np.sqrt(
-                (pos[i, 0] + vel[i, 0] * t) ** 2
-                + (pos[i, 1] + vel[i, 1] * t) ** 2
-                + (pos[i, 2] + vel[i, 2] * t) ** 2
-            )
-            # delta_c = theta' (R(t_c) - R(t_mid));  phi_c = 4 pi R(t_c) / lambda + delta_c (N-1)/2
-            delta = k_beat * (r - r_mid)
-            phi = (k_phase * r) % (2 * np.pi) + delta * centre
-            z = np.cos(phi) + 1j * np.sin(phi)
-            y[i, c % n_tx, c // n_tx] = z
-            y1[i, c % n_tx, c // n_tx] = delta * z
-        if clutter_removal:
-            for s in range(n_tx):
-                mean = y[i, s, :].sum() / n_loops
-                mean1 = y1[i, s, :].sum() / n_loops
-                for m in range(n_loops):
-                    y[i, s, m] -= mean
-                    y1[i, s, m] -= mean1
-    return y, y1
-
-
-@numba.njit(cache=True, nogil=True)
-def _noise_map(s, rd, s2, n_use, n_v):  # pragma: no cover
-    """Noise-only map: ``rd[k, d] = s2[d] Gamma(L)`` (float32) for ``k < n_use`` (row by row),
-    the mean ``L s2[d]`` beyond (never read by the CFAR). Draws from the six-word state ``s``
-    (advanced): NumPy's float32 Gamma algorithm (:func:`~core.simulation.rng_kernels.gamma_f32`),
-    as ``standard_gamma(L, dtype=float32)`` fed the same words."""
-    n_r, n_d = rd.shape
-    # Marsaglia-Tsang constants of Gamma(L) in float32: b = L - 1/3, c = 1 / sqrt(9 b)
-    b = np.float32(n_v) - np.float32(1.0 / 3.0)
-    c = np.float32(np.float32(1.0) / np.sqrt(np.float32(9.0) * b))
-    s2_32 = s2.astype(np.float32)
-    ki, wi, fi = KI, WI, FI
-    # the generator state in registers
-    s0, s1, s2_, s3, buf, has = s[0], s[1], s[2], s[3], s[4], s[5] != 0
-    for k in range(n_use):
-        for d in range(n_d):
-            g, s0, s1, s2_, s3, buf, has = gamma_f32_l(s0, s1, s2_, s3, buf, has, b, c, ki, wi, fi)
-            # noise-only cell: sum of L exponentials of mean s2[d] ~ s2[d] Gamma(L)
-            rd[k, d] = g * s2_32[d]
-    s[0], s[1], s[2], s[3], s[4], s[5] = s0, s1, s2_, s3, buf, np.uint64(has)
-    for k in range(n_use, n_r):
-        for d in range(n_d):
-            rd[k, d] = np.float32(n_v * s2[d])
-
-
-@numba.njit(cache=True, nogil=True)
-def _fft_pow2(a, tw):  # pragma: no cover
-    """In-place radix-2 FFT of ``a`` (length a power of 2); ``tw[k] = exp(-j 2 pi k / n)``."""
-    n = a.shape[0]
-    j = 0
-    for i in range(1, n):
-        bit = n >> 1
-        while j & bit:
-            j ^= bit
-            bit >>= 1
-        j |= bit
-        if i < j:
-            a[i], a[j] = a[j], a[i]
-    size = 2
-    while size <= n:
-        half = size // 2
-        step = n // size
-        for first in range(0, n, size):
-            for k in range(half):
-                # butterfly: (u, v w) -> (u + v w, u - v w)
-                v = a[first + k + half] * tw[k * step]
-                u = a[first + k]
-                a[first + k] = u + v
-                a[first + k + half] = u - v
-        size *= 2
-
-
-@numba.njit(cache=True, nogil=True)
-def _patches_kernel(
-    s, rd, amp, theta, slow, slow1, wd, b, s2, steer, slot, threshold, tw_r, tw_d, noise, k_max
-):  # pragma: no cover
-    """Patch cells, their noise-free channel values and their noisy channel sums.
-
-    amp (N,), theta (N,) beat tone rad/sample, slow/slow1 (N, n_tx, M) slow-time sequences
-    (after clutter removal), wd (M,) Doppler window (times ``(-1)^m`` when ``tw_d`` is the
-    radix-2 FFT's twiddles), b (2J+1,) range window coefficients, s2 (M,) cell noise power,
-    steer (N, L), slot (L,) TX slot of each channel, tw_r (N,) = exp(-j 2 pi k / N); tw_d either
-    (M, M) = exp(-j 2 pi (d - M/2) m / M) (direct DFT) or (1, M/2) = exp(-j 2 pi k / M) (M a
-    power of two: radix-2 FFT of the window-shifted sequence, the same transform). Adds the
-    patch cells' noisy power into ``rd`` (draws from the generator state ``s``); only range
-    bins below ``k_max`` are looked at.
-    """
-    n_samples = tw_r.shape[0]
-    n_s = amp.shape[0]
-    n_tx, m = slow.shape[1], slow.shape[2]
-    n_v = steer.shape[1]
-    half = (b.shape[0] - 1) // 2
-    nn = n_samples
-    centre = (nn - 1) / 2
-    # range response R_i[k] = sum_j b_j G(theta - 2 pi (k - j) / N),
-    # G(phi) = (1 - exp(j phi N)) / (1 - exp(j phi)), exp(j phi N) = exp(j theta N);
-    # its centred derivative R1_i[k] = dR/dtheta - j (N - 1)/2 R = sum_n w_n j (n - (N-1)/2) ...
-    # G and dG/dtheta are evaluated once per index k - j (shared by the 2J+1 terms of R)
-    n_g = k_max + 2 * half
-    gg = np.empty(n_g, dtype=np.complex128)
-    gg1 = np.empty(n_g, dtype=np.complex128)
-    rr = np.empty((n_s, k_max), dtype=np.complex128)
-    rr1 = np.empty((n_s, k_max), dtype=np.complex128)
-    pr = np.empty((n_s, k_max))
-    pr1 = np.empty((n_s, k_max))
-    for i in range(n_s):
-        e_n = np.exp(1j * theta[i] * nn)
-        num = 1.0 - e_n
-        e = np.exp(1j * theta[i])
-        for t in range(n_g):
-            q = e * tw_r[(t - half) % nn]  # exp(j phi), phi = theta - 2 pi (t - J) / N
-            den = 1.0 - q
-            den2 = den.real * den.real + den.imag * den.imag
-            if den2 < 1e-18:
-                gg[t] = nn + 0.0j
-                gg1[t] = 1j * nn * (nn - 1) / 2
-            else:
-                inv = den.conjugate() * (1.0 / den2)  # 1 / (1 - q)
-                gg[t] = num * inv
-                # dG/dtheta = (-j N e^{j N theta} (1 - q) + (1 - e^{j N theta}) j q) / (1 - q)^2
-                gg1[t] = (-1j * nn * e_n * den + num * 1j * q) * (inv * inv)
-        for k in range(k_max):
-            acc = 0.0 + 0.0j
-            acc1 = 0.0 + 0.0j
-            for jj in range(-half, half + 1):
-                # G at phi = theta - 2 pi (k - jj) / N is gg[k - jj + J]
-                acc += b[jj + half] * gg[k - jj + half]
-                acc1 += b[jj + half] * gg1[k - jj + half]
-            rr[i, k] = amp[i] * acc
-            rr1[i, k] = amp[i] * (acc1 - 1j * centre * acc)
-            pr[i, k] = rr[i, k].real ** 2 + rr[i, k].imag ** 2
-            pr1[i, k] = rr1[i, k].real ** 2 + rr1[i, k].imag ** 2
-    # Doppler responses D_i[s, d] = sum_m wd[m] y[m] exp(-j 2 pi (d - M/2) m / M), D1 of delta y
-    dd = np.empty((n_s, n_tx, m), dtype=np.complex128)
-    dd1 = np.empty((n_s, n_tx, m), dtype=np.complex128)
-    pd = np.zeros((n_s, m))
-    pd1 = np.zeros((n_s, m))
-    pd_max = np.zeros(n_s)
-    pd1_max = np.zeros(n_s)
-    ws = np.empty(m, dtype=np.complex128)
-    ws1 = np.empty(m, dtype=np.complex128)
-    radix2 = tw_d.shape[0] == 1
-    for i in range(n_s):
-        for sl in range(n_tx):
-            for t in range(m):
-                ws[t] = wd[t] * slow[i, sl, t]
-                ws1[t] = wd[t] * slow1[i, sl, t]
-            if radix2:
-                _fft_pow2(ws, tw_d[0])
-                _fft_pow2(ws1, tw_d[0])
-                for d in range(m):
-                    dd[i, sl, d] = ws[d]
-                    dd1[i, sl, d] = ws1[d]
-            else:
-                for d in range(m):
-                    acc = 0.0 + 0.0j
-                    acc1 = 0.0 + 0.0j
-                    for t in range(m):
-                        acc += ws[t] * tw_d[d, t]
-                        acc1 += ws1[t] * tw_d[d, t]
-                    dd[i, sl, d] = acc
-                    dd1[i, sl, d] = acc1
-            for d in range(m):
-                a0 = dd[i, sl, d]
-                a1 = dd1[i, sl, d]
-                pd[i, d] = max(pd[i, d], a0.real**2 + a0.imag**2)
-                pd1[i, d] = max(pd1[i, d], a1.real**2 + a1.imag**2)
-        for d in range(m):
-            pd_max[i] = max(pd_max[i], pd[i, d])
-            pd1_max[i] = max(pd1_max[i], pd1[i, d])
-    s2_min = s2[0]
-    for d in range(m):
-        s2_min = min(s2_min, s2[d])
-    lim_min = threshold * s2_min
-    cells_k = np.empty(k_max * m, dtype=np.int64)
-    cells_d = np.empty(k_max * m, dtype=np.int64)
-    n_c = 0
-    for k in range(k_max):
-        # skip the range bin when no scatterer can reach the smallest limit in any Doppler bin
-        # (pr pd[d] + pr1 pd1[d] <= pr max pd + pr1 max pd1, and lim[d] >= lim_min)
-        maybe = False
-        for i in range(n_s):
-            if pr[i, k] * pd_max[i] + pr1[i, k] * pd1_max[i] > lim_min:
-                maybe = True
-                break
-        if not maybe:
-            continue
-        for d in range(m):
-            lim = threshold * s2[d]
-            for i in range(n_s):
-                if pr[i, k] * pd[i, d] + pr1[i, k] * pd1[i, d] > lim:
-                    cells_k[n_c] = k
-                    cells_d[n_c] = d
-                    n_c += 1
-                    break
-    x = np.zeros((n_c, n_v), dtype=np.complex128)
-    along = np.zeros(n_c, dtype=np.complex128)
-    ortho = np.zeros(n_c)
-    g = np.empty(n_tx, dtype=np.complex128)
-    # Marsaglia-Tsang constants of Gamma(L - 1)
-    dk = n_v - 1.0 - 1.0 / 3.0
-    ck = 1.0 / np.sqrt(9.0 * dk)
-    s0, s1, s2_, s3 = s[0], s[1], s[2], s[3]  # the generator state in registers
-    for c in range(n_c):
-        k = cells_k[c]
-        d = cells_d[c]
-        for i in range(n_s):
-            if pr[i, k] * pd[i, d] + pr1[i, k] * pd1[i, d] < 1e-6 * s2[d]:
-                continue  # below -60 dB of the noise: nothing to add
-            for sl in range(n_tx):
-                # first order in the beat tone's drift: R D + R1 D1
-                g[sl] = rr[i, k] * dd[i, sl, d] + rr1[i, k] * dd1[i, sl, d]
-            for v in range(n_v):
-                # X[c, v] = sum_i A_i R_i[k] D_i[slot(v), d] a_i[v]
-                x[c, v] += g[slot[v]] * steer[i, v]
-        norm2 = 0.0
-        for v in range(n_v):
-            norm2 += x[c, v].real ** 2 + x[c, v].imag ** 2
-        if noise:
-            sd = np.sqrt(s2[d] / 2)
-            re, s0, s1, s2_, s3 = normal_l(s0, s1, s2_, s3)
-            im, s0, s1, s2_, s3 = normal_l(s0, s1, s2_, s3)
-            along[c] = sd * (re + 1j * im)
-            g_o, s0, s1, s2_, s3 = gamma_l(s0, s1, s2_, s3, dk, ck)
-            ortho[c] = s2[d] * g_o
-        # P = |(|s| + n_1)|^2 + |n_perp|^2
-        z = np.sqrt(norm2) + along[c]
-        rd[k, d] = z.real**2 + z.imag**2 + ortho[c]
-    s[0], s[1], s[2], s[3] = s0, s1, s2_, s3
-    return cells_k[:n_c], cells_d[:n_c], x, along, ortho
-
-
-@functools.lru_cache(maxsize=8)
-def _twiddles(n_r: int, n_d: int) -> tuple[np.ndarray, np.ndarray]:
-    """``exp(-j 2 pi k / Nr)`` ``(Nr,)`` and the Doppler transform's twiddles.
-
-    Doppler index ``d`` is zero-velocity centred (bin ``d - Nd // 2``), as in the exact chain.
-    ``Nd`` a power of two: ``(1, Nd/2)`` ``exp(-j 2 pi k / Nd)`` for the radix-2 FFT of the
-    window-shifted sequence (:func:`_doppler_weights`); otherwise ``(Nd, Nd)``
-    ``exp(-j 2 pi (d - Nd/2) m / Nd)`` for the direct DFT.
-    """
-    k = np.arange(n_r)
-    m = np.arange(n_d)
-    if _is_pow2(n_d):
-        tw_d = np.exp(-2j * np.pi * np.arange(n_d // 2) / n_d)[None, :]
-    else:
-        tw_d = np.exp(-2j * np.pi * np.outer(m - n_d // 2, m) / n_d)
-    return np.exp(-2j * np.pi * k / n_r), tw_d
-
-
-def _is_pow2(n: int) -> bool:
-    return n >= 2 and n & (n - 1) == 0
-
-
-def _doppler_weights(name: str, n: int) -> np.ndarray:
-    """The Doppler window as :func:`_patches_kernel` wants it (see :func:`_twiddles`)."""
-    if _is_pow2(n):
-        return _doppler_window_shifted(name, n)
-    return window(name, n).astype(np.float64)
 
 
 class Spectrum(NamedTuple):
@@ -601,7 +189,7 @@ def fast_spectrum(
     state = state6(state_from(rng if noise else None))
     rd = np.zeros((n_r, n_d), dtype=np.float32)
     if noise:
-        _noise_map(state, rd, s2, n_use, n_v)
+        noise_map(state, rd, s2, n_use, n_v)
     if len(scatterers) == 0:
         e = np.zeros(0)
         return Spectrum(
@@ -617,20 +205,20 @@ def fast_spectrum(
         axis=1,
     )
     # theta = 2 pi (2 S R / c) / Fs   (rad per sample)
-    theta = _beat_rad_per_sample_per_m(radar) * r_mid
-    k_idx, d_idx, x, along, ortho = _patches_kernel(
+    theta = beat_rad_per_sample_per_m(radar) * r_mid
+    k_idx, d_idx, x, along, ortho = patches_kernel(
         state,
         rd,
         amp,
         theta,
         *slow_time_sequences(radar, scatterers, settings),
-        _doppler_weights(settings.doppler_window, n_d),
-        _cosine_sum_coefficients(settings.range_window, n_r),
+        doppler_weights(settings.doppler_window, n_d),
+        cosine_sum_coefficients(settings.range_window, n_r),
         s2,
         steering_vectors(radar, scatterers),
         np.arange(n_v) // radar.n_rx,
         PATCH_THRESHOLD,
-        *_twiddles(n_r, n_d),
+        *twiddles(n_r, n_d),
         noise,
         n_use,
     )
@@ -758,208 +346,6 @@ def label_points(radar: RadarConfig, pc: PointCloud, scatterers: Scatterers) -> 
     )
 
 
-# ---- the exact chain's two-stage CFAR with the fast level's thresholds -------------------------
-# The library's compiled kernel (core.processing.cfar.two_stage_kernel: same edge rules, peak
-# grouping and output order as core.processing.two_stage_cfar), with thresholds for the fast
-# level's independent cells when asked.
-
-
-def two_stage_cfar_compiled(
-    rd_map: np.ndarray,
-    radar: RadarConfig,
-    settings: ProcessingSettings = DEFAULT_PROCESSING,
-    *,
-    n_channels: int | None = None,
-    independent_cells: bool = False,
-) -> Detections:
-    """:func:`core.processing.two_stage_cfar`, compiled: the same detections, in the same order.
-
-    Parameters and returns as there (``rd_map`` ``[range bin, Doppler bin]``, Doppler zero
-    velocity centred). ``independent_cells=True`` sets the thresholds for independent cells
-    (what the ``fast`` level's noise map has) instead of the window-correlated cells of the
-    exact chain, with the exact chain's noise false alarms per frame after both stages and
-    peak grouping (:func:`independent_cell_stages`).
-    """
-    rd = np.ascontiguousarray(rd_map)
-    L = radar.n_virtual if n_channels is None else n_channels
-    args = _cfar_arguments(radar, settings, L, rd.shape[0], rd.shape[1], independent_cells)
-    if args is None:
-        return _no_detections()
-    r, d, noise = two_stage_kernel(rd, *args)
-    return Detections(
-        range_bin=r, doppler_index=d, power=rd[r, d].astype(np.float64), noise_power=noise
-    )
-
-
-@functools.lru_cache(maxsize=64)
-def _cfar_arguments(
-    radar: RadarConfig,
-    settings: ProcessingSettings,
-    n_channels: int,
-    n_r: int,
-    n_d: int,
-    independent_cells: bool,
-):
-    """Whitening profile, range limits, training windows and thresholds (cached)."""
-    k = np.arange(n_r) * radar.range_resolution_m
-    in_range = (k >= settings.min_range_m) & (k <= settings.max_range_m)
-    if not in_range.any():
-        return None
-    lo, hi = (int(i) for i in np.flatnonzero(in_range)[[0, -1]])
-    rc, dc = settings.range_cfar, settings.doppler_cfar
-    margin = rc.n_train + rc.n_guard
-    a, b = max(0, lo - margin), min(n_r, hi + 1 + margin)
-    ne_r = ne_d = None
-    profile = np.ones(n_d)
-    if settings.cfar_noise_model:
-        ne_r = effective_cells_or_none(settings.range_window, radar.n_samples, rc.n_train)
-        ne_d = effective_cells_or_none(settings.doppler_window, n_d, dc.n_train)
-        if settings.static_clutter_removal:
-            profile = clutter_removal_noise_profile(settings.doppler_window, n_d)
-    if independent_cells and cells_correlated(radar, settings):
-        rc, dc, rf, df = _independent_stages(radar, settings, n_channels, n_r)
-    else:
-        rf, df = (
-            _factors(make_cfar(rc, n_channels, ne_r)),
-            _factors(make_cfar(dc, n_channels, ne_d)),
-        )
-    return (
-        np.ascontiguousarray(profile, dtype=np.float64),
-        lo, hi, a, b,
-        rc.n_train, rc.n_guard, rc.cyclic, _METHOD_CODE[rc.method], rf.both, rf.one,
-        dc.n_train, dc.n_guard, dc.cyclic, _METHOD_CODE[dc.method], df.both, df.one,
-        settings.peak_grouping,
-    )  # fmt: skip
-
-
-@functools.lru_cache(maxsize=16)
-def cfar_range_bins(radar: RadarConfig, settings: ProcessingSettings) -> int:
-    """Range bins the two-stage CFAR reads: up to its range limit plus guard and training."""
-    k = np.arange(radar.n_samples) * radar.range_resolution_m
-    inside = np.flatnonzero((k >= settings.min_range_m) & (k <= settings.max_range_m))
-    if inside.size == 0:
-        return 0
-    margin = settings.range_cfar.n_train + settings.range_cfar.n_guard
-    return int(min(radar.n_samples, inside[-1] + 1 + margin))
-
-
-def independent_cell_stages(
-    radar: RadarConfig, settings: ProcessingSettings, n_channels: int, n_range_bins: int
-) -> tuple[CfarSettings, CfarSettings]:
-    """CFAR stages for independent cells with the exact chain's noise false alarms per frame.
-
-    The exact chain's cells are window-correlated and its thresholds account for it; the
-    ``fast`` level's noise map has independent cells. With the same per-stage ``pfa`` the two
-    would differ in their two-stage rate (the stages share the cell under test) and in what peak
-    grouping removes (correlated neighbours are rarely all below a noise peak: 12 % of the exact
-    chain's false alarms go, 3 % of independent cells'). Both stages' ``pfa`` are scaled by one
-    factor ``kappa`` so that the model of
-    :func:`core.processing.false_alarms.noise_detections_per_frame` (both stages and peak
-    grouping) gives the same expected detections per noise-only frame for independent cells as
-    for the exact chain's cells with its own thresholds. ``n_range_bins``: rows of the map.
-    """
-    return _independent_stages(radar, settings, n_channels, n_range_bins)[:2]
-
-
-@functools.lru_cache(maxsize=16)
-def _independent_stages(
-    radar: RadarConfig, settings: ProcessingSettings, n_channels: int, n_range_bins: int
-) -> tuple[CfarSettings, CfarSettings, StageFactors, StageFactors]:
-    """:func:`independent_cell_stages` and their threshold factors (cached)."""
-    L = n_channels
-    target = noise_detections_per_frame(
-        radar, settings, *chain_factors(radar, settings, L), n_channels=L, n_range_bins=n_range_bins
-    )
-    rc, dc = settings.range_cfar, settings.doppler_cfar
-
-    def stages(log_kappa: float) -> tuple[CfarSettings, CfarSettings]:
-        k = float(np.exp(log_kappa))
-        return (
-            dataclasses.replace(rc, pfa=min(rc.pfa * k, 0.5)),
-            dataclasses.replace(dc, pfa=min(dc.pfa * k, 0.5)),
-        )
-
-    def with_factors(log_kappa: float):
-        r, d = stages(log_kappa)
-        return r, d, independent_factors(r, L), independent_factors(d, L)
-
-    def err(log_kappa: float) -> float:
-        fr, fd = with_factors(log_kappa)[2:]
-        p = noise_detections_per_frame(
-            radar, settings, fr, fd, independent_cells=True, n_channels=L,
-            n_range_bins=n_range_bins,
-        )  # fmt: skip
-        return float(np.log(p) - np.log(target))
-
-    if target <= 0.0:
-        return with_factors(0.0)
-    # log rate is smooth and nearly linear in log kappa: secant steps from kappa = 1 (four or
-    # five evaluations to 1e-7 in the rate), bracketing as a fall-back
-    u0, u1 = 0.0, -0.5
-    e0, e1 = err(u0), err(u1)
-    for _ in range(30):
-        if abs(e1) < 1e-7:
-            return with_factors(u1)
-        if e1 == e0:
-            break
-        u0, e0, u1 = u1, e1, float(np.clip(u1 - e1 * (u1 - u0) / (e1 - e0), -6.0, 3.0))
-        e1 = err(u1)
-    return with_factors(brentq(err, -6.0, 3.0, xtol=1e-7))
-
-
-def _factors(c) -> StageFactors:
-    return StageFactors(both=c.alpha(), one=c.alpha_one_side())
-
-
-@functools.lru_cache(maxsize=256)
-def independent_factors(c: CfarSettings, n_channels: int) -> StageFactors:
-    """Threshold factors of a stage on independent cells (``make_cfar(c, L)``'s, to 1e-12).
-
-    CASO by a bracketed root search between the one-sided CA factors for ``pfa`` and ``pfa/2``
-    (``Pfa_CA1(T) <= Pfa_SO(T) <= 2 Pfa_CA1(T)``: the smaller side is below either side, and
-    above the noise peak only if one of them is) instead of the library's scan from ``T = e^-8``
-    (one tenth of the evaluations: the threshold search runs a few times per slider move).
-    """
-    L, n, pfa = n_channels, c.n_train, c.pfa
-
-    def t_ca(cells: float, p: float) -> float:
-        # Pfa_CA(T) = 1 - I_{T/(1+T)}(L, N L)  ->  T = b / (1 - b)
-        b = float(betainccinv(L, cells * L, p))
-        return b / (1.0 - b)
-
-    one = n * t_ca(n, pfa)
-    if c.method == "ca":
-        return StageFactors(both=2 * n * t_ca(2 * n, pfa), one=one)
-    if c.method == "cago":
-        return StageFactors(both=threshold_factor("cago", n, pfa, L), one=one)
-    lo, hi = np.log(t_ca(n, pfa)), np.log(t_ca(n, pfa / 2))
-    log_t = brentq(lambda u: np.log(pfa_caso(np.exp(u), n, L)) - np.log(pfa), lo, hi, xtol=1e-13)
-    return StageFactors(both=n * float(np.exp(log_t)), one=one)
-
-
-def chain_factors(
-    radar: RadarConfig, settings: ProcessingSettings, n_channels: int
-) -> tuple[StageFactors, StageFactors]:
-    """The exact chain's threshold factors (range stage, Doppler stage), as ``two_stage_cfar``."""
-    rc, dc = settings.range_cfar, settings.doppler_cfar
-    ne_r = ne_d = None
-    if settings.cfar_noise_model:
-        ne_r = effective_cells_or_none(settings.range_window, radar.n_samples, rc.n_train)
-        ne_d = effective_cells_or_none(settings.doppler_window, radar.n_loops, dc.n_train)
-    return _factors(make_cfar(rc, n_channels, ne_r)), _factors(make_cfar(dc, n_channels, ne_d))
-
-
-def effective_cells_or_none(window_name: str, n_fft: int, n_train: int) -> float | None:
-    """Effective independent cells of ``n_train`` window-correlated ones (None: independent)."""
-    ne = effective_cells(window_name, n_fft, n_train)
-    return None if abs(ne - n_train) < 1e-9 else ne
-
-
-def _no_detections() -> Detections:
-    e = np.zeros(0, dtype=np.int64)
-    return Detections(range_bin=e, doppler_index=e, power=np.zeros(0), noise_power=np.zeros(0))
-
-
 def points_compiled(
     radar: RadarConfig,
     settings: ProcessingSettings,
@@ -969,7 +355,7 @@ def points_compiled(
     elevation: bool,
 ) -> PointCloud:
     """:func:`points_from_channels`, compiled: the same point cloud (``source`` = -2)."""
-    r_bin, d_bin, az, el = _points_kernel(
+    r_bin, d_bin, az, el = points_kernel(
         rd,
         det.range_bin,
         det.doppler_index,
@@ -1095,104 +481,106 @@ def _detected_channels_kernel(s, rd, r, d, cells_k, cells_d, x, along, ortho):  
     return out
 
 
+class SpectrumTables(NamedTuple):
+    """What the compiled frame kernel draws a frame's noise map and patches with."""
+
+    n_use: int  # range bins drawn (the CFAR's reach; all of them when the map is kept)
+    n_v: int  # virtual channels L
+    wd: np.ndarray  # (n_d,) Doppler window as patches_kernel wants it (doppler_weights)
+    b: np.ndarray  # (2J+1,) range window's cosine-sum coefficients
+    s2: np.ndarray  # (n_d,) per-channel cell noise power, V²
+    slot: np.ndarray  # (L,) TX slot of each virtual channel
+    threshold: float  # patch threshold relative to s2 (PATCH_THRESHOLD)
+    tw_r: np.ndarray  # (n_r,) range twiddles
+    tw_d: np.ndarray  # Doppler twiddles (see twiddles)
+
+
+class PointTables(NamedTuple):
+    """What the compiled frame kernel turns detections into labelled points with."""
+
+    n_tx: int
+    n_rx: int
+    row_ch: np.ndarray  # azimuth row: channels
+    row_pos: np.ndarray  # azimuth row: positions (half wavelengths)
+    upper: np.ndarray  # elevation pairs: upper channels (empty without elevation)
+    lower: np.ndarray  # elevation pairs: lower channels
+    tw_a: np.ndarray  # angle FFT twiddles
+    res_r: float  # range resolution, m
+    res_v: float  # velocity resolution, m/s
+    t_mid: float  # the frame's middle, s (labels)
+    span: float  # unambiguous velocity span 2 v_max, m/s (labels)
+
+
+def spectrum_tables(
+    radar: RadarConfig, settings: ProcessingSettings, keep_rd_map: bool
+) -> SpectrumTables:
+    """The :class:`SpectrumTables` of a radar and settings."""
+    n_r, n_d, n_v = radar.n_samples, radar.n_loops, radar.n_virtual
+    tw_r, tw_d = twiddles(n_r, n_d)
+    return SpectrumTables(
+        n_use=n_r if keep_rd_map else max(0, min(n_r, cfar_range_bins(radar, settings))),
+        n_v=n_v,
+        wd=doppler_weights(settings.doppler_window, n_d),
+        b=cosine_sum_coefficients(settings.range_window, n_r),
+        s2=cell_noise_power_v2(radar, settings),
+        slot=np.arange(n_v) // radar.n_rx,
+        threshold=PATCH_THRESHOLD,
+        tw_r=tw_r,
+        tw_d=tw_d,
+    )
+
+
+def point_tables(
+    radar: RadarConfig, settings: ProcessingSettings, elevation: bool, t_mid: float
+) -> PointTables:
+    """The :class:`PointTables` of a radar and settings (elevation pairs only if asked)."""
+    row_ch, row_pos, upper, lower = detection_rows(radar, elevation)
+    return PointTables(
+        n_tx=radar.n_tx,
+        n_rx=radar.n_rx,
+        row_ch=row_ch,
+        row_pos=row_pos,
+        upper=upper,
+        lower=lower,
+        tw_a=angle_twiddles(radar, settings.angle_fft_size),
+        res_r=radar.range_resolution_m,
+        res_v=radar.velocity_resolution_mps,
+        t_mid=t_mid,
+        span=2 * radar.max_velocity_mps,
+    )
+
+
+#: Stand-in CFAR arguments when no range bin lies inside the limits (``has_cfar`` False).
+_NO_CFAR = TwoStageCfarArgs(
+    profile=np.ones(1),
+    lo=0,
+    hi=0,
+    a=0,
+    b=0,
+    range_stage=CfarStageArgs(1, 0, False, 0, 1.0, 1.0),
+    doppler_stage=CfarStageArgs(1, 0, False, 0, 1.0, 1.0),
+    peak_grouping=False,
+)
+
+
 @numba.njit(cache=True, nogil=True)
 def _frame_kernel(
-    s,
-    rd,
-    amp,
-    theta,
-    slow,
-    slow1,
-    steer,
-    pos,
-    vel,
-    source,
-    elevation,
-    noise,
-    n_use,
-    wd,
-    b,
-    s2,
-    slot,
-    threshold,
-    tw_r,
-    tw_d,
-    has_cfar,
-    profile,
-    lo,
-    hi,
-    a,
-    bb,
-    rn,
-    rg,
-    rcyc,
-    rmeth,
-    ralpha,
-    ralpha1,
-    dn,
-    dg,
-    dcyc,
-    dmeth,
-    dalpha,
-    dalpha1,
-    peak,
-    n_tx,
-    n_rx,
-    row_ch,
-    row_pos,
-    upper,
-    lower,
-    tw_a,
-    res_r,
-    res_v,
-    t_mid,
-    span,
-):  # pragma: no cover
+    s, rd, amp, theta, slow, slow1, steer, pos, vel, source, elevation, noise, spec, has_cfar,
+    cfar, pts,
+):  # fmt: skip  # pragma: no cover
     """One frame after its noise map: patches, CFAR, detected channels, points, labels.
 
-    Returns ``(det_r, det_d, f64 (n, 8), source)`` with ``f64`` columns range, azimuth,
-    elevation, radial velocity, SNR, x, y, z.
+    ``amp`` … ``source``: the frame's reflectors (see :func:`patches_kernel`); ``spec``:
+    :class:`SpectrumTables`; ``cfar``: :class:`~core.processing.cfar.TwoStageCfarArgs` (used
+    when ``has_cfar``); ``pts``: :class:`PointTables`. Returns ``(det_r, det_d, f64 (n, 8),
+    source)`` with ``f64`` columns range, azimuth, elevation, radial velocity, SNR, x, y, z.
     """
-    cells_k, cells_d, x, along, ortho = _patches_kernel(
-        s,
-        rd,
-        amp,
-        theta,
-        slow,
-        slow1,
-        wd,
-        b,
-        s2,
-        steer,
-        slot,
-        threshold,
-        tw_r,
-        tw_d,
-        noise,
-        n_use,
-    )
+    cells_k, cells_d, x, along, ortho = patches_kernel(
+        s, rd, amp, theta, slow, slow1, spec.wd, spec.b, spec.s2, steer, spec.slot,
+        spec.threshold, spec.tw_r, spec.tw_d, noise, spec.n_use,
+    )  # fmt: skip
     if has_cfar:
-        r, d, nz = two_stage_kernel(
-            rd,
-            profile,
-            lo,
-            hi,
-            a,
-            bb,
-            rn,
-            rg,
-            rcyc,
-            rmeth,
-            ralpha,
-            ralpha1,
-            dn,
-            dg,
-            dcyc,
-            dmeth,
-            dalpha,
-            dalpha1,
-            peak,
-        )
+        r, d, nz = two_stage_kernel(rd, cfar)
     else:
         r = np.zeros(0, dtype=np.int64)
         d = np.zeros(0, dtype=np.int64)
@@ -1202,8 +590,8 @@ def _frame_kernel(
         return r, d, np.empty((0, 8)), np.full(0, -2, dtype=np.int32)
     ch = _detected_channels_kernel(s, rd, r, d, cells_k, cells_d, x, along, ortho)
     f64, src = point_rows(
-        rd, r, d, nz, ch, n_tx, n_rx, row_ch, row_pos, upper, lower, tw_a, elevation, pos, vel,
-        source, t_mid, res_r, res_v, span,
+        rd, r, d, nz, ch, pts.n_tx, pts.n_rx, pts.row_ch, pts.row_pos, pts.upper, pts.lower,
+        pts.tw_a, elevation, pos, vel, source, pts.t_mid, pts.res_r, pts.res_v, pts.span,
     )  # fmt: skip
     return r, d, f64, src  # fmt: skip
 
@@ -1226,11 +614,10 @@ def _grow(f64, i64, i32, need):  # pragma: no cover
 @numba.njit(cache=True, nogil=True)
 def _frames_kernel(
     states, start, elev, maps, keep, amp, theta, slow, slow1, steer, pos, vel, source, noise,
-    n_use, n_v, wd, b, s2, slot, threshold, tw_r, tw_d, has_cfar, profile, lo, hi, a, bb, rn, rg,
-    rcyc, rmeth, ralpha, ralpha1, dn, dg, dcyc, dmeth, dalpha, dalpha1, peak, n_tx, n_rx,
-    row_ch, row_pos, upper, lower, tw_a, res_r, res_v, t_mid, span,
+    spec, has_cfar, cfar, pts,
 ):  # fmt: skip  # pragma: no cover
-    """Every frame: noise map, then :func:`_frame_kernel`; frame ``f`` draws from ``states[f]``.
+    """Every frame: noise map, then :func:`_frame_kernel`; frame ``f`` draws from ``states[f]``
+    and has the reflectors ``start[f]:start[f+1]`` (arguments as there).
 
     Returns ``(det (n, 2), f64 (n, 8), source (n,), counts (F,))`` concatenated in frame order.
     """
@@ -1245,16 +632,13 @@ def _frames_kernel(
         s = states[f].copy()
         rd = maps[f] if keep else maps[0]
         if noise:
-            _noise_map(s, rd, s2, n_use, n_v)
+            noise_map(s, rd, spec.s2, spec.n_use, spec.n_v)
         else:
             rd[:] = 0.0
         i0, i1 = start[f], start[f + 1]
         r, d, f64, src = _frame_kernel(
             s, rd, amp[i0:i1], theta[i0:i1], slow[i0:i1], slow1[i0:i1], steer[i0:i1],
-            pos[i0:i1], vel[i0:i1], source[i0:i1], elev[f], noise, n_use, wd, b, s2, slot,
-            threshold, tw_r, tw_d, has_cfar, profile, lo, hi, a, bb, rn, rg, rcyc, rmeth, ralpha,
-            ralpha1, dn, dg, dcyc, dmeth, dalpha, dalpha1, peak, n_tx, n_rx, row_ch, row_pos,
-            upper, lower, tw_a, res_r, res_v, t_mid, span,
+            pos[i0:i1], vel[i0:i1], source[i0:i1], elev[f], noise, spec, has_cfar, cfar, pts,
         )  # fmt: skip
         n = r.shape[0]
         f64_all, det_all, src_all = _grow(f64_all, det_all, src_all, n_out + n)
@@ -1287,8 +671,6 @@ def _frames_fast(
         raise InputError(f"rngs: {len(rngs)} generators for {len(frames)} frames")
     n_f = len(frames)
     n_r, n_d, n_v = radar.n_samples, radar.n_loops, radar.n_virtual
-    s2 = cell_noise_power_v2(radar, settings)  # (n_d,)
-    n_use = n_r if keep_rd_map else max(0, min(n_r, cfar_range_bins(radar, settings)))
     counts = np.fromiter((len(s) for s in frames), dtype=np.int64, count=n_f)
     start = np.zeros(n_f + 1, dtype=np.int64)
     np.cumsum(counts, out=start[1:])
@@ -1299,7 +681,7 @@ def _frames_fast(
     t_mid = 0.5 * radar.n_loops * radar.n_tx * radar.chirp_period_s
     r_mid = np.linalg.norm(every.position_m + every.velocity_mps * t_mid, axis=1)
     # theta = 2 pi (2 S R / c) / Fs   (rad per sample)
-    theta = _beat_rad_per_sample_per_m(radar) * r_mid
+    theta = beat_rad_per_sample_per_m(radar) * r_mid
     slow, slow1 = slow_time_sequences(radar, every, settings)
     steer = np.ascontiguousarray(steering_vectors(radar, every))
     pos = np.ascontiguousarray(every.position_m, dtype=np.float64)
@@ -1311,23 +693,16 @@ def _frames_fast(
         elev = np.zeros(n_f, dtype=bool)
     else:
         elev = np.fromiter((needs_elevation(radar, s) for s in frames), dtype=bool, count=n_f)
-    cfar = _cfar_arguments(radar, settings, n_v, n_r, n_d, True)
-    has_cfar = cfar is not None
-    if cfar is None:  # no range bin inside the limits: nothing is tested
-        e = np.ones(1)
-        cfar = (e, 0, 0, 0, 0, 1, 0, False, 0, 1.0, 1.0, 1, 0, False, 0, 1.0, 1.0, False)
+    cfar = cfar_arguments(radar, settings, n_v, n_r, n_d, True)
+    has_cfar = cfar is not None  # None: no range bin inside the limits, nothing is tested
     states = np.zeros((n_f, 6), dtype=np.uint64)  # core.simulation.gaussian's six words
     for f in range(n_f):
         states[f, :4] = state_from(rngs[f] if noise else None)
     maps = np.empty((n_f if keep_rd_map else 1, n_r, n_d), dtype=np.float32)
     det, f64, src, n_out = _frames_kernel(
         states, start, elev, maps, bool(keep_rd_map), amp, theta, slow, slow1, steer, pos, vel,
-        source, bool(noise), n_use, n_v, _doppler_weights(settings.doppler_window, n_d),
-        _cosine_sum_coefficients(settings.range_window, n_r), s2, np.arange(n_v) // radar.n_rx,
-        PATCH_THRESHOLD, *_twiddles(n_r, n_d), has_cfar, *cfar, radar.n_tx, radar.n_rx,
-        *detection_rows(radar, bool(elev.any())), angle_twiddles(radar, settings.angle_fft_size),
-        radar.range_resolution_m, radar.velocity_resolution_mps, t_mid,
-        2 * radar.max_velocity_mps,
+        source, bool(noise), spectrum_tables(radar, settings, bool(keep_rd_map)), has_cfar,
+        cfar if has_cfar else _NO_CFAR, point_tables(radar, settings, bool(elev.any()), t_mid),
     )  # fmt: skip
     pc = cloud_from_rows(f64, src)
     out = FramesOutput(point_cloud=pc, counts=n_out, detections=det)

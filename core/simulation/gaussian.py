@@ -143,7 +143,7 @@ def _next_float(s):  # pragma: no cover
 
 
 @numba.njit(nogil=True)
-def _slow_draw(s, idx, rabs, x, fi):  # pragma: no cover
+def slow_draw(s, idx, rabs, x, fi):  # pragma: no cover
     """The 1.5 % of draws outside their layer's rectangle: the tail or the wedge test.
 
     Returns the draw, or NaN when it is rejected (the caller starts afresh). Kept out of line:
@@ -170,7 +170,7 @@ def _accumulate_normals(f, sigma, w, s, ki, wi, fi):  # pragma: no cover
     """``f[i, j] = (f[i, j] + sigma g) w[j]`` with ``g`` the next N(0, 1) draw, row by row.
 
     The ziggurat's common path is written out here, in the loop, on purpose (see
-    :func:`_slow_draw`).
+    :func:`slow_draw`).
     """
     n_rows, n = f.shape
     sig = np.float32(sigma)
@@ -188,7 +188,7 @@ def _accumulate_normals(f, sigma, w, s, ki, wi, fi):  # pragma: no cover
                     x = -x
                 if rabs < ki[idx]:
                     break  # inside the layer's rectangle: 98.5 % of the draws
-                x = _slow_draw(s, idx, rabs, x, fi)
+                x = slow_draw(s, idx, rabs, x, fi)
                 if not np.isnan(x):
                     break
             row[j] = (row[j] + sig * x) * w[j]

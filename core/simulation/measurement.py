@@ -49,6 +49,13 @@ the same kernel with one frame). The kernel draws from its own xoshiro256** gene
 per frame with four raw draws of that frame's ``rng`` (:func:`frame_seed`), so both entry
 points give the same frames bit for bit (``docs/decisions/fidelity-04``).
 
+Layout: about 950 lines, most of them the one compiled kernel (:func:`_measure_frames`, steps
+1-4 with its xoshiro256** generator) and the tables and false-alarm pool it reads, which are
+tabulated here with the same conventions (bin offsets, leakage sides) the kernel indexes them
+by; its arguments are grouped (:class:`ModelConstants`, :class:`KernelTables`,
+:class:`ArrayLayout`, :class:`FalseAlarmPool`). The false-alarm measurement
+(:func:`chain_false_alarms`) could move out on its own.
+
 Not modelled (measured against ``exact`` in ``docs/fidelity.md``): the extra detections next to
 very strong or fast reflectors (window sidelobes, clutter-removal residuals), two reflectors
 sharing a cell, the threshold effect of the estimators at very low SNR.
@@ -62,6 +69,7 @@ import os
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import NamedTuple
 
 import numba
 import numpy as np
@@ -71,17 +79,12 @@ from core.errors import InputError
 from core.pointcloud import SOURCE_OTHER, PointCloud
 from core.processing import estimate_angles, make_cfar
 from core.processing.angle import log_parabolic_offset
+from core.processing.cfar import METHOD_CODE, effective_cells_or_none
+from core.processing.points import angle_twiddles, angles_of, array_rows
 from core.processing.spectrum import window
 from core.simulation.antenna import AntennaGain
-from core.simulation.fast import (
-    FramesOutput,
-    angle_twiddles,
-    angles_of,
-    array_rows,
-    cell_noise_power_v2,
-    effective_cells_or_none,
-    range_responses,
-)
+from core.simulation.fast import FramesOutput
+from core.simulation.fast_model import cell_noise_power_v2, range_responses
 from core.simulation.frame import FrameOutput, needs_elevation
 from core.simulation.gaussian import state_from
 from core.simulation.link import receiver_voltage_scale
@@ -326,20 +329,105 @@ def _measure_false_alarms(
 
 
 #: No false alarms (noise-free frames).
-_NO_FALSE_ALARMS = FalseAlarms(
+
+
+class ModelCfarStage(NamedTuple):
+    """One CFAR stage as the compiled model draws it."""
+
+    method: int  # METHOD_CODE of the estimator
+    n_train: int  # training cells per side
+    n_eff: float  # effective independent cells among them (window correlation)
+    alpha: float  # threshold factor, both sides
+
+
+class ModelConstants(NamedTuple):
+    """Per-radar scalars of the compiled model."""
+
+    t_mid: float  # the frame's middle, s
+    range_res: float  # m
+    vel_res: float  # m/s
+    n_loops: int
+    doppler_scale: float  # the chain's Doppler reading per true radial velocity
+    c_amp2: float  # A^2 = c_amp2 g^2 sigma / R^4
+    L: float  # virtual channels
+    range_stage: ModelCfarStage
+    doppler_stage: ModelCfarStage
+    m_az: int  # channels of the azimuth row
+    bin_lo: int  # first range bin inside the limits
+    bin_hi: int  # last range bin inside the limits (-1: none)
+
+
+class KernelTables(NamedTuple):
+    """The :class:`ChainTables` the compiled model reads (shapes there)."""
+
+    range_gain: np.ndarray
+    range_est: np.ndarray
+    range_leak: np.ndarray
+    doppler_gain: np.ndarray
+    doppler_index: np.ndarray
+    doppler_est: np.ndarray
+    doppler_leak: np.ndarray
+    cell_noise: np.ndarray
+
+
+class ArrayLayout(NamedTuple):
+    """The virtual array as the compiled model's angle estimate reads it."""
+
+    az_pos: np.ndarray  # azimuth positions (half wavelengths)
+    el_pos: np.ndarray  # elevation positions
+    n_tx: int
+    n_rx: int
+    row_ch: np.ndarray  # azimuth row: channels
+    row_pos: np.ndarray  # azimuth row: positions
+    upper: np.ndarray  # elevation pairs: upper channels
+    lower: np.ndarray  # elevation pairs: lower channels
+    tw_a: np.ndarray  # angle FFT twiddles
+
+
+class FalseAlarmPool(NamedTuple):
+    """:class:`FalseAlarms` as the compiled model resamples them."""
+
+    rate_per_frame: float
+    doppler_index: np.ndarray
+    snr_db: np.ndarray
+    azimuth_rad: np.ndarray
+    range_frac: np.ndarray
+
+
+#: The pool of noise-free frames: no false alarms.
+_NO_FALSE_ALARM_POOL = FalseAlarmPool(
     rate_per_frame=0.0,
     doppler_index=np.zeros(0, dtype=np.int64),
     snr_db=np.zeros(0),
     azimuth_rad=np.zeros(0),
     range_frac=np.zeros(0),
-    n_frames=0,
 )
 
 
 @functools.lru_cache(maxsize=16)
 def _setup(radar: RadarConfig, settings: ProcessingSettings) -> tuple[ChainTables, dict]:
     """Tables and constants of a radar and settings (one cache look-up per frame)."""
-    return chain_tables(radar, settings), _constants(radar, settings)
+    tab = chain_tables(radar, settings)
+    const = dict(_constants(radar, settings))
+    const["tables"] = KernelTables(
+        tab.range_gain,
+        tab.range_est,
+        tab.range_leak,
+        tab.doppler_gain,
+        tab.doppler_index,
+        tab.doppler_est,
+        tab.doppler_leak,
+        tab.cell_noise,
+    )
+    return tab, const
+
+
+@functools.lru_cache(maxsize=16)
+def _false_alarm_pool(radar: RadarConfig, settings: ProcessingSettings) -> FalseAlarmPool:
+    fa = chain_false_alarms(radar, settings)
+    return FalseAlarmPool(
+        fa.rate_per_frame, fa.doppler_index, fa.snr_db, fa.azimuth_rad, fa.range_frac
+    )
 
 
 @functools.lru_cache(maxsize=16)
@@ -366,16 +454,15 @@ def _constants(radar: RadarConfig, settings: ProcessingSettings):
     beat = 2 * np.pi * 2 * radar.slope_hz_per_s / (SPEED_OF_LIGHT_MPS * radar.sample_rate_hz)
     doppler_scale = 1.0 + beat * (radar.n_samples - 1) / 2 / (4 * np.pi / radar.wavelength_m)
     t_mid = 0.5 * radar.n_loops * radar.n_tx * radar.chirp_period_s
-    method = {"ca": 0, "caso": 1, "cago": 2}
-    kernel = (
+    kernel = ModelConstants(
         t_mid, radar.range_resolution_m, radar.velocity_resolution_mps, radar.n_loops,
         doppler_scale, c_amp2, float(L),
-        method[rs.method], rs.n_train, float(ne_r or rs.n_train), rc.alpha(),
-        method[ds.method], ds.n_train, float(ne_d or ds.n_train), dc.alpha(),
+        ModelCfarStage(METHOD_CODE[rs.method], rs.n_train, float(ne_r or rs.n_train), rc.alpha()),
+        ModelCfarStage(METHOD_CODE[ds.method], ds.n_train, float(ne_d or ds.n_train), dc.alpha()),
         min(n_row, len(set(radar.azimuth_positions))),
         int(ok[0]) if ok.size else 0, int(ok[-1]) if ok.size else -1,
     )  # fmt: skip
-    array = (
+    array = ArrayLayout(
         np.asarray(radar.azimuth_positions, dtype=np.float64),
         np.asarray(radar.elevation_positions, dtype=np.float64),
         radar.n_tx,
@@ -456,8 +543,8 @@ def simulate_frames_measurement(
 
 def _run(radar, settings, antenna, states, start, pos, vel, rcs, source, elev, noise):
     """The compiled kernel over frames ``start[f]:start[f+1]`` of the concatenated reflectors."""
-    tab, const = _setup(radar, settings)
-    fa = chain_false_alarms(radar, settings) if noise else _NO_FALSE_ALARMS
+    _, const = _setup(radar, settings)
+    fa = _false_alarm_pool(radar, settings) if noise else _NO_FALSE_ALARM_POOL
     g_db = antenna.gain_db(np.arctan2(pos[:, 0], pos[:, 1])) if len(pos) else np.zeros(0)
     counts, f64, i64 = _measure_frames(
         states,
@@ -468,21 +555,10 @@ def _run(radar, settings, antenna, states, start, pos, vel, rcs, source, elev, n
         np.ascontiguousarray(rcs),
         elev,
         bool(noise),
-        *const["kernel"],
-        tab.range_gain,
-        tab.range_est,
-        tab.range_leak,
-        tab.doppler_gain,
-        tab.doppler_index,
-        tab.doppler_est,
-        tab.doppler_leak,
-        tab.cell_noise,
-        *const["array"],
-        fa.rate_per_frame,
-        fa.doppler_index,
-        fa.snr_db,
-        fa.azimuth_rad,
-        fa.range_frac,
+        const["kernel"],
+        const["tables"],
+        const["array"],
+        fa,
     )
     ref = i64[:, 0]
     src = np.full(len(ref), SOURCE_OTHER, dtype=np.int32)
@@ -654,62 +730,33 @@ def _grow(f64, i64, need):  # pragma: no cover
 
 @numba.njit(cache=True, nogil=True)
 def _measure_frames(
-    states,
-    start,
-    pos,
-    vel,
-    gain_db,
-    rcs,
-    elev,
-    noise,
-    t_mid,
-    range_res,
-    vel_res,
-    n_loops,
-    doppler_scale,
-    c_amp2,
-    L,
-    rmeth,
-    rn,
-    rne,
-    ralpha,
-    dmeth,
-    dn,
-    dne,
-    dalpha,
-    m_az,
-    bin_lo,
-    bin_hi,
-    range_gain,
-    range_est,
-    range_leak,
-    doppler_gain,
-    doppler_index,
-    doppler_est,
-    doppler_leak,
-    cell_noise,
-    az_pos,
-    el_pos,
-    n_tx,
-    n_rx,
-    row_ch,
-    row_pos,
-    upper,
-    lower,
-    tw_a,
-    fa_rate,
-    fa_doppler,
-    fa_snr,
-    fa_az,
-    fa_frac,
+    states, start, pos, vel, gain_db, rcs, elev, noise, const, tables, array, fa
 ):  # pragma: no cover
     """Steps 1-4 of the module docstring for every frame ``f`` (reflectors
     ``start[f]:start[f+1]``), frame ``f`` drawing from the generator state ``states[f]``.
 
     Returns ``counts`` ``(F,)``, ``f64`` ``(n, 8)`` (range, azimuth, elevation, radial velocity,
     SNR, x, y, z) and ``i64`` ``(n, 3)`` (reflector index or -1 for a false alarm, range bin,
-    Doppler index).
+    Doppler index). ``const``: :class:`ModelConstants`; ``tables``: :class:`KernelTables`;
+    ``array``: :class:`ArrayLayout`; ``fa``: :class:`FalseAlarmPool`.
     """
+    t_mid, range_res, vel_res, n_loops = const.t_mid, const.range_res, const.vel_res, const.n_loops
+    doppler_scale, c_amp2, L = const.doppler_scale, const.c_amp2, const.L
+    rmeth, rn, rne, ralpha = const.range_stage
+    dmeth, dn, dne, dalpha = const.doppler_stage
+    bin_lo, bin_hi = const.bin_lo, const.bin_hi  # (const.m_az: not read here)
+    range_gain, range_est, range_leak = tables.range_gain, tables.range_est, tables.range_leak
+    doppler_gain, doppler_index = tables.doppler_gain, tables.doppler_index
+    doppler_est, doppler_leak, cell_noise = (
+        tables.doppler_est,
+        tables.doppler_leak,
+        tables.cell_noise,
+    )
+    az_pos, el_pos, n_tx, n_rx = array.az_pos, array.el_pos, array.n_tx, array.n_rx
+    row_ch, row_pos, upper, lower, tw_a = (
+        array.row_ch, array.row_pos, array.upper, array.lower, array.tw_a
+    )  # fmt: skip
+    fa_rate, fa_doppler, fa_snr, fa_az, fa_frac = fa
     n_frames = states.shape[0]
     counts = np.zeros(n_frames, dtype=np.int64)
     cap = start[n_frames] + 4 * n_frames + 16

@@ -32,8 +32,8 @@ from core.simulation.gaussian import (  # noqa: F401  (state_from: re-exported f
     FI,
     KI,
     WI,
-    _slow_draw,
     next_u32,
+    slow_draw,
     state_from,
     xoshiro_step,
     ziggurat_tables,
@@ -195,7 +195,7 @@ def _u32_l(s0, s1, s2, s3, buf, has):  # pragma: no cover
 
 @numba.njit(inline="always")
 def _slow_l(idx, rabs, x, fi, s0, s1, s2, s3, buf, has):  # pragma: no cover
-    """:func:`core.simulation.gaussian._slow_draw` on a state in registers (the ziggurat's rare
+    """:func:`core.simulation.gaussian.slow_draw` on a state in registers (the ziggurat's rare
     tail and wedge draws). ``(x or NaN, s0, s1, s2, s3, buf, has)``."""
     if idx == 0:
         # tail beyond r (Marsaglia 1964): x = r + E1 / r, accepted when 2 E2 > (E1 / r)^2
@@ -280,7 +280,7 @@ def _gamma_f32_array(s, b, c, ki, wi, fi):  # pragma: no cover
                     x = -x
                 if rabs < ki[idx]:
                     break
-                x = _slow_draw(s, idx, rabs, x, fi)
+                x = slow_draw(s, idx, rabs, x, fi)
                 if not np.isnan(x):
                     break
             v = _F1 + c * x

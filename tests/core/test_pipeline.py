@@ -21,6 +21,9 @@ from core.pipeline import (
     scene_clutter_density,
     simulate_scene,
 )
+from core.pipeline import cache as pipeline_cache
+from core.pipeline import frames as pipeline_frames
+from core.pipeline import reflectors as pipeline_reflectors
 from core.pointcloud import POINT_FIELDS
 from core.scene import Person, Scene, class_scene, profile_trajectory
 
@@ -127,13 +130,13 @@ def test_unknown_fidelity_consumer_or_stage_is_an_input_error() -> None:
 
 def test_skipped_clutter_stage_is_not_run_and_changes_nothing(monkeypatch) -> None:
     calls = []
-    real = pipeline.draw_clutter
+    real = pipeline_reflectors.draw_clutter
 
     def counting(*args, **kwargs):
         calls.append(1)
         return real(*args, **kwargs)
 
-    monkeypatch.setattr(pipeline, "draw_clutter", counting)
+    monkeypatch.setattr(pipeline_reflectors, "draw_clutter", counting)
     scene = short_scene(clutter=0.0)
     skipped = simulate_scene(scene)
     assert calls == []
@@ -151,7 +154,7 @@ def test_skipped_person_rcs_stage_draws_nothing(monkeypatch) -> None:
         streams.append(stage)
         return real(seed, stage, frame)
 
-    monkeypatch.setattr(pipeline, "stage_rng", counting)
+    monkeypatch.setattr(pipeline_reflectors, "stage_rng", counting)
     scene = short_scene(rcs=-8.0)
     skipped = simulate_scene(scene)
     assert "person_rcs" not in streams
@@ -168,7 +171,7 @@ def test_rd_maps_only_when_asked_and_clouds_unchanged(monkeypatch) -> None:
         seen.append(kwargs["keep_rd_map"])
         return real(*args, **kwargs)
 
-    monkeypatch.setattr(pipeline, "simulator", lambda fidelity: recording)
+    monkeypatch.setattr(pipeline_frames, "simulator", lambda fidelity: recording)
     scene = short_scene(clutter=0.02, frames=4)
     plain = simulate_scene(scene)
     assert plain.rd_maps_db is None and seen == [False] * 4
@@ -285,7 +288,7 @@ def test_dataset_is_cached_by_hash_and_saved_atomically(tmp_path: Path, monkeypa
     def no_simulation(*args, **kwargs):
         raise AssertionError("simulated although cached")
 
-    monkeypatch.setattr(pipeline, "_simulate_task", no_simulation)
+    monkeypatch.setattr(pipeline_cache, "_simulate_task", no_simulation)
     again = build_dataset(scenes, seed=1, jobs=1)
     np.testing.assert_array_equal(first.range_m, again.range_m)
     assert isinstance(again, Dataset)

@@ -18,8 +18,8 @@ from core.simulation.fast import (
     cell_noise_power_v2,
     fast_spectrum,
     simulate_frame_fast,
-    two_stage_cfar_compiled,
 )
+from core.simulation.fast_cfar import two_stage_cfar_compiled
 from core.simulation.link import noise_power_v2
 
 RADAR = PAPER_RADAR

@@ -10,17 +10,16 @@ from core import pipeline
 from core.pointcloud import POINT_FIELDS
 from core.processing import Detections
 from core.scene import paper_scenes
-from core.simulation import AntennaGain, Scatterers
+from core.simulation import LEVELS, AntennaGain, Scatterers
 from core.simulation.fast import (
-    cfar_range_bins,
     detected_channels,
     fast_spectrum,
     label_points,
     points_compiled,
     simulate_frame_fast,
     simulate_frames_fast,
-    two_stage_cfar_compiled,
 )
+from core.simulation.fast_cfar import cfar_range_bins, two_stage_cfar_compiled
 
 
 @pytest.fixture(scope="module")
@@ -28,7 +27,7 @@ def trajectory():
     scene = paper_scenes(0, 1)[0]
     antenna = AntennaGain.draw(scene.radar, pipeline.stage_rng(scene.seed, "antenna"))
     settings = pipeline.processing_settings(scene)
-    refl = pipeline._Reflectors.build(scene, pipeline.plan(scene), scene.seed, antenna, settings)
+    refl = pipeline.Reflectors.build(scene, pipeline.plan(scene), scene.seed, antenna, settings)
     frames = [refl.frame(f)[0] for f in range(40)]
     frames[7] = Scatterers.empty()  # a frame without reflectors
     return scene.radar, frames, antenna, settings
@@ -89,7 +88,7 @@ def test_compiled_frame_equals_the_stage_functions(trajectory) -> None:
 
 def test_pipeline_uses_the_batch_path_with_the_per_frame_frames() -> None:
     scene = paper_scenes(0, 1)[0]
-    assert pipeline.BATCH_SIMULATORS["fast"].endswith(":simulate_frames_fast")
+    assert LEVELS["fast"].simulate_frames is simulate_frames_fast
     run = pipeline.simulate_scene(scene, fidelity="fast", seed=9)
     frames = list(pipeline.iter_frames(scene, fidelity="fast", seed=9, frames=range(12)))
     for fr in frames:

@@ -20,7 +20,8 @@ from core.config import ProcessingSettings, RadarConfig
 from core.processing import doppler_fft, range_doppler_map, range_fft, spectrum, two_stage_cfar
 from core.processing.false_alarms import StageFactors, noise_detections_per_frame
 from core.simulation import AntennaGain, synthesize_noise
-from core.simulation.fast import _cfar_arguments, chain_factors, simulate_frames_fast
+from core.simulation.fast import simulate_frames_fast
+from core.simulation.fast_cfar import cfar_arguments, chain_factors
 from core.simulation.scatterers import Scatterers
 
 RADAR = RadarConfig()
@@ -79,12 +80,12 @@ def test_fast_false_alarms_match_exact_chain_and_model(exact_maps, name: str) ->
     # the model's predictions: the exact chain's thresholds on correlated cells, and the fast
     # level's own thresholds on independent cells (equal by construction of those thresholds)
     pred_exact = noise_detections_per_frame(RADAR, s, *chain_factors(RADAR, s, 12))
-    a = _cfar_arguments(RADAR, s, 12, RADAR.n_samples, RADAR.n_loops, True)
+    a = cfar_arguments(RADAR, s, 12, RADAR.n_samples, RADAR.n_loops, True)
     pred_fast = noise_detections_per_frame(
         RADAR,
         s,
-        StageFactors(both=a[9], one=a[10]),
-        StageFactors(both=a[15], one=a[16]),
+        StageFactors(both=a.range_stage.alpha_both, one=a.range_stage.alpha_one),
+        StageFactors(both=a.doppler_stage.alpha_both, one=a.doppler_stage.alpha_one),
         independent_cells=True,
     )
     assert pred_fast == pytest.approx(pred_exact, rel=1e-4)

@@ -1,4 +1,4 @@
-"""Every entry point takes the fidelity level: the pipeline dispatches on FIDELITY_LEVELS."""
+"""Every entry point takes the fidelity level: the pipeline dispatches on core.simulation.LEVELS."""
 
 from __future__ import annotations
 
@@ -7,10 +7,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from core.pipeline import SIMULATORS, build_dataset, iter_frames, simulate_scene, simulator
+from core.errors import InputError
+from core.pipeline import build_dataset, iter_frames, simulate_scene, simulator
 from core.pointcloud import POINT_FIELDS
 from core.scene import Person, Scene, profile_trajectory
-from core.simulation import FIDELITY_LEVELS
+from core.simulation import FIDELITY_LEVELS, LEVELS
 
 
 def short_scene(frames: int = 12) -> Scene:
@@ -26,9 +27,12 @@ def short_scene(frames: int = 12) -> Scene:
 
 
 def test_every_level_is_registered_in_the_pipeline() -> None:
-    assert set(SIMULATORS) == set(FIDELITY_LEVELS)
+    assert list(FIDELITY_LEVELS) == list(LEVELS) == ["exact", "fast", "measurement"]
     for name, fn in FIDELITY_LEVELS.items():
-        assert simulator(name) is fn
+        assert simulator(name) is fn is LEVELS[name].simulate_frame
+        assert LEVELS[name].name == name and LEVELS[name].description
+    with pytest.raises(InputError, match="fidelity must be one of"):
+        simulator("exactly")
 
 
 @pytest.mark.parametrize("level", ["fast", "measurement"])

@@ -1,4 +1,4 @@
-"""The pipeline's per-frame reflector builder: its cached shortcuts give the same bits as the
+"""The pipeline's per-frame reflector builder: its shortcuts give the same bits as the
 straightforward calls they replace (the frames of every data set depend on it)."""
 
 from __future__ import annotations
@@ -17,10 +17,10 @@ from core.scene import Scene
 ROOT = Path(__file__).resolve().parents[3]
 
 
-def _reflectors(scene: Scene, seed: int = 7) -> pipeline._Reflectors:
+def _reflectors(scene: Scene, seed: int = 7) -> pipeline.Reflectors:
     antenna = sim.AntennaGain.draw(scene.radar, pipeline.stage_rng(seed, "antenna"))
     settings = pipeline.processing_settings(scene)
-    return pipeline._Reflectors.build(scene, pipeline.plan(scene), seed, antenna, settings)
+    return pipeline.Reflectors.build(scene, pipeline.plan(scene), seed, antenna, settings)
 
 
 def test_stage_rng_is_default_rng_of_the_stage_seed_sequence() -> None:
@@ -29,18 +29,6 @@ def test_stage_rng_is_default_rng_of_the_stage_seed_sequence() -> None:
             a = pipeline.stage_rng(123, stage, f).random(5)
             seq = np.random.SeedSequence(123, spawn_key=(key, f))
             assert a.tobytes() == np.random.default_rng(seq).random(5).tobytes()
-
-
-def test_cached_clutter_rcs_equals_rcs_for_snr_db_bit_for_bit() -> None:
-    scene = Scene.from_json(ROOT / "resources/scenes/two_persons.json")
-    refl = _reflectors(scene)
-    rng = np.random.default_rng(0)
-    xy = scene.aoi.sample_uniform(200, rng)
-    snr = rng.uniform(5.0, 25.0, 200)
-    r = np.hypot(xy[:, 0], xy[:, 1])
-    az = np.arctan2(xy[:, 0], xy[:, 1])
-    want = sim.rcs_for_snr_db(scene.radar, r, az, snr, refl.antenna, refl.settings)
-    assert refl._clutter_rcs_dbsm(xy, snr).tobytes() == want.tobytes()
 
 
 def test_frames_match_the_straightforward_construction() -> None:

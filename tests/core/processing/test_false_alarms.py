@@ -17,7 +17,7 @@ from core.processing.false_alarms import (
     noise_detections_per_frame,
     weighted_gamma_cdf,
 )
-from core.simulation.fast import _cfar_arguments, chain_factors
+from core.simulation.fast_cfar import cfar_arguments, chain_factors
 
 RADAR = RadarConfig()
 L = 12
@@ -87,9 +87,7 @@ def test_rectangular_windows_need_no_other_thresholds() -> None:
     assert not cells_correlated(RADAR, s)
     assert cells_correlated(RADAR, ProcessingSettings())
     # the fast level's thresholds are the chain's, and both models give the same rate
-    assert _cfar_arguments(RADAR, s, L, 256, 32, True) == _cfar_arguments(
-        RADAR, s, L, 256, 32, False
-    )
+    assert cfar_arguments(RADAR, s, L, 256, 32, True) == cfar_arguments(RADAR, s, L, 256, 32, False)
     f = chain_factors(RADAR, s, L)
     exact = noise_detections_per_frame(RADAR, s, *f)
     fast = noise_detections_per_frame(RADAR, s, *f, independent_cells=True)

@@ -76,7 +76,7 @@ def test_exact_frames_equal_the_numpy_detection_half() -> None:
     scene = paper_scenes(0, 1)[0]
     antenna = AntennaGain.draw(scene.radar, pipeline.stage_rng(scene.seed, "antenna"))
     settings = pipeline.processing_settings(scene)
-    refl = pipeline._Reflectors.build(scene, pipeline.plan(scene), scene.seed, antenna, settings)
+    refl = pipeline.Reflectors.build(scene, pipeline.plan(scene), scene.seed, antenna, settings)
     n_points = 0
     for f in range(0, 40, 4):
         sc = refl.frame(f)[0]

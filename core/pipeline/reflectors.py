@@ -1,0 +1,273 @@
+"""The reflectors of every frame of a scene: persons (points or walking bodies), clutter and
+static reflectors, each frame drawn from its own random streams (stages truth … scatterers of
+the plan)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from core.config import ProcessingSettings
+from core.pipeline.plan import Plan, plan, processing_settings
+from core.pipeline.streams import stage_rng
+from core.scene import Scene, draw_clutter
+from core.scene.body import body_scatterers, walking_headings
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Reflectors:
+    """Builds the scatterers of any frame of a scene (stages truth … scatterers of the plan)."""
+
+    scene: Scene
+    seed: int
+    antenna: Any
+    settings: ProcessingSettings
+    truth_t_s: np.ndarray  # (F,)
+    truth_xy_m: np.ndarray  # (F, n_persons, 2)
+    truth_v_mps: np.ndarray  # (F, n_persons, 2)
+    fixed_rcs: np.ndarray  # (n_persons,), NaN where drawn
+    extended: np.ndarray  # (n_persons,) bool: body model applies
+    headings: dict[int, np.ndarray]
+    run_rcs: bool
+    run_clutter: bool
+    run_static: bool
+    _consts: _FrameConstants
+
+    @classmethod
+    def build(cls, scene: Scene, p: Plan, seed: int, antenna, settings) -> Reflectors:
+        """The builder of a scene's frames under plan ``p`` (``seed``: every stream's seed)."""
+        t_s, xy, v = scene.truth()
+        extended = np.array([q.model == "extended" for q in scene.persons], dtype=bool)
+        if not p.runs("body_model"):
+            extended[:] = False
+        fixed_rcs = np.array([np.nan if q.rcs_dbsm is None else q.rcs_dbsm for q in scene.persons])
+        return cls(
+            scene=scene,
+            seed=seed,
+            antenna=antenna,
+            settings=settings,
+            truth_t_s=t_s,
+            truth_xy_m=xy,
+            truth_v_mps=v,
+            fixed_rcs=fixed_rcs,
+            extended=extended,
+            headings={
+                i: walking_headings(q.trajectory.velocity_mps)
+                for i, q in enumerate(scene.persons)
+                if extended[i]
+            },
+            run_rcs=p.runs("person_rcs"),
+            run_clutter=p.runs("clutter"),
+            run_static=p.runs("static_reflectors"),
+            _consts=cls._constants(scene, fixed_rcs, p.runs("static_reflectors")),
+        )
+
+    def frame(self, f: int) -> tuple[Any, int]:
+        """Scatterers of frame ``f`` and the number of clutter reflectors among them.
+
+        Bit for bit the reflectors of the straightforward construction (persons, body parts,
+        clutter, static reflectors, in this order) with the same per-frame streams (tested).
+        """
+        out, n_clutter = self.frames_at(np.array([f], dtype=np.int64))
+        return out[0], int(n_clutter[0])
+
+    def frames(self, n_frames: int | None = None) -> tuple[list[Any], np.ndarray]:
+        """The scatterers of frames ``0 .. n_frames - 1`` and their clutter counts, at once.
+
+        Bit for bit ``[self.frame(f) for f in range(n_frames)]`` (tested): every frame draws
+        from its own streams in the same order; what follows the draws (persons' RCS, clutter
+        velocities and RCS, assembly, validation) runs once over all frames instead of once per
+        frame. The frames are views into shared arrays.
+        """
+        n_f = len(self.truth_t_s) if n_frames is None else int(n_frames)
+        return self.frames_at(np.arange(n_f, dtype=np.int64))
+
+    def frames_at(self, idx: np.ndarray) -> tuple[list[Any], np.ndarray]:
+        """Scatterers and clutter counts of the frames ``idx`` (see :meth:`frames`)."""
+        from core import simulation as sim
+
+        scene = self.scene
+        k = self._consts
+        n_f = len(idx)
+        n_p = scene.n_persons
+        if n_f == 0:
+            return [], np.zeros(0, dtype=np.int64)
+        rcs = np.broadcast_to(self.fixed_rcs, (n_f, n_p))
+        if self.run_rcs:
+            # σ_dBsm ~ N(−8, 16), eq. (5), drawn afresh every frame
+            drawn = np.empty((n_f, n_p))
+            for row, f in enumerate(idx):
+                drawn[row] = sim.draw_person_rcs_dbsm(
+                    stage_rng(self.seed, "person_rcs", int(f)), n_p
+                )
+            rcs = np.where(k.drawn_rcs[None, :], drawn, self.fixed_rcs[None, :])
+        xy, v = self.truth_xy_m[idx], self.truth_v_mps[idx]
+        active = ~np.isnan(xy[:, :, 0])  # (F, n_p)
+        point = active & ~self.extended[None, :]
+        n_point = point.sum(axis=1)
+        # extended persons: the body model per frame and person (frame order, person order)
+        body_pos, body_vel, body_rcs, body_src = [], [], [], []
+        n_body = np.zeros(n_f, dtype=np.int64)
+        if self.extended.any():
+            for row, f in enumerate(idx):
+                for i in np.flatnonzero(active[row] & self.extended):
+                    bp, bv, frac = body_scatterers(
+                        xy[row, i], v[row, i], self.headings[i][f], self.truth_t_s[f]
+                    )
+                    body_pos.append(bp)
+                    body_vel.append(bv)
+                    # σ_part = σ · share (linear power)
+                    body_rcs.append(rcs[row, i] + 10 * np.log10(frac))
+                    body_src.append(np.full(len(bp), i, dtype=np.int32))
+                    n_body[row] += len(bp)
+        n_clutter = np.zeros(n_f, dtype=np.int64)
+        c_pos, c_vr, c_snr = [], [], []
+        if self.run_clutter:
+            for row, f in enumerate(idx):
+                c = draw_clutter(
+                    scene.aoi,
+                    scene.clutter_density_per_m2,
+                    scene.radar,
+                    stage_rng(self.seed, "clutter", int(f)),
+                )
+                n_clutter[row] = len(c)
+                c_pos.append(c.position_m)
+                c_vr.append(c.radial_velocity_mps)
+                c_snr.append(c.snr_db)
+        n_static = len(k.static_rcs)
+        per_frame = n_point + n_body + n_clutter + n_static
+        start = np.zeros(n_f + 1, dtype=np.int64)
+        np.cumsum(per_frame, out=start[1:])
+        n = int(start[-1])
+        position = np.zeros((n, 3))
+        velocity = np.zeros((n, 3))
+        rcs_all = np.empty(n)
+        source = np.empty(n, dtype=np.int32)
+        # persons as points: frame f's j-th active point person at start[f] + j
+        ff, ii = np.nonzero(point)
+        at = start[ff] + (np.cumsum(point, axis=1) - 1)[ff, ii]
+        position[at, :2] = xy[ff, ii]
+        velocity[at, :2] = v[ff, ii]
+        rcs_all[at] = rcs[ff, ii]
+        source[at] = ii
+        # then the body parts, the clutter and the static reflectors of each frame
+        frame_of = np.repeat(np.arange(n_f), per_frame)
+        slot = np.arange(n) - start[frame_of]  # position within the frame
+        first = n_point[frame_of]
+        if body_pos:
+            at = np.flatnonzero((slot >= first) & (slot < first + n_body[frame_of]))
+            position[at, :2] = np.concatenate(body_pos)
+            velocity[at, :2] = np.concatenate(body_vel)
+            rcs_all[at] = np.concatenate(body_rcs)
+            source[at] = np.concatenate(body_src)
+        first = first + n_body[frame_of]
+        if n_clutter.any():
+            at = np.flatnonzero((slot >= first) & (slot < first + n_clutter[frame_of]))
+            pos = np.concatenate(c_pos)
+            vr = np.concatenate(c_vr)
+            # v = vr p / |p|  (ClutterDraw.velocity_mps)
+            r = np.hypot(pos[:, 0], pos[:, 1])
+            position[at, :2] = pos
+            velocity[at, :2] = pos / r[:, None] * vr[:, None]
+            rcs_all[at] = self._clutter_rcs_dbsm(pos, np.concatenate(c_snr))
+            source[at] = -1
+        if n_static:
+            at = np.flatnonzero(slot >= first + n_clutter[frame_of])
+            j = slot[at] - (first + n_clutter[frame_of])[at]
+            position[at] = k.static_position[j]
+            rcs_all[at] = k.static_rcs[j]
+            source[at] = k.static_source[j]
+        whole_ok = _arrays_ok(position, velocity, rcs_all)
+        out = []
+        for row in range(n_f):
+            s = slice(start[row], start[row + 1])
+            part = (position[s], velocity[s], rcs_all[s], source[s])
+            # an invalid reflector: the frame's validating constructor names the field
+            out.append(_checked_scatterers(sim, *part) if whole_ok else _scatterers(sim, *part))
+        return out, n_clutter
+
+    @staticmethod
+    def _constants(scene: Scene, fixed_rcs, run_static: bool) -> _FrameConstants:
+        """What does not change from frame to frame."""
+        static = scene.static_reflectors
+        run_static = run_static and bool(static)
+        return _FrameConstants(
+            drawn_rcs=np.isnan(fixed_rcs),
+            static_position=np.array([[q.x_m, q.y_m, q.z_m] for q in static], dtype=np.float64)
+            if run_static
+            else np.zeros((0, 3)),
+            static_rcs=np.array([q.rcs_dbsm for q in static], dtype=np.float64)
+            if run_static
+            else np.zeros(0),
+            static_source=np.full(len(static) if run_static else 0, -1, dtype=np.int32),
+        )
+
+    def _clutter_rcs_dbsm(self, xy_m: np.ndarray, snr_db: np.ndarray) -> np.ndarray:
+        """RCS giving each clutter reflector its drawn SNR (the link budget's inverse)."""
+        from core import simulation as sim
+
+        r = np.hypot(xy_m[:, 0], xy_m[:, 1])
+        az = np.arctan2(xy_m[:, 0], xy_m[:, 1])
+        return sim.rcs_for_snr_db(self.scene.radar, r, az, snr_db, self.antenna, self.settings)
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class _FrameConstants:
+    """Frame-independent inputs of :meth:`Reflectors.frame`."""
+
+    drawn_rcs: np.ndarray  # (n_persons,) bool: RCS drawn every frame
+    static_position: np.ndarray  # (S, 3)
+    static_rcs: np.ndarray  # (S,)
+    static_source: np.ndarray  # (S,) int32, -1
+
+
+def _arrays_ok(position, velocity, rcs_dbsm) -> bool:
+    """What the ``Scatterers`` constructor checks, in one pass: finite, off the radar."""
+    return bool(
+        np.isfinite(position).all()
+        and np.isfinite(velocity).all()
+        and np.isfinite(rcs_dbsm).all()
+        and (len(position) == 0 or np.einsum("ij,ij->i", position, position).min() > 0)
+    )
+
+
+def _scatterers(sim, position, velocity, rcs_dbsm, source):
+    """``Scatterers`` of arrays checked here in one pass (finite, off the radar); arrays that
+    fail go through the validating constructor, which names the field."""
+    if not _arrays_ok(position, velocity, rcs_dbsm):
+        return sim.Scatterers(
+            position_m=position, velocity_mps=velocity, rcs_dbsm=rcs_dbsm, source=source
+        )
+    return _checked_scatterers(sim, position, velocity, rcs_dbsm, source)
+
+
+def _checked_scatterers(sim, position, velocity, rcs_dbsm, source):
+    """``Scatterers`` of arrays already checked (:func:`_arrays_ok`), without the constructor."""
+    s = object.__new__(sim.Scatterers)
+    for name, value in (
+        ("position_m", position),
+        ("velocity_mps", velocity),
+        ("rcs_dbsm", rcs_dbsm),
+        ("source", source),
+    ):
+        object.__setattr__(s, name, value)
+    return s
+
+
+def frame_scatterers(scene: Scene, frame: int, *, seed: int | None = None, the_plan=None):
+    """The reflectors of one frame (persons, clutter, static reflectors) as the chain sees them.
+
+    Returns
+    -------
+    core.simulation.Scatterers
+        ``source``: person index, or −1 for clutter and static reflectors.
+    """
+    from core import simulation as sim
+
+    p = the_plan or plan(scene)
+    seed = scene.seed if seed is None else int(seed)
+    antenna = sim.AntennaGain.draw(scene.radar, stage_rng(seed, "antenna"))
+    settings = processing_settings(scene)
+    return Reflectors.build(scene, p, seed, antenna, settings).frame(frame)[0]

@@ -1,0 +1,435 @@
+"""The ``fast`` level's closed-form model (see :mod:`core.simulation.fast`): the chain's range and
+Doppler responses of a point scatterer, the per-cell noise power, and the compiled kernels that
+draw a frame's noise map and its patches (cells where some scatterer's energy matters).
+"""
+
+from __future__ import annotations
+
+import functools
+
+import numba
+import numpy as np
+import scipy.fft
+
+from core.config import SPEED_OF_LIGHT_MPS, ProcessingSettings, RadarConfig
+from core.processing import window
+from core.simulation.gaussian import FI, KI, WI
+from core.simulation.link import noise_power_v2
+from core.simulation.rng_kernels import gamma_f32_l, gamma_l, normal_l
+from core.simulation.scatterers import Scatterers
+
+#: Per-channel signal power, relative to the cell's noise power, above which a cell gets
+#: per-channel noise and the coherent signal (-30 dB: the signal changes the cell's mean power
+#: by less than 0.1 % elsewhere).
+PATCH_THRESHOLD = 1e-3
+
+
+@functools.lru_cache(maxsize=32)
+def _doppler_window_shifted(name: str, n: int) -> np.ndarray:
+    """Doppler window with the fftshift folded in (``w[m] (-1)^m`` for even ``n``), complex128."""
+    w = window(name, n).astype(np.float64)
+    if n % 2 == 0:
+        w = w * np.where(np.arange(n) % 2 == 0, 1.0, -1.0)
+    return w
+
+
+@functools.lru_cache(maxsize=32)
+def cell_noise_power_v2(radar: RadarConfig, settings: ProcessingSettings) -> np.ndarray:
+    """Noise power per virtual channel and range-Doppler cell after both FFTs, ``(n_loops,)`` V².
+
+    ``s2[d] = sigma^2 sum w_r^2 (sum w_d^2 - |W_d(d)|^2 / Nc)`` with static clutter removal,
+    ``sigma^2 sum w_r^2 sum w_d^2`` without; index ``d`` is zero-velocity centred. The same for
+    every range bin.
+    """
+    wr = window(settings.range_window, radar.n_samples).astype(np.float64)
+    wd = window(settings.doppler_window, radar.n_loops).astype(np.float64)
+    n = radar.n_loops
+    gain_d = np.full(n, np.sum(wd**2))
+    if settings.static_clutter_removal:
+        # W_d(d) = sum_m w_m exp(-j 2 pi (d - n/2) m / n)
+        big_w = (
+            np.fft.fftshift(np.fft.fft(wd))
+            if n % 2
+            else np.fft.fft(_doppler_window_shifted(settings.doppler_window, n))
+        )
+        # s2[d] / (sigma^2 sum w_r^2) = sum w_d^2 - |W_d(d)|^2 / Nc
+        gain_d = gain_d - np.abs(big_w) ** 2 / n
+    out = noise_power_v2(radar) * np.sum(wr**2) * gain_d
+    out.flags.writeable = False
+    return out
+
+
+def range_responses(radar: RadarConfig, range_m: np.ndarray, settings: ProcessingSettings):
+    """Range window's response to each scatterer's beat tone, ``(N, n_samples)`` complex128.
+
+    ``R[k] = sum_n w_r[n] exp(j theta n) exp(-j 2 pi k n / Nadc)``,
+    ``theta = 2 pi (2 S R / c) / Fs``.
+    """
+    n = np.arange(radar.n_samples)
+    # theta = 2 pi (2 S R / c) / Fs   (rad per sample)
+    theta = (
+        2
+        * np.pi
+        * 2
+        * radar.slope_hz_per_s
+        * np.asarray(range_m)
+        / (SPEED_OF_LIGHT_MPS * radar.sample_rate_hz)
+    )
+    wr = window(settings.range_window, radar.n_samples).astype(np.float64)
+    tone = wr[None, :] * np.exp(1j * ((theta[:, None] * n[None, :]) % (2 * np.pi)))
+    return scipy.fft.fft(tone, axis=-1)
+
+
+def slow_time_sequences(
+    radar: RadarConfig, scatterers: Scatterers, settings: ProcessingSettings
+) -> tuple[np.ndarray, np.ndarray]:
+    """Slow-time sequences ``y`` and ``delta y`` per scatterer and TX slot, ``(N, n_tx, n_loops)``.
+
+    ``y_c = exp(j (4 pi R(t_c) / lambda + delta_c (Nadc - 1) / 2))`` and ``delta_c y_c`` with
+    ``delta_c = theta' (R(t_c) - R(t_mid))`` the beat tone's drift (rad/sample) at chirp ``c``;
+    both after static clutter removal when the settings ask for it.
+    """
+    return _slow_time_kernel(
+        np.ascontiguousarray(scatterers.position_m, dtype=np.float64),
+        np.ascontiguousarray(scatterers.velocity_mps, dtype=np.float64),
+        radar.n_tx,
+        radar.n_loops,
+        radar.chirp_period_s,
+        4 * np.pi / radar.wavelength_m,
+        beat_rad_per_sample_per_m(radar),
+        radar.n_samples,
+        settings.static_clutter_removal,
+    )
+
+
+def beat_rad_per_sample_per_m(radar: RadarConfig) -> float:
+    """``theta' = 2 pi (2 S / c) / Fs``: beat tone phase per ADC sample per metre of range."""
+    return 2 * np.pi * 2 * radar.slope_hz_per_s / (SPEED_OF_LIGHT_MPS * radar.sample_rate_hz)
+
+
+def doppler_responses(
+    radar: RadarConfig, scatterers: Scatterers, settings: ProcessingSettings
+) -> np.ndarray:
+    """Slow-time response of each scatterer per TX slot, ``(N, n_tx, n_loops)`` complex128.
+
+    Index ``d`` is zero-velocity centred. Includes the TDM slot delay, static clutter removal
+    and the beat tone's phase drift with the range (see the module docstring).
+    """
+    y = slow_time_sequences(radar, scatterers, settings)[0]
+    w = _doppler_window_shifted(settings.doppler_window, radar.n_loops)
+    out = scipy.fft.fft(y * w, axis=-1)
+    if radar.n_loops % 2:
+        out = np.fft.fftshift(out, axes=-1)
+    return out
+
+
+@functools.lru_cache(maxsize=32)
+def cosine_sum_coefficients(name: str, n: int) -> np.ndarray:
+    """``b_j`` (j = -J..J) with ``w[n] = sum_j b_j exp(j 2 pi j n / N)``, complex128 ``(2J+1,)``.
+
+    The library's windows are periodic cosine sums (rect, Hann, Hamming, Blackman), so the
+    window's DFT ``W`` has only these few non-zero coefficients: ``b_j = W[j] / N``.
+    """
+    w = window(name, n).astype(np.float64)
+    big_w = np.fft.fft(w) / n
+    half = 0
+    for j in range(1, n // 2):
+        if abs(big_w[j]) > 1e-6 * abs(big_w[0]):
+            half = j
+    b = np.array([big_w[j % n] for j in range(-half, half + 1)])
+    # the closed form below is exact only for cosine sums: check that nothing else is left
+    rebuilt = np.real(
+        np.sum(
+            b[:, None]
+            * np.exp(2j * np.pi * np.outer(np.arange(-half, half + 1), np.arange(n)) / n),
+            axis=0,
+        )
+    )
+    if half > 4 or np.max(np.abs(rebuilt - w)) > 1e-5:
+        raise ValueError(f"window {name!r} is not a short cosine sum")
+    return b
+
+
+@numba.njit(cache=True, nogil=True)
+def _slow_time_kernel(
+    pos, vel, n_tx, n_loops, t_chirp, k_phase, k_beat, n_samples, clutter_removal
+):  # pragma: no cover
+    """Slow-time sequences ``y`` and ``delta y``, each ``(N, n_tx, n_loops)``.
+
+    See :func:`slow_time_sequences`.
+    """
+    n_s = pos.shape[0]
+    n_ch = n_tx * n_loops
+    y = np.empty((n_s, n_tx, n_loops), dtype=np.complex128)
+    y1 = np.empty((n_s, n_tx, n_loops), dtype=np.complex128)
+    centre = (n_samples - 1) / 2
+    for i in range(n_s):
+        t_mid = (n_ch // 2) * t_chirp
+        r_mid = np.sqrt(
+            (pos[i, 0] + vel[i, 0] * t_mid) ** 2
+            + (pos[i, 1] + vel[i, 1] * t_mid) ** 2
+            + (pos[i, 2] + vel[i, 2] * t_mid) ** 2
+        )
+        for c in range(n_ch):
+            t = c * t_chirp
+            # R(t_c) = |p + v t_c|
+            r = np.sqrt(
+                (pos[i, 0] + vel[i, 0] * t) ** 2
+                + (pos[i, 1] + vel[i, 1] * t) ** 2
+                + (pos[i, 2] + vel[i, 2] * t) ** 2
+            )
+            # delta_c = theta' (R(t_c) - R(t_mid));  phi_c = 4 pi R(t_c) / lambda + delta_c (N-1)/2
+            delta = k_beat * (r - r_mid)
+            phi = (k_phase * r) % (2 * np.pi) + delta * centre
+            z = np.cos(phi) + 1j * np.sin(phi)
+            y[i, c % n_tx, c // n_tx] = z
+            y1[i, c % n_tx, c // n_tx] = delta * z
+        if clutter_removal:
+            for s in range(n_tx):
+                mean = y[i, s, :].sum() / n_loops
+                mean1 = y1[i, s, :].sum() / n_loops
+                for m in range(n_loops):
+                    y[i, s, m] -= mean
+                    y1[i, s, m] -= mean1
+    return y, y1
+
+
+@numba.njit(cache=True, nogil=True)
+def noise_map(s, rd, s2, n_use, n_v):  # pragma: no cover
+    """Noise-only map: ``rd[k, d] = s2[d] Gamma(L)`` (float32) for ``k < n_use`` (row by row),
+    the mean ``L s2[d]`` beyond (never read by the CFAR). Draws from the six-word state ``s``
+    (advanced): NumPy's float32 Gamma algorithm (:func:`~core.simulation.rng_kernels.gamma_f32`),
+    as ``standard_gamma(L, dtype=float32)`` fed the same words."""
+    n_r, n_d = rd.shape
+    # Marsaglia-Tsang constants of Gamma(L) in float32: b = L - 1/3, c = 1 / sqrt(9 b)
+    b = np.float32(n_v) - np.float32(1.0 / 3.0)
+    c = np.float32(np.float32(1.0) / np.sqrt(np.float32(9.0) * b))
+    s2_32 = s2.astype(np.float32)
+    ki, wi, fi = KI, WI, FI
+    # the generator state in registers
+    s0, s1, s2_, s3, buf, has = s[0], s[1], s[2], s[3], s[4], s[5] != 0
+    for k in range(n_use):
+        for d in range(n_d):
+            g, s0, s1, s2_, s3, buf, has = gamma_f32_l(s0, s1, s2_, s3, buf, has, b, c, ki, wi, fi)
+            # noise-only cell: sum of L exponentials of mean s2[d] ~ s2[d] Gamma(L)
+            rd[k, d] = g * s2_32[d]
+    s[0], s[1], s[2], s[3], s[4], s[5] = s0, s1, s2_, s3, buf, np.uint64(has)
+    for k in range(n_use, n_r):
+        for d in range(n_d):
+            rd[k, d] = np.float32(n_v * s2[d])
+
+
+@numba.njit(cache=True, nogil=True)
+def _fft_pow2(a, tw):  # pragma: no cover
+    """In-place radix-2 FFT of ``a`` (length a power of 2); ``tw[k] = exp(-j 2 pi k / n)``."""
+    n = a.shape[0]
+    j = 0
+    for i in range(1, n):
+        bit = n >> 1
+        while j & bit:
+            j ^= bit
+            bit >>= 1
+        j |= bit
+        if i < j:
+            a[i], a[j] = a[j], a[i]
+    size = 2
+    while size <= n:
+        half = size // 2
+        step = n // size
+        for first in range(0, n, size):
+            for k in range(half):
+                # butterfly: (u, v w) -> (u + v w, u - v w)
+                v = a[first + k + half] * tw[k * step]
+                u = a[first + k]
+                a[first + k] = u + v
+                a[first + k + half] = u - v
+        size *= 2
+
+
+@numba.njit(cache=True, nogil=True)
+def patches_kernel(
+    s, rd, amp, theta, slow, slow1, wd, b, s2, steer, slot, threshold, tw_r, tw_d, noise, k_max
+):  # pragma: no cover
+    """Patch cells, their noise-free channel values and their noisy channel sums.
+
+    amp (N,), theta (N,) beat tone rad/sample, slow/slow1 (N, n_tx, M) slow-time sequences
+    (after clutter removal), wd (M,) Doppler window (times ``(-1)^m`` when ``tw_d`` is the
+    radix-2 FFT's twiddles), b (2J+1,) range window coefficients, s2 (M,) cell noise power,
+    steer (N, L), slot (L,) TX slot of each channel, tw_r (N,) = exp(-j 2 pi k / N); tw_d either
+    (M, M) = exp(-j 2 pi (d - M/2) m / M) (direct DFT) or (1, M/2) = exp(-j 2 pi k / M) (M a
+    power of two: radix-2 FFT of the window-shifted sequence, the same transform). Adds the
+    patch cells' noisy power into ``rd`` (draws from the generator state ``s``); only range
+    bins below ``k_max`` are looked at.
+    """
+    n_samples = tw_r.shape[0]
+    n_s = amp.shape[0]
+    n_tx, m = slow.shape[1], slow.shape[2]
+    n_v = steer.shape[1]
+    half = (b.shape[0] - 1) // 2
+    nn = n_samples
+    centre = (nn - 1) / 2
+    # range response R_i[k] = sum_j b_j G(theta - 2 pi (k - j) / N),
+    # G(phi) = (1 - exp(j phi N)) / (1 - exp(j phi)), exp(j phi N) = exp(j theta N);
+    # its centred derivative R1_i[k] = dR/dtheta - j (N - 1)/2 R = sum_n w_n j (n - (N-1)/2) ...
+    # G and dG/dtheta are evaluated once per index k - j (shared by the 2J+1 terms of R)
+    n_g = k_max + 2 * half
+    gg = np.empty(n_g, dtype=np.complex128)
+    gg1 = np.empty(n_g, dtype=np.complex128)
+    rr = np.empty((n_s, k_max), dtype=np.complex128)
+    rr1 = np.empty((n_s, k_max), dtype=np.complex128)
+    pr = np.empty((n_s, k_max))
+    pr1 = np.empty((n_s, k_max))
+    for i in range(n_s):
+        e_n = np.exp(1j * theta[i] * nn)
+        num = 1.0 - e_n
+        e = np.exp(1j * theta[i])
+        for t in range(n_g):
+            q = e * tw_r[(t - half) % nn]  # exp(j phi), phi = theta - 2 pi (t - J) / N
+            den = 1.0 - q
+            den2 = den.real * den.real + den.imag * den.imag
+            if den2 < 1e-18:
+                gg[t] = nn + 0.0j
+                gg1[t] = 1j * nn * (nn - 1) / 2
+            else:
+                inv = den.conjugate() * (1.0 / den2)  # 1 / (1 - q)
+                gg[t] = num * inv
+                # dG/dtheta = (-j N e^{j N theta} (1 - q) + (1 - e^{j N theta}) j q) / (1 - q)^2
+                gg1[t] = (-1j * nn * e_n * den + num * 1j * q) * (inv * inv)
+        for k in range(k_max):
+            acc = 0.0 + 0.0j
+            acc1 = 0.0 + 0.0j
+            for jj in range(-half, half + 1):
+                # G at phi = theta - 2 pi (k - jj) / N is gg[k - jj + J]
+                acc += b[jj + half] * gg[k - jj + half]
+                acc1 += b[jj + half] * gg1[k - jj + half]
+            rr[i, k] = amp[i] * acc
+            rr1[i, k] = amp[i] * (acc1 - 1j * centre * acc)
+            pr[i, k] = rr[i, k].real ** 2 + rr[i, k].imag ** 2
+            pr1[i, k] = rr1[i, k].real ** 2 + rr1[i, k].imag ** 2
+    # Doppler responses D_i[s, d] = sum_m wd[m] y[m] exp(-j 2 pi (d - M/2) m / M), D1 of delta y
+    dd = np.empty((n_s, n_tx, m), dtype=np.complex128)
+    dd1 = np.empty((n_s, n_tx, m), dtype=np.complex128)
+    pd = np.zeros((n_s, m))
+    pd1 = np.zeros((n_s, m))
+    pd_max = np.zeros(n_s)
+    pd1_max = np.zeros(n_s)
+    ws = np.empty(m, dtype=np.complex128)
+    ws1 = np.empty(m, dtype=np.complex128)
+    radix2 = tw_d.shape[0] == 1
+    for i in range(n_s):
+        for sl in range(n_tx):
+            for t in range(m):
+                ws[t] = wd[t] * slow[i, sl, t]
+                ws1[t] = wd[t] * slow1[i, sl, t]
+            if radix2:
+                _fft_pow2(ws, tw_d[0])
+                _fft_pow2(ws1, tw_d[0])
+                for d in range(m):
+                    dd[i, sl, d] = ws[d]
+                    dd1[i, sl, d] = ws1[d]
+            else:
+                for d in range(m):
+                    acc = 0.0 + 0.0j
+                    acc1 = 0.0 + 0.0j
+                    for t in range(m):
+                        acc += ws[t] * tw_d[d, t]
+                        acc1 += ws1[t] * tw_d[d, t]
+                    dd[i, sl, d] = acc
+                    dd1[i, sl, d] = acc1
+            for d in range(m):
+                a0 = dd[i, sl, d]
+                a1 = dd1[i, sl, d]
+                pd[i, d] = max(pd[i, d], a0.real**2 + a0.imag**2)
+                pd1[i, d] = max(pd1[i, d], a1.real**2 + a1.imag**2)
+        for d in range(m):
+            pd_max[i] = max(pd_max[i], pd[i, d])
+            pd1_max[i] = max(pd1_max[i], pd1[i, d])
+    s2_min = s2[0]
+    for d in range(m):
+        s2_min = min(s2_min, s2[d])
+    lim_min = threshold * s2_min
+    cells_k = np.empty(k_max * m, dtype=np.int64)
+    cells_d = np.empty(k_max * m, dtype=np.int64)
+    n_c = 0
+    for k in range(k_max):
+        # skip the range bin when no scatterer can reach the smallest limit in any Doppler bin
+        # (pr pd[d] + pr1 pd1[d] <= pr max pd + pr1 max pd1, and lim[d] >= lim_min)
+        maybe = False
+        for i in range(n_s):
+            if pr[i, k] * pd_max[i] + pr1[i, k] * pd1_max[i] > lim_min:
+                maybe = True
+                break
+        if not maybe:
+            continue
+        for d in range(m):
+            lim = threshold * s2[d]
+            for i in range(n_s):
+                if pr[i, k] * pd[i, d] + pr1[i, k] * pd1[i, d] > lim:
+                    cells_k[n_c] = k
+                    cells_d[n_c] = d
+                    n_c += 1
+                    break
+    x = np.zeros((n_c, n_v), dtype=np.complex128)
+    along = np.zeros(n_c, dtype=np.complex128)
+    ortho = np.zeros(n_c)
+    g = np.empty(n_tx, dtype=np.complex128)
+    # Marsaglia-Tsang constants of Gamma(L - 1)
+    dk = n_v - 1.0 - 1.0 / 3.0
+    ck = 1.0 / np.sqrt(9.0 * dk)
+    s0, s1, s2_, s3 = s[0], s[1], s[2], s[3]  # the generator state in registers
+    for c in range(n_c):
+        k = cells_k[c]
+        d = cells_d[c]
+        for i in range(n_s):
+            if pr[i, k] * pd[i, d] + pr1[i, k] * pd1[i, d] < 1e-6 * s2[d]:
+                continue  # below -60 dB of the noise: nothing to add
+            for sl in range(n_tx):
+                # first order in the beat tone's drift: R D + R1 D1
+                g[sl] = rr[i, k] * dd[i, sl, d] + rr1[i, k] * dd1[i, sl, d]
+            for v in range(n_v):
+                # X[c, v] = sum_i A_i R_i[k] D_i[slot(v), d] a_i[v]
+                x[c, v] += g[slot[v]] * steer[i, v]
+        norm2 = 0.0
+        for v in range(n_v):
+            norm2 += x[c, v].real ** 2 + x[c, v].imag ** 2
+        if noise:
+            sd = np.sqrt(s2[d] / 2)
+            re, s0, s1, s2_, s3 = normal_l(s0, s1, s2_, s3)
+            im, s0, s1, s2_, s3 = normal_l(s0, s1, s2_, s3)
+            along[c] = sd * (re + 1j * im)
+            g_o, s0, s1, s2_, s3 = gamma_l(s0, s1, s2_, s3, dk, ck)
+            ortho[c] = s2[d] * g_o
+        # P = |(|s| + n_1)|^2 + |n_perp|^2
+        z = np.sqrt(norm2) + along[c]
+        rd[k, d] = z.real**2 + z.imag**2 + ortho[c]
+    s[0], s[1], s[2], s[3] = s0, s1, s2_, s3
+    return cells_k[:n_c], cells_d[:n_c], x, along, ortho
+
+
+@functools.lru_cache(maxsize=8)
+def twiddles(n_r: int, n_d: int) -> tuple[np.ndarray, np.ndarray]:
+    """``exp(-j 2 pi k / Nr)`` ``(Nr,)`` and the Doppler transform's twiddles.
+
+    Doppler index ``d`` is zero-velocity centred (bin ``d - Nd // 2``), as in the exact chain.
+    ``Nd`` a power of two: ``(1, Nd/2)`` ``exp(-j 2 pi k / Nd)`` for the radix-2 FFT of the
+    window-shifted sequence (:func:`doppler_weights`); otherwise ``(Nd, Nd)``
+    ``exp(-j 2 pi (d - Nd/2) m / Nd)`` for the direct DFT.
+    """
+    k = np.arange(n_r)
+    m = np.arange(n_d)
+    if _is_pow2(n_d):
+        tw_d = np.exp(-2j * np.pi * np.arange(n_d // 2) / n_d)[None, :]
+    else:
+        tw_d = np.exp(-2j * np.pi * np.outer(m - n_d // 2, m) / n_d)
+    return np.exp(-2j * np.pi * k / n_r), tw_d
+
+
+def _is_pow2(n: int) -> bool:
+    return n >= 2 and n & (n - 1) == 0
+
+
+def doppler_weights(name: str, n: int) -> np.ndarray:
+    """The Doppler window as :func:`patches_kernel` wants it (see :func:`twiddles`)."""
+    if _is_pow2(n):
+        return _doppler_window_shifted(name, n)
+    return window(name, n).astype(np.float64)
