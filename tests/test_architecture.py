@@ -162,12 +162,6 @@ def test_known_cycles_still_exist(cycles: list[frozenset[str]]) -> None:
 KNOWN_PRIVATE_IMPORTS: dict[tuple[str, str, str], str] = {
     # branch `tracking`: the model comparison moves into core/evaluation/ without it
     ("core/model_comparison.py", "core.tracking.batch", "_prepare"): "branch tracking",
-    # the sim benchmark's plain CFAR reuses the chain's effective training-cell count
-    # not yet addressed: names the fast level and its kernels share with processing/simulation
-    ("core/benchmarks/sim.py", "core.processing.cfar", "_effective"): "to be made public",
-    ("core/simulation/fast.py", "core.processing.cfar", "_METHOD_CODE"): "to be made public",
-    ("core/simulation/fast.py", "core.processing.points", "_points_kernel"): "to be made public",
-    ("core/simulation/rng_kernels.py", "core.simulation.gaussian", "_slow_draw"): "idem",
 }
 
 

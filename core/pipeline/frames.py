@@ -191,6 +191,7 @@ def _simulate_scene_batch(
     from core import simulation as sim
 
     simulate = sim.fidelity_level(p.fidelity).simulate_frames
+    assert simulate is not None, "the plan chose the batch path only for a level that has one"
     radar = scene.radar
     settings = processing_settings(scene)
     antenna = sim.AntennaGain.draw(radar, stage_rng(seed, "antenna"))

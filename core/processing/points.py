@@ -250,7 +250,9 @@ def _azimuth_rows(radar: RadarConfig):
 
 
 @functools.lru_cache(maxsize=16)
-def array_rows(radar: RadarConfig):
+def array_rows(radar: RadarConfig) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The virtual array's azimuth row (channels, positions) and elevation pairs (upper, lower),
+    as int64 arrays for the compiled angle estimate."""
     row_ch, row_pos = azimuth_row(radar)
     upper, lower = elevation_pairs(radar)
     return (
