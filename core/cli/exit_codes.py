@@ -12,7 +12,8 @@ from __future__ import annotations
 #: the study reached its total (``tune``), or the worker ran until the total or was stopped
 #: politely with SIGTERM after finishing its trial (``worker``)
 EXIT_OK = 0
-#: bad input: one line on stderr names the file, field or value (nothing was changed)
+#: bad input (or, from a worker, a broken objective): one line on stderr names the file, field
+#: or value
 EXIT_INPUT_ERROR = 2
 #: ``tune`` only: a worker was killed (or stopped from outside) before the total was reached;
 #: the study is intact and resumable — run the same command again
@@ -23,7 +24,8 @@ EXIT_INTERRUPTED = 130
 _TUNE = f"""\
 exit codes:
   {EXIT_OK}    the study reached its total (--trials); the best trial is printed as JSON
-  {EXIT_INPUT_ERROR}    bad input (one line on stderr says what); the study was not changed
+  {EXIT_INPUT_ERROR}    bad input, or a broken objective (5 failed trials in a row); one line on
+       stderr says what
   {EXIT_WORKER_LOST}    a worker was killed (SIGKILL, out of memory, crash) or stopped from outside
        before the total was reached: finished trials are kept, the study is resumable —
        run the same command again
