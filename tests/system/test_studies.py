@@ -272,10 +272,10 @@ def test_killed_worker_exits_3_resumable_and_the_same_command_completes(tmp_path
 
     url = f"sqlite:///{tmp_path}/k.db"
     # created before tune starts, so that polling never races tune's creation of the schema
-    prepare_study(StudySettings(model="cv", n_trials=4, storage=url, study_name="k",
+    prepare_study(StudySettings(model="cv", n_trials=6, storage=url, study_name="k",
                                 objective="quadratic"))  # fmt: skip
     # one worker, trials of 5 x 0.15 s: it is mid-trial for most of the time
-    args = ["tune", "--model", "cv", "--trials", "4", "--jobs", "1", "--storage", url,
+    args = ["tune", "--model", "cv", "--trials", "6", "--jobs", "1", "--storage", url,
             "--study", "k", *QUAD, "--objective-option", "delay_s=0.15"]  # fmt: skip
     parent = subprocess.Popen(
         [sys.executable, "-m", "core.cli", *args],
@@ -314,8 +314,9 @@ def test_killed_worker_exits_3_resumable_and_the_same_command_completes(tmp_path
     again = cli(*args)
     assert again.returncode == EXIT_OK, again.stderr
     after = _states(url, "k")
-    assert _counted(after) == 4
-    assert [s for s, _ in after.values()].count("FAIL") == 1  # the killed worker's trial
+    assert _counted(after) == 6
+    # the killed worker's trial (none if the kill fell between two of its trials)
+    assert [s for s, _ in after.values()].count("FAIL") <= 1
 
 
 def test_two_tune_runs_on_one_study_repeat_no_parameter_set(tmp_path: Path) -> None:
