@@ -2,22 +2,36 @@
 
 Example: ``radartune tune --model cv --trials 300 --jobs 2 --storage sqlite:///studies.db``.
 Progress bar with the best loss so far; Ctrl-C stops after the running trials (twice: abort).
+Exit codes: :mod:`core.cli.exit_codes` (also in ``radartune tune --help``).
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import signal
 import sys
 import time
 
+from core.cli.exit_codes import (
+    EXIT_INPUT_ERROR,
+    EXIT_INTERRUPTED,
+    EXIT_OK,
+    EXIT_WORKER_LOST,
+    epilog,
+)
 from core.errors import InputError
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
     from core.optimization.storage import DEFAULT_STORAGE
 
-    p = sub.add_parser("tune", help="find optimal tracker parameters with Optuna")
+    p = sub.add_parser(
+        "tune",
+        help="find optimal tracker parameters with Optuna",
+        epilog=epilog("tune"),
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
     p.add_argument("--model", required=True, help="motion model: cv or ca")
     p.add_argument("--trials", type=int, default=300, help="total trials (all workers)")
     p.add_argument("--jobs", type=int, default=1, help="worker processes (default: %(default)s)")
@@ -132,7 +146,60 @@ def run(args: argparse.Namespace) -> int:
                 }
             )
         )
-    bad = [c for c in codes if c not in (0, None)]
-    if bad:
-        return 2 if 2 in bad else (130 if interrupted else bad[0])
-    return 130 if interrupted and n < settings.n_trials else 0
+    pids = [p.pid for p in handle.procs]
+    return exit_code(codes, pids, n, settings.n_trials, settings.name, interrupted=interrupted)
+
+
+def _ending(code: int) -> str:
+    """How a worker process ended, from its ``Popen.returncode``."""
+    if code < 0:
+        try:
+            return f"was killed by {signal.Signals(-code).name}"
+        except ValueError:
+            return f"was killed by signal {-code}"
+    return f"exited with code {code}"
+
+
+def exit_code(
+    codes: list[int | None],
+    pids: list[int],
+    n_counted: int,
+    total: int,
+    name: str,
+    *,
+    interrupted: bool,
+) -> int:
+    """``tune``'s exit code from its workers' return codes (see :mod:`core.cli.exit_codes`).
+
+    ``codes`` are the workers' ``Popen.returncode`` (negative: killed by that signal), ``pids``
+    their process ids; ``n_counted`` of ``total`` trials are COMPLETE or PRUNED. Prints one
+    line on stderr for every worker that ended abnormally.
+    """
+    if EXIT_INPUT_ERROR in codes:
+        return EXIT_INPUT_ERROR  # the worker printed its one line
+    done = n_counted >= total
+    lost = [(pid, c) for pid, c in zip(pids, codes, strict=True) if c not in (EXIT_OK, None)]
+    if interrupted:
+        return EXIT_OK if done else EXIT_INTERRUPTED
+    for pid, code in lost:
+        if done:
+            print(
+                f"radartune tune: worker {pid} {_ending(code)}; the other workers reached "
+                f"the total",
+                file=sys.stderr,
+            )
+        else:
+            print(
+                f"radartune tune: worker {pid} {_ending(code)}; study {name!r} is resumable "
+                f"({n_counted} of {total} trials counted): run the same command again",
+                file=sys.stderr,
+            )
+    if done:
+        return EXIT_OK
+    if not lost:
+        print(
+            f"radartune tune: the workers stopped before the total ({n_counted} of {total} "
+            f"trials counted); study {name!r} is resumable: run the same command again",
+            file=sys.stderr,
+        )
+    return EXIT_WORKER_LOST

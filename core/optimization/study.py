@@ -12,6 +12,11 @@ closed as FAIL with the user attribute ``surplus=True`` (Optuna cannot delete tr
 numbers are assigned atomically by every storage, so two workers can never both take the last
 slot. A trial that fails (tracker error) frees its slot, so the total is still reached.
 
+Seeds: trial n samples with a sampler seeded by :func:`trial_seed` (base seed, n). Trial numbers
+are unique in a study, so no two trials — of one worker, of several workers, of two ``tune`` runs
+on the study at once, of a resume or of a ``worker`` that joins — ever sample with the same seed,
+and one worker with the same base seed reproduces the same trials.
+
 Crashes: every trial records its worker ``host:pid:start-ticks``. On resume, a RUNNING trial whose
 worker is on this host and no longer alive is marked FAIL at once; one from another host is
 marked FAIL when it has run longer than ``stale_after_s`` (trials take seconds).
@@ -73,7 +78,7 @@ class StudySettings:
     study_name
         None: ``radartune-<model>``.
     seed
-        Base seed; worker i gets its own seed derived from it.
+        Base seed: trial n samples with :func:`trial_seed` (seed, n).
     sampler
         ``"tpe"`` or ``"random"`` (baseline).
     pruner
@@ -232,8 +237,23 @@ def _worker_alive(wid: str) -> bool | None:
     return now is not None and now == ticks
 
 
-def _ask_as(study: Any, worker: str) -> Any:
+def trial_seed(seed: int, number: int) -> int:
+    """The sampler seed of trial ``number`` in a study with base seed ``seed``.
+
+    ``(h(seed) + number) mod 2**32`` with ``h`` a SeedSequence hash: distinct for every trial
+    number (below 2**32) of a base seed, so the trials of a study never share a seed whichever
+    worker or run asks for them; other base seeds give unrelated sequences.
+    """
+    base = int(np.random.SeedSequence(int(seed) % 2**64).generate_state(1)[0])
+    return (base + int(number)) % 2**32
+
+
+def _ask_as(study: Any, worker: str, sampler: Callable[[int], Any] | None = None) -> Any:
     """``study.ask()`` with the worker recorded in the same storage write that creates the trial.
+
+    ``sampler(number)``, if given, becomes ``study.sampler`` for the new trial once its number
+    is known (the sampler is consulted first when the ``optuna.Trial`` is made; enqueued trials,
+    whose parameters are fixed, keep the current sampler).
 
     Set afterwards (``trial.set_user_attr``), a SIGKILL between the two writes left a RUNNING
     trial without a worker, which resume could not tell from a live one on another host (seen
@@ -254,6 +274,8 @@ def _ask_as(study: Any, worker: str) -> Any:
         system_attrs={}, intermediate_values={}, trial_id=-1,
     )  # fmt: skip
     trial_id = study._storage.create_new_trial(study._study_id, template_trial=template)
+    if sampler is not None:
+        study.sampler = sampler(study._storage.get_trial_number_from_id(trial_id))
     return optuna.Trial(study, trial_id)
 
 
@@ -380,7 +402,7 @@ def run_worker(
     storage, study_name
         The study to join (created beforehand by :func:`prepare_study`).
     seed
-        This worker's sampler seed.
+        Base sampler seed (None: the study's ``seed``); trial n uses :func:`trial_seed` (seed, n).
     dataset_path
         Overrides the data-set path recorded in the study (another machine's file system).
     stop
@@ -404,10 +426,15 @@ def run_worker(
         raise InputError(f"study {study_name!r} was not created by radartune (no model attribute)")
     model = attrs["model"]
     n_total = int(attrs["n_trials"])
+    base_seed = int(attrs.get("seed", 0)) if seed is None else int(seed)
+
+    def sampler_for(number: int) -> Any:
+        return make_sampler(attrs["sampler"], trial_seed(base_seed, number))
+
     study = optuna.load_study(
         study_name=study_name,
         storage=store,
-        sampler=make_sampler(attrs["sampler"], seed),
+        sampler=sampler_for(0),
         pruner=make_pruner(attrs["pruner"]),
     )
     losses = make_losses(
@@ -429,7 +456,7 @@ def run_worker(
             # slots held by RUNNING trials of dead workers are freed, then counted again
             if not fail_stale_trials(study) or count_trials(study) >= n_total:
                 break
-        trial = _ask_as(study, me)
+        trial = _ask_as(study, me, sampler_for)
         try:
             if count_trials(study, below=trial.number) >= n_total:
                 trial.set_user_attr("surplus", True)
@@ -462,16 +489,6 @@ def run_worker(
             study.tell(trial, result.value)
         finished += 1
     return finished
-
-
-def worker_seeds(seed: int, n_jobs: int, n_existing: int) -> list[int]:
-    """One seed per worker from (base seed, trials already in the study).
-
-    Including the number of existing trials keeps a resumed random-sampling study from
-    replaying the points of its first run.
-    """
-    ss = np.random.SeedSequence([int(seed), int(n_existing)])
-    return [int(c.generate_state(1)[0]) for c in ss.spawn(n_jobs)]
 
 
 # ---- processes --------------------------------------------------------------------------------
@@ -540,7 +557,8 @@ def start_study(
 ) -> StudyHandle:
     """Create or resume the study, then start ``n_jobs`` worker processes; return their handle.
 
-    The study is created here, once, before any worker starts. Each worker gets its own seed.
+    The study is created here, once, before any worker starts. Every worker gets the base seed:
+    the sampler seed of each trial is derived from it and the trial's number.
     ``dataset_path`` (default ``settings.dataset``) must be the cached ``.npz`` for the tracker
     objective (see :func:`core.optimization.data.resolve_dataset`).
     """
@@ -548,20 +566,18 @@ def start_study(
     if path:
         path = str(Path(path).resolve())
     settings = replace(settings, storage=absolute_url(settings.storage))
-    study = prepare_study(settings, dataset_path=path)
-    n_existing = len(study.get_trials(deepcopy=False))
-    seeds = worker_seeds(settings.seed, settings.n_jobs, n_existing)
+    prepare_study(settings, dataset_path=path)
     env = dict(os.environ)
     env["PYTHONPATH"] = os.pathsep.join([str(ROOT), env.get("PYTHONPATH", "")]).rstrip(os.pathsep)
     procs = [
         subprocess.Popen(
-            worker_command(settings.storage, settings.name, s, path),
+            worker_command(settings.storage, settings.name, settings.seed, path),
             cwd=str(ROOT),
             env=env,
             stdout=stdout,
             stderr=stderr,
         )
-        for s in seeds
+        for _ in range(settings.n_jobs)
     ]
     return StudyHandle(settings, procs)
 

@@ -263,3 +263,127 @@ def test_gui_handle_stops_workers_cleanly(tmp_path: Path) -> None:
     assert handle.returncodes() == [0, 0]  # SIGTERM: finish the trial, exit normally
     states = [t.state for t in study_progress(url, s.name)[0]]
     assert "RUNNING" not in states and 0 < states.count("COMPLETE") < 500
+
+
+# ---- exit codes, seeds --------------------------------------------------------------------------
+def test_killed_worker_exits_3_resumable_and_the_same_command_completes(tmp_path: Path) -> None:
+    from core.cli.exit_codes import EXIT_OK, EXIT_WORKER_LOST
+    from core.optimization import StudySettings, prepare_study
+
+    url = f"sqlite:///{tmp_path}/k.db"
+    # created before tune starts, so that polling never races tune's creation of the schema
+    prepare_study(StudySettings(model="cv", n_trials=6, storage=url, study_name="k",
+                                objective="quadratic"))  # fmt: skip
+    # one worker, trials of 5 x 0.15 s: it is mid-trial for most of the time
+    args = ["tune", "--model", "cv", "--trials", "6", "--jobs", "1", "--storage", url,
+            "--study", "k", *QUAD, "--objective-option", "delay_s=0.15"]  # fmt: skip
+    parent = subprocess.Popen(
+        [sys.executable, "-m", "core.cli", *args],
+        cwd=ROOT,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    victim = None
+    try:
+        deadline = time.monotonic() + 40
+        while victim is None and time.monotonic() < deadline and parent.poll() is None:
+            time.sleep(0.1)
+            try:
+                summaries, _ = study_progress(url, "k")
+            except Exception:
+                continue
+            running = [t for t in summaries if t.state == "RUNNING" and t.worker]
+            if any(t.state == "COMPLETE" for t in summaries) and running:
+                victim = int(running[0].worker.rsplit(":", 2)[1])
+        if victim is None:
+            parent.kill()
+            pytest.fail(f"no running trial to kill: {parent.communicate()[1]}")
+        os.kill(victim, signal.SIGKILL)
+        _, err = parent.communicate(timeout=30)
+    finally:
+        if parent.poll() is None:
+            parent.kill()
+            parent.wait()
+    assert parent.returncode == EXIT_WORKER_LOST, err
+    last = err.strip().splitlines()[-1]
+    assert f"worker {victim} was killed by SIGKILL" in last
+    assert "resumable" in last and "run the same command again" in last
+    assert "Traceback" not in err
+
+    again = cli(*args)
+    assert again.returncode == EXIT_OK, again.stderr
+    after = _states(url, "k")
+    assert _counted(after) == 6
+    # the killed worker's trial (none if the kill fell between two of its trials)
+    assert [s for s, _ in after.values()].count("FAIL") <= 1
+
+
+def test_two_tune_runs_on_one_study_repeat_no_parameter_set(tmp_path: Path) -> None:
+    url = f"sqlite:///{tmp_path}/r.db"
+    common = ["tune", "--model", "cv", "--storage", url, "--study", "r", "--sampler", "random",
+              "--pruner", "none", *QUAD, "--objective-option", "delay_s=0.02"]  # fmt: skip
+    from core.optimization import StudySettings, prepare_study
+
+    prepare_study(StudySettings(model="cv", storage=url, study_name="r", sampler="random",
+                                pruner="none", objective="quadratic"))  # fmt: skip
+    # two runs on the study at once, each with 2 workers and the same --seed
+    runs = [
+        subprocess.Popen(
+            [sys.executable, "-m", "core.cli", *common, "--trials", "16", "--jobs", "2"],
+            cwd=ROOT,
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.PIPE,
+            text=True,
+        )
+        for _ in range(2)
+    ]
+    for run in runs:
+        _, err = run.communicate(timeout=120)
+        assert run.returncode == 0, err
+    summaries, _ = study_progress(url, "r")
+    points = [tuple(sorted(t.params.items())) for t in summaries if t.state == "COMPLETE"]
+    assert len(points) == 16
+    assert len(set(points)) == 16, "a parameter set was sampled twice"
+    workers = {t.worker for t in summaries if t.state == "COMPLETE"}
+    assert len(workers) >= 3  # the runs' workers did share the study
+
+
+@pytest.mark.parametrize(
+    ("codes", "counted", "interrupted", "expected", "says"),
+    [
+        ([0, 0], 10, False, 0, None),
+        ([0, -9], 10, False, 0, "worker 2 was killed by SIGKILL; the other workers reached"),
+        ([-9, 0], 7, False, 3, "worker 1 was killed by SIGKILL; study 'x' is resumable"),
+        ([1, 0], 7, False, 3, "worker 1 exited with code 1; study 'x' is resumable"),
+        ([0, 0], 7, False, 3, "the workers stopped before the total"),
+        ([2, -9], 7, False, 2, None),
+        ([130, 130], 7, True, 130, None),
+        ([0, 0], 10, True, 0, None),
+    ],
+)
+def test_tune_exit_code_from_worker_codes(
+    codes: list[int], counted: int, interrupted: bool, expected: int, says: str | None, capsys
+) -> None:
+    from core.cli.tune import exit_code
+
+    assert exit_code(codes, [1, 2], counted, 10, "x", interrupted=interrupted) == expected
+    err = capsys.readouterr().err
+    if says is None:
+        assert err == ""
+    else:
+        assert len(err.strip().splitlines()) == 1 and says in err
+
+
+@pytest.mark.parametrize("command", ["tune", "worker"])
+def test_help_lists_the_exit_codes(command: str) -> None:
+    from core.cli import exit_codes
+
+    out = cli(command, "--help")
+    assert out.returncode == 0
+    assert "exit codes:" in out.stdout
+    codes = [exit_codes.EXIT_OK, exit_codes.EXIT_INPUT_ERROR, exit_codes.EXIT_INTERRUPTED]
+    if command == "tune":
+        codes.append(exit_codes.EXIT_WORKER_LOST)
+    for code in codes:
+        assert f"\n  {code} " in out.stdout

@@ -19,7 +19,7 @@ from core.optimization import (
     tracker_params_dict,
 )
 from core.optimization.space import search_space
-from core.optimization.study import worker_seeds
+from core.optimization.study import trial_seed
 
 
 def settings(tmp_path: Path, **kw) -> StudySettings:
@@ -111,11 +111,39 @@ def test_enqueued_parameters_run_first(tmp_path: Path) -> None:
         enqueue_params(s.storage, s.name, {**tracker_params_dict(flat, "cv"), "model": "ca"})
 
 
-def test_worker_seeds_differ_per_worker_and_per_resume() -> None:
-    a = worker_seeds(0, 3, 0)
-    assert len(set(a)) == 3
-    assert a == worker_seeds(0, 3, 0)
-    assert set(a).isdisjoint(worker_seeds(0, 3, 10))
+def test_trial_seeds_are_distinct_per_trial_and_reproducible() -> None:
+    # (h(seed) + n) mod 2**32: one seed per trial number, whoever asks; another base: other seeds
+    seeds = [trial_seed(0, n) for n in range(10_000)]
+    assert len(set(seeds)) == 10_000
+    assert seeds == [trial_seed(0, n) for n in range(10_000)]
+    assert (seeds[1] - seeds[0]) % 2**32 == 1
+    assert trial_seed(1, 0) not in seeds[:100]
+    assert 0 <= trial_seed(-3, 2**40) < 2**32
+
+
+def test_two_workers_with_one_seed_repeat_no_parameter_set(tmp_path: Path) -> None:
+    # two workers (or two tune runs) joining one study with the same base seed: trial numbers
+    # differ, so the sampler seeds differ; with the random sampler every trial is a new point
+    s = settings(tmp_path, n_trials=12, sampler="random", pruner="none")
+    prepare_study(s)
+    run_worker(s.storage, s.name, seed=7, stop=_after(6, s))
+    run_worker(s.storage, s.name, seed=7)
+    summaries, _ = study_progress(s.storage, s.name)
+    points = [tuple(sorted(t.params.items())) for t in summaries if t.state == "COMPLETE"]
+    assert len(points) == 12 and len(set(points)) == 12
+    # the study's own seed is the default base: trial n samples as with seed=s.seed
+    t = settings(tmp_path, study_name="default", n_trials=3, sampler="random", pruner="none")
+    u = settings(tmp_path, study_name="explicit", n_trials=3, sampler="random", pruner="none")
+    prepare_study(t), prepare_study(u)
+    run_worker(t.storage, t.name, seed=None)
+    run_worker(u.storage, u.name, seed=t.seed)
+    a, b = study_progress(t.storage, t.name)[0], study_progress(u.storage, u.name)[0]
+    assert [x.params for x in a] == [x.params for x in b]
+
+
+def _after(n: int, s: StudySettings):
+    """A stop() that is true once the study has n trials."""
+    return lambda: len(study_progress(s.storage, s.name)[0]) >= n
 
 
 @pytest.mark.parametrize(("pruner", "pruned"), [("wilcoxon", True), ("none", False)])
