@@ -102,7 +102,9 @@ def run(
         window.playback.set_playing(True)
     if quit_after is not None:
         QtCore.QTimer.singleShot(int(quit_after * 1000), window.close)
-    return app.exec()
+    code = app.exec()
+    window.shutdown()  # joins the workers before the window (their parent) is destroyed
+    return code
 
 
 def main(argv: list[str] | None = None) -> int:
