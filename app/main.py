@@ -1,4 +1,9 @@
-"""Start the application: ``radartune gui`` / ``python -m app`` / ``make run``."""
+"""Start the application: ``radartune gui`` / ``python -m app`` / ``make run``.
+
+The app owns its command line: :func:`add_arguments` is the one table of the GUI's options and
+:func:`main` parses them. ``radartune gui`` (:mod:`core.cli.gui`) passes its arguments through to
+:func:`main`, finding this module by name only when it runs. Importing this module loads no Qt.
+"""
 
 from __future__ import annotations
 
@@ -6,7 +11,24 @@ import argparse
 import sys
 import traceback
 
-from core.cli.gui import add_arguments
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    """The app's options (``radartune gui``, ``python -m app``)."""
+    p.add_argument("--scene", metavar="FILE", help="scene JSON to open (default: the paper scene)")
+    p.add_argument(
+        "--quit-after",
+        metavar="SECONDS",
+        type=float,
+        default=None,
+        help="close the window after this many seconds (smoke tests)",
+    )
+    p.add_argument("--paused", action="store_true", help="open without playing")
+    p.add_argument(
+        "--settings",
+        metavar="FILE",
+        default=None,
+        help="settings file (INI); default: the user's RadarTune settings",
+    )
 
 
 def build_parser() -> argparse.ArgumentParser:
