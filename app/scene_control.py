@@ -1,7 +1,8 @@
 """Scene control: open, save and edit the scene, apply a TI ``.cfg`` to its radar, re-simulate.
 
 :class:`SceneController` is the one place that changes which scene the window shows. A file that
-cannot be read or validated becomes one line on ``error`` and the current scene stays. Every
+cannot be read or validated (whatever the exception) becomes one line naming the file on
+``error``, unexpected exceptions are logged with their traceback, and the current scene stays. Every
 adopted scene is announced with its :class:`~app.data.SceneInfo` on ``info_changed`` (the window
 updates its views) and re-simulated after a short debounce, so a burst of edits simulates once.
 """
@@ -12,8 +13,9 @@ from pathlib import Path
 
 from PySide6 import QtCore, QtWidgets
 
+from app.errors import log_exception, one_line
 from app.models import RadarModel, SceneModel
-from app.workers import SimulationController, TrackingController, describe_error
+from app.workers import SimulationController, TrackingController
 from core.config import PAPER_RADAR
 from core.errors import InputError
 
@@ -55,30 +57,29 @@ class SceneController(QtCore.QObject):
     # ---- files ----
     def load_initial(self, path: str | None) -> None:
         """The scene given on the command line, else (or when it is bad) the paper scene."""
-        if path:
-            try:
-                self.scene_model.load(path)
-                self._remember(path)
-                return
-            except InputError as exc:
-                self.error.emit(str(exc))
+        if path and self.load(path):
+            return
         self.load_paper_scene()
 
     def load_paper_scene(self) -> None:
         try:
             self.scene_model.set_document(self.engine.paper_document())
-        except InputError as exc:
-            self.error.emit(str(exc))
+        except Exception as exc:
+            self._fail("paper scene", exc)
 
     def load(self, path: str | Path) -> bool:
         """Load a scene file; on error show it and keep the current scene."""
         try:
             self.scene_model.load(path)
-        except InputError as exc:
-            self.error.emit(str(exc))
+        except Exception as exc:  # InputError, or a reader fault: one line, the file named
+            self._fail(f"cannot load scene {path}", exc, str(path))
             return False
         self._remember(str(path))
         return True
+
+    def _fail(self, what: str, exc: Exception, source: str | None = None) -> None:
+        log_exception(what, exc)
+        self.error.emit(one_line(exc, source))
 
     def _remember(self, path: str) -> None:
         self.settings.setValue("scene/last_dir", str(Path(path).resolve().parent))
@@ -101,19 +102,16 @@ class SceneController(QtCore.QObject):
                 self.scene_model.save(path)
                 self._remember(path)
                 self.message.emit(f"scene saved to {path}")
-            except InputError as exc:
-                self.error.emit(str(exc))
+            except Exception as exc:
+                self._fail(f"cannot save scene {path}", exc, path)
 
     # ---- TI radar configuration ----
     def load_cfg(self, path: str | Path) -> bool:
         """Load a TI .cfg into the radar; on error show it, keep the current radar."""
         try:
             radar = self.engine.read_ti_cfg(path)
-        except InputError as exc:
-            self.error.emit(str(exc))
-            return False
-        except Exception as exc:  # a reader bug must not crash the app
-            self.error.emit(f"{path}: {describe_error(exc)}")
+        except Exception as exc:  # InputError, or a reader bug: must not crash the app
+            self._fail(f"cannot load TI config {path}", exc, str(path))
             return False
         self.radar_model.set_radar(radar)
         return True

@@ -14,6 +14,7 @@ from pathlib import Path
 from PySide6 import QtCore, QtGui, QtWidgets
 
 from app.engine import Engine
+from app.errors import log_exception, one_line
 from app.models import (
     FrameCache,
     PlaybackModel,
@@ -32,7 +33,7 @@ from app.study import StudyController, StudyModel
 from app.views.psi_view import PsiView
 from app.views.rd_view import RangeDopplerView
 from app.views.top_view import TopView
-from app.workers import SimulationController, TrackingController, describe_error, freeze_heap
+from app.workers import SimulationController, TrackingController, freeze_heap
 from core.config import PAPER_RADAR
 from core.errors import InputError
 
@@ -240,7 +241,8 @@ class MainWindow(QtWidgets.QMainWindow):
 
     # ---- errors ----
     def show_error(self, message: str) -> None:
-        """One message naming the problem; never blocks, never crashes."""
+        """One line naming the problem (and the file); never blocks, never crashes."""
+        message = " ".join(part.strip() for part in message.splitlines() if part.strip())
         self.errors.append(message)
         self.statusBar().showMessage(message, 10000)
         if self._error_box is None:
@@ -299,6 +301,9 @@ class MainWindow(QtWidgets.QMainWindow):
             self.show_error(f"{path}: {exc}")
         except InputError as exc:
             self.show_error(str(exc) if exc.source else f"{path}: {exc}")
+        except Exception as exc:  # a reader fault (bad bytes, nesting): one line, the file named
+            log_exception(f"cannot load tracker parameters {path}", exc)
+            self.show_error(one_line(exc, str(path)))
         return False
 
     def save_params_dialog(self) -> None:
@@ -307,9 +312,12 @@ class MainWindow(QtWidgets.QMainWindow):
         )
         if path:
             try:
-                self.params_model.params().save(path)
+                self.params_model.params().save(path)  # atomic: nothing half-written
             except (InputError, OSError) as exc:
-                self.show_error(str(exc))
+                self.show_error(one_line(exc, path))
+            except Exception as exc:
+                log_exception(f"cannot save tracker parameters {path}", exc)
+                self.show_error(one_line(exc, path))
 
     def _on_params_changed(self) -> None:
         extra = self.params_model.extra_effective()
@@ -428,7 +436,8 @@ class MainWindow(QtWidgets.QMainWindow):
         except InputError as exc:
             self.show_error(str(exc))
         except Exception as exc:
-            self.show_error(f"cannot start study: {describe_error(exc)}")
+            log_exception("cannot start study", exc)
+            self.show_error(f"cannot start study: {one_line(exc)}")
 
     def enqueue_current(self) -> None:
         self.study.enqueue(
@@ -444,7 +453,8 @@ class MainWindow(QtWidgets.QMainWindow):
             self.show_error(str(exc))
             return
         except Exception as exc:
-            self.show_error(f"cannot start the dashboard: {describe_error(exc)}")
+            log_exception("cannot start the dashboard", exc)
+            self.show_error(f"cannot start the dashboard: {one_line(exc)}")
             return
         self.statusBar().showMessage(f"dashboard at {url}", 10000)
         QtCore.QTimer.singleShot(1500, lambda: webbrowser.open(url))

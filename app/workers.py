@@ -8,11 +8,11 @@ from __future__ import annotations
 
 import threading
 import time
-import traceback
 
 from PySide6 import QtCore
 
 from app.data import TrackingResult
+from app.errors import log_exception, one_line
 from app.models import FrameCache, TrackerParamsModel, TrackingModel
 from core.errors import InputError
 
@@ -28,13 +28,6 @@ def freeze_heap() -> None:
     import gc
 
     gc.freeze()
-
-
-def describe_error(exc: BaseException) -> str:
-    """One line for the user: InputError as is, anything else with its type."""
-    from app.engine import describe
-
-    return describe(exc)
 
 
 class SimulationWorker(QtCore.QThread):
@@ -63,8 +56,8 @@ class SimulationWorker(QtCore.QThread):
             if not self._stop.is_set():
                 self.done.emit(self.generation)
         except Exception as exc:  # any failure becomes a message, never a crash
-            traceback.print_exc()
-            self.failed.emit(self.generation, describe_error(exc))
+            log_exception("simulation failed", exc)
+            self.failed.emit(self.generation, one_line(exc))
 
 
 class SimulationController(QtCore.QObject):
@@ -170,8 +163,8 @@ class _TrackJob(QtCore.QRunnable):
                 result = engine.track(frames, params, frame_period_s, key=key)
                 self._signals.result.emit(self._ticket, result)
         except Exception as exc:
-            traceback.print_exc()
-            self._signals.failed.emit(self._ticket, describe_error(exc))
+            log_exception("re-tracking failed", exc)
+            self._signals.failed.emit(self._ticket, one_line(exc))
         finally:
             self._signals.done.emit(self._ticket)
 
