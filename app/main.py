@@ -1,12 +1,38 @@
-"""Start the application: ``radartune gui`` / ``python -m app`` / ``make run``."""
+"""Start the application: ``radartune gui`` / ``python -m app`` / ``make run``.
+
+The app owns its command line: :func:`add_arguments` is the one table of the GUI's options and
+:func:`main` parses them. ``radartune gui`` (:mod:`core.cli.gui`) passes its arguments through to
+:func:`main`, finding this module by name only when it runs. Importing this module loads no Qt.
+"""
 
 from __future__ import annotations
 
 import argparse
 import sys
-import traceback
 
-from core.cli.gui import add_arguments
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    """The app's options (``radartune gui``, ``python -m app``)."""
+    p.add_argument("--scene", metavar="FILE", help="scene JSON to open (default: the paper scene)")
+    p.add_argument(
+        "--quit-after",
+        metavar="SECONDS",
+        type=float,
+        default=None,
+        help="close the window after this many seconds (smoke tests)",
+    )
+    p.add_argument("--paused", action="store_true", help="open without playing")
+    p.add_argument(
+        "--settings",
+        metavar="FILE",
+        default=None,
+        help="settings file (INI); default: the user's RadarTune settings",
+    )
+    p.add_argument(
+        "--debug",
+        action="store_true",
+        help="also print the traceback of an unexpected error on stderr (always in the log)",
+    )
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -59,6 +85,24 @@ def debian_package(soname: str) -> str:
     return f"{name}-{version}" if name[-1].isdigit() else f"{name}{version}"
 
 
+def scene_error(path: str) -> str | None:
+    """Why the scene file cannot be opened, as one line naming it; None when it can.
+
+    Read and validated exactly as the window will (before any window exists), so that a bad
+    ``--scene`` is one line on stderr and exit 2 rather than a window or a traceback.
+    """
+    from app.engine import Engine
+    from app.errors import log_exception, one_line
+    from app.models import SceneModel
+
+    try:
+        SceneModel(Engine()).load(path)
+    except Exception as exc:
+        log_exception(f"cannot load scene {path}", exc)
+        return one_line(exc, path)
+    return None
+
+
 def run(
     scene: str | None = None,
     quit_after: float | None = None,
@@ -66,6 +110,11 @@ def run(
     settings_file: str | None = None,
 ) -> int:
     """Create the QApplication and the main window, play, and run the event loop."""
+    if scene is not None:
+        problem = scene_error(scene)
+        if problem is not None:
+            print(f"radartune gui: error: {problem}", file=sys.stderr)
+            return 2
     missing = missing_platform_libraries()
     if missing:
         packages = " ".join(debian_package(m) for m in missing)
@@ -78,6 +127,7 @@ def run(
     import pyqtgraph as pg
     from PySide6 import QtCore, QtWidgets
 
+    from app.errors import install_excepthooks
     from app.window import MainWindow
 
     app = QtWidgets.QApplication.instance() or QtWidgets.QApplication(sys.argv[:1])
@@ -91,23 +141,34 @@ def run(
             QtCore.QSettings.IniFormat, QtCore.QSettings.UserScope, "RadarTune", "RadarTune"
         )
     window = MainWindow(settings, scene_path=scene)
-
-    def excepthook(exc_type, exc, tb):  # an unexpected error becomes a message, not a crash
-        traceback.print_exception(exc_type, exc, tb)
-        window.show_error(f"internal error: {exc_type.__name__}: {exc}")
-
-    sys.excepthook = excepthook
+    restore_hooks = install_excepthooks(window.show_error)  # a message box, never a crash
     window.show()
     if not paused:
         window.playback.set_playing(True)
     if quit_after is not None:
         QtCore.QTimer.singleShot(int(quit_after * 1000), window.close)
-    return app.exec()
+    code = app.exec()
+    window.shutdown()  # joins the workers before the window (their parent) is destroyed
+    restore_hooks()
+    return code
 
 
 def main(argv: list[str] | None = None) -> int:
+    """Parse the app's arguments and run it; an unexpected error before the window exists (or
+    after it closed) is one line on stderr and exit 2, its traceback in the log."""
+    from app.errors import LOG_FILE, log_exception, one_line, setup_logging
+
     args = build_parser().parse_args(argv)
-    return run(args.scene, args.quit_after, args.paused, args.settings)
+    setup_logging(debug=args.debug)
+    try:
+        return run(args.scene, args.quit_after, args.paused, args.settings)
+    except Exception as exc:
+        log_exception("the app failed", exc)
+        print(
+            f"radartune gui: error: internal error: {one_line(exc)} (details in {LOG_FILE})",
+            file=sys.stderr,
+        )
+        return 2
 
 
 if __name__ == "__main__":

@@ -1,5 +1,7 @@
-"""The main window: live views in the centre, editor panels in docks, playback toolbar,
-persistence of settings and layout (QSettings)."""
+"""The main window: live views in the centre, editor panels in docks, persistence of settings
+and layout (QSettings). It composes the controllers: :class:`~app.playback.PlaybackController`
+(play timer, playback bar, frame index), :class:`~app.scene_control.SceneController` (scene
+files and edits, TI .cfg, re-simulation), the simulation / re-tracking workers and the study."""
 
 from __future__ import annotations
 
@@ -12,6 +14,7 @@ from pathlib import Path
 from PySide6 import QtCore, QtGui, QtWidgets
 
 from app.engine import Engine
+from app.errors import log_exception, one_line
 from app.models import (
     FrameCache,
     PlaybackModel,
@@ -24,16 +27,17 @@ from app.panels.radar_panel import RadarPanel
 from app.panels.scene_panel import ScenePanel
 from app.panels.study_panel import StudyPanel
 from app.panels.tracker_panel import TrackerPanel
+from app.playback import PlaybackController
+from app.scene_control import SceneController
 from app.study import StudyController, StudyModel
 from app.views.psi_view import PsiView
 from app.views.rd_view import RangeDopplerView
 from app.views.top_view import TopView
-from app.workers import SimulationController, TrackingController, describe_error, freeze_heap
+from app.workers import SimulationController, TrackingController, freeze_heap
 from core.config import PAPER_RADAR
 from core.errors import InputError
 
 DRAW_INTERVAL_MS = 30  # GUI draw timer: at most ~33 redraws per second, stale frames dropped
-SPEEDS = (0.25, 0.5, 1.0, 2.0, 4.0, 8.0)
 RETRACK_EVERY_N_FRAMES = 20  # while the simulation fills the cache
 
 
@@ -105,14 +109,30 @@ class MainWindow(QtWidgets.QMainWindow):
         self.docks["Scene"].raise_()
         self.docks["Tracker"].raise_()
 
-        self._build_playback_bar()
+        self.playback_control = PlaybackController(self.playback, self.cache, self)
+        pc = self.playback_control  # the bar's widgets, as attributes of the window
+        self.playback_bar, self._play_timer = pc.bar, pc.timer
+        self.act_back, self.act_play, self.act_fwd = pc.act_back, pc.act_play, pc.act_fwd
+        self.speed_combo, self.timeline = pc.speed_combo, pc.timeline
+        self.frame_label, self.fps_label = pc.frame_label, pc.fps_label
+        self.scene_control = SceneController(
+            self.engine,
+            self.settings,
+            self.scene_model,
+            self.radar_model,
+            self.sim,
+            self.tracker,
+            self,
+        )
+        self._scene_timer = self.scene_control.timer
         self._build_view_bar()
         self._build_menus()
         self._build_status()
 
         # ---- wiring ----------------------------------------------------------------------------
-        self.scene_model.changed.connect(self._on_scene_changed)
-        self.radar_model.changed.connect(self._on_radar_edited)
+        self.scene_control.info_changed.connect(self._on_scene_info)
+        self.scene_control.error.connect(self.show_error)
+        self.scene_control.message.connect(lambda m: self.statusBar().showMessage(m, 5000))
         self.cache.reset.connect(self._on_cache_reset)
         self.cache.frames_added.connect(self._on_frames_added)
         self.cache.finished.connect(self._on_cache_finished)
@@ -121,12 +141,10 @@ class MainWindow(QtWidgets.QMainWindow):
         self.tracker.finished.connect(self._on_tracked)
         self.tracking_model.changed.connect(self._on_tracking_changed)
         self.params_model.changed.connect(self._on_params_changed)
-        self.playback.frame_changed.connect(self._on_frame_changed)
-        self.playback.playing_changed.connect(self._on_playing_changed)
-        self.playback.speed_changed.connect(self._on_speed_changed)
+        self.playback.frame_changed.connect(self._mark_dirty)
         for panel in (self.scene_panel, self.radar_panel, self.tracker_panel, self.study_panel):
             panel.error.connect(self.show_error)
-        self.radar_panel.load_cfg_requested.connect(self.load_cfg_dialog)
+        self.radar_panel.load_cfg_requested.connect(self.scene_control.load_cfg_dialog)
         self.scene_panel.draw_mode_changed.connect(self.top_view.set_draw_mode)
         self.top_view.waypoint_added.connect(self.scene_panel.append_waypoint)
         self.top_view.waypoints_moved.connect(self.scene_panel.set_waypoints)
@@ -143,12 +161,6 @@ class MainWindow(QtWidgets.QMainWindow):
         self.study_model.message.connect(lambda m: self.statusBar().showMessage(m, 8000))
         self.study_model.form_changed.connect(lambda _f: self.study.refresh())
 
-        self._scene_timer = QtCore.QTimer(self)
-        self._scene_timer.setSingleShot(True)
-        self._scene_timer.setInterval(150)
-        self._scene_timer.timeout.connect(self._resimulate)
-        self._play_timer = QtCore.QTimer(self)
-        self._play_timer.timeout.connect(self._on_play_tick)
         self._draw_timer = QtCore.QTimer(self)
         self._draw_timer.setInterval(DRAW_INTERVAL_MS)
         self._draw_timer.timeout.connect(self._draw)
@@ -156,13 +168,11 @@ class MainWindow(QtWidgets.QMainWindow):
         self._dirty = True
         self._draw_times: deque[float] = deque(maxlen=60)
         self.n_draws = 0
-        self._frame_period_s = PAPER_RADAR.frame_period_s
-        self._update_play_interval()
 
         if restore:
             self.restore_settings()
         if load_scene:
-            self.load_initial_scene(scene_path)
+            self.scene_control.load_initial(scene_path)
         freeze_heap()
 
     # ---- construction helpers ----
@@ -177,51 +187,6 @@ class MainWindow(QtWidgets.QMainWindow):
         dock.setMinimumWidth(300)
         self.addDockWidget(area, dock)
         self.docks[title] = dock
-
-    def _build_playback_bar(self) -> None:
-        bar = QtWidgets.QToolBar("Playback", self)
-        bar.setObjectName("playbackBar")
-        self.playback_bar = bar
-        self.addToolBar(QtCore.Qt.BottomToolBarArea, bar)
-        style = self.style()
-        self.act_back = bar.addAction(
-            style.standardIcon(QtWidgets.QStyle.SP_MediaSeekBackward), "Step back"
-        )
-        self.act_play = bar.addAction(style.standardIcon(QtWidgets.QStyle.SP_MediaPlay), "Play")
-        self.act_play.setCheckable(True)
-        self.act_fwd = bar.addAction(
-            style.standardIcon(QtWidgets.QStyle.SP_MediaSeekForward), "Step forward"
-        )
-        self.act_back.setShortcut(QtGui.QKeySequence(QtCore.Qt.Key_Left))
-        self.act_fwd.setShortcut(QtGui.QKeySequence(QtCore.Qt.Key_Right))
-        self.act_play.setShortcut(QtGui.QKeySequence(QtCore.Qt.Key_Space))
-        self.speed_combo = QtWidgets.QComboBox()
-        self.speed_combo.setObjectName("speedCombo")
-        for s in SPEEDS:
-            self.speed_combo.addItem(f"{s:g}×", s)
-        self.speed_combo.setCurrentIndex(SPEEDS.index(1.0))
-        bar.addWidget(QtWidgets.QLabel(" speed "))
-        bar.addWidget(self.speed_combo)
-        self.timeline = QtWidgets.QSlider(QtCore.Qt.Horizontal)
-        self.timeline.setObjectName("timeline")
-        self.timeline.setRange(0, 0)
-        self.timeline.setMinimumWidth(300)
-        bar.addWidget(self.timeline)
-        self.frame_label = QtWidgets.QLabel("frame – / –")
-        self.frame_label.setObjectName("frameLabel")
-        self.frame_label.setMinimumWidth(170)
-        bar.addWidget(self.frame_label)
-        self.fps_label = QtWidgets.QLabel()
-        self.fps_label.setObjectName("fpsLabel")
-        self.fps_label.setMinimumWidth(230)
-        bar.addWidget(self.fps_label)
-        self.act_back.triggered.connect(lambda: self._step(-1))
-        self.act_fwd.triggered.connect(lambda: self._step(1))
-        self.act_play.toggled.connect(self.playback.set_playing)
-        self.speed_combo.currentIndexChanged.connect(
-            lambda i: self.playback.set_speed(self.speed_combo.itemData(i))
-        )
-        self.timeline.valueChanged.connect(self.playback.set_frame)
 
     def _build_view_bar(self) -> None:
         bar = QtWidgets.QToolBar("View", self)
@@ -252,11 +217,12 @@ class MainWindow(QtWidgets.QMainWindow):
 
     def _build_menus(self) -> None:
         file_menu = self.menuBar().addMenu("&File")
-        file_menu.addAction("&Open scene …", QtGui.QKeySequence.Open, self.open_scene_dialog)
-        file_menu.addAction("&Save scene as …", QtGui.QKeySequence.SaveAs, self.save_scene_dialog)
-        file_menu.addAction("Paper scene", self.load_paper_scene)
+        scenes = self.scene_control
+        file_menu.addAction("&Open scene …", QtGui.QKeySequence.Open, scenes.open_dialog)
+        file_menu.addAction("&Save scene as …", QtGui.QKeySequence.SaveAs, scenes.save_dialog)
+        file_menu.addAction("Paper scene", scenes.load_paper_scene)
         file_menu.addSeparator()
-        file_menu.addAction("Load TI radar .cfg …", self.load_cfg_dialog)
+        file_menu.addAction("Load TI radar .cfg …", scenes.load_cfg_dialog)
         file_menu.addAction("Load tracker parameters …", self.load_params_dialog)
         file_menu.addAction("Save tracker parameters …", self.save_params_dialog)
         file_menu.addSeparator()
@@ -275,7 +241,8 @@ class MainWindow(QtWidgets.QMainWindow):
 
     # ---- errors ----
     def show_error(self, message: str) -> None:
-        """One message naming the problem; never blocks, never crashes."""
+        """One line naming the problem (and the file); never blocks, never crashes."""
+        message = " ".join(part.strip() for part in message.splitlines() if part.strip())
         self.errors.append(message)
         self.statusBar().showMessage(message, 10000)
         if self._error_box is None:
@@ -287,62 +254,17 @@ class MainWindow(QtWidgets.QMainWindow):
         self._error_box.setText(message)
         self._error_box.show()
 
-    # ---- scene ----
-    def load_initial_scene(self, path: str | None) -> None:
-        if path:
-            try:
-                self.scene_model.load(path)
-                self._remember_scene(path)
-                return
-            except InputError as exc:
-                self.show_error(str(exc))
-        self.load_paper_scene()
-
-    def load_paper_scene(self) -> None:
-        try:
-            self.scene_model.set_document(self.engine.paper_document())
-        except InputError as exc:
-            self.show_error(str(exc))
-
+    # ---- scene (SceneController) ----
     def load_scene(self, path: str | Path) -> bool:
         """Load a scene file; on error show it and keep the current scene."""
-        try:
-            self.scene_model.load(path)
-        except InputError as exc:
-            self.show_error(str(exc))
-            return False
-        self._remember_scene(str(path))
-        return True
+        return self.scene_control.load(path)
 
-    def _remember_scene(self, path: str) -> None:
-        self.settings.setValue("scene/last_dir", str(Path(path).resolve().parent))
+    def load_cfg(self, path: str | Path) -> bool:
+        """Load a TI .cfg into the radar; on error show it, keep the current radar."""
+        return self.scene_control.load_cfg(path)
 
-    def open_scene_dialog(self) -> None:
-        start = self.settings.value("scene/last_dir", str(Path.cwd()), type=str)
-        path, _ = QtWidgets.QFileDialog.getOpenFileName(
-            self, "Open scene", start, "Scene JSON (*.json);;All files (*)"
-        )
-        if path:
-            self.load_scene(path)
-
-    def save_scene_dialog(self) -> None:
-        start = self.settings.value("scene/last_dir", str(Path.cwd()), type=str)
-        path, _ = QtWidgets.QFileDialog.getSaveFileName(
-            self, "Save scene", str(Path(start) / "scene.json"), "Scene JSON (*.json)"
-        )
-        if path:
-            try:
-                self.scene_model.save(path)
-                self._remember_scene(path)
-                self.statusBar().showMessage(f"scene saved to {path}", 5000)
-            except InputError as exc:
-                self.show_error(str(exc))
-
-    def _on_scene_changed(self) -> None:
-        scene = self.scene_model.scene
-        info = self.engine.scene_info(scene)
-        self._frame_period_s = info.frame_period_s
-        self.tracker.frame_period_s = info.frame_period_s
+    def _on_scene_info(self, info) -> None:
+        self.playback_control.set_frame_period(info.frame_period_s)
         self.top_view.set_aoi(
             info.aoi["min_range_m"], info.aoi["max_range_m"], info.aoi["max_azimuth_deg"]
         )
@@ -353,49 +275,6 @@ class MainWindow(QtWidgets.QMainWindow):
         traj = doc["persons"][sel]["trajectory"] if doc.get("persons") else {}
         self.top_view.set_waypoints(traj.get("waypoints"))
         self.rd_view.set_radar(info.radar)
-        self.radar_model.set_radar(info.radar)
-        self._update_play_interval()
-        self._scene_timer.start()
-
-    def _resimulate(self) -> None:
-        scene = self.scene_model.scene
-        if scene is None:
-            return
-        self.tracker.invalidate()
-        self.sim.start(scene)
-
-    def _on_radar_edited(self, radar) -> None:
-        scene = self.scene_model.scene
-        if scene is None or scene.radar == radar:
-            return
-        spec = "paper" if radar == PAPER_RADAR else radar.to_dict()
-        try:
-            self.scene_model.edit(radar=spec)
-        except InputError as exc:
-            self.show_error(str(exc))
-            self.radar_model.set_radar(scene.radar)
-
-    def load_cfg(self, path: str | Path) -> bool:
-        """Load a TI .cfg into the radar; on error show it, keep the current radar."""
-        try:
-            radar = self.engine.read_ti_cfg(path)
-        except InputError as exc:
-            self.show_error(str(exc))
-            return False
-        except Exception as exc:  # a reader bug must not crash the app
-            self.show_error(f"{path}: {describe_error(exc)}")
-            return False
-        self.radar_model.set_radar(radar)
-        return True
-
-    def load_cfg_dialog(self) -> None:
-        start = self.settings.value("radar/last_dir", str(Path.cwd()), type=str)
-        path, _ = QtWidgets.QFileDialog.getOpenFileName(
-            self, "Load TI mmWave .cfg", start, "TI config (*.cfg);;All files (*)"
-        )
-        if path:
-            self.settings.setValue("radar/last_dir", str(Path(path).parent))
-            self.load_cfg(path)
 
     # ---- tracker parameters ----
     def load_params_dialog(self) -> None:
@@ -422,6 +301,9 @@ class MainWindow(QtWidgets.QMainWindow):
             self.show_error(f"{path}: {exc}")
         except InputError as exc:
             self.show_error(str(exc) if exc.source else f"{path}: {exc}")
+        except Exception as exc:  # a reader fault (bad bytes, nesting): one line, the file named
+            log_exception(f"cannot load tracker parameters {path}", exc)
+            self.show_error(one_line(exc, str(path)))
         return False
 
     def save_params_dialog(self) -> None:
@@ -430,9 +312,12 @@ class MainWindow(QtWidgets.QMainWindow):
         )
         if path:
             try:
-                self.params_model.params().save(path)
+                self.params_model.params().save(path)  # atomic: nothing half-written
             except (InputError, OSError) as exc:
-                self.show_error(str(exc))
+                self.show_error(one_line(exc, path))
+            except Exception as exc:
+                log_exception(f"cannot save tracker parameters {path}", exc)
+                self.show_error(one_line(exc, path))
 
     def _on_params_changed(self) -> None:
         extra = self.params_model.extra_effective()
@@ -451,21 +336,13 @@ class MainWindow(QtWidgets.QMainWindow):
 
     # ---- cache, tracking ----
     def _on_cache_reset(self) -> None:
-        self.playback.set_available(0)
-        self.playback.set_frame(0)
-        self.timeline.setRange(0, 0)
         self._dirty = True
 
     def _on_frames_added(self, n: int) -> None:
-        self.playback.set_available(n)
-        self.timeline.blockSignals(True)
-        self.timeline.setRange(0, max(n - 1, 0))
-        self.timeline.blockSignals(False)
         if n == 1 or n % RETRACK_EVERY_N_FRAMES == 0:
             self.tracker.request()
         if self.playback.frame >= n - 1:
             self._dirty = True
-        self._update_frame_label()
 
     def _on_cache_finished(self) -> None:
         freeze_heap()  # the cached frames live as long as the scene
@@ -477,64 +354,13 @@ class MainWindow(QtWidgets.QMainWindow):
         self.tracker_panel.show_timing(elapsed_s, n)
 
     def _on_tracking_changed(self, result) -> None:
-        self.psi_view.set_result(result, self._frame_period_s)
+        self.psi_view.set_result(result, self.playback_control.frame_period_s)
         self._dirty = True
-
-    # ---- playback ----
-    def _step(self, delta: int) -> None:
-        self.playback.set_playing(False)
-        self.playback.step(delta)
-
-    def _on_frame_changed(self, index: int) -> None:
-        self.timeline.blockSignals(True)
-        self.timeline.setValue(index)
-        self.timeline.blockSignals(False)
-        self._dirty = True
-        self._update_frame_label()
-
-    def _on_playing_changed(self, playing: bool) -> None:
-        self.act_play.blockSignals(True)
-        self.act_play.setChecked(playing)
-        self.act_play.blockSignals(False)
-        icon = QtWidgets.QStyle.SP_MediaPause if playing else QtWidgets.QStyle.SP_MediaPlay
-        self.act_play.setIcon(self.style().standardIcon(icon))
-        self.act_play.setText("Pause" if playing else "Play")
-        if playing:
-            self._play_timer.start()
-        else:
-            self._play_timer.stop()
-
-    def _on_speed_changed(self, speed: float) -> None:
-        i = self.speed_combo.findData(speed)
-        if i >= 0:
-            self.speed_combo.blockSignals(True)
-            self.speed_combo.setCurrentIndex(i)
-            self.speed_combo.blockSignals(False)
-        self._update_play_interval()
-
-    def _update_play_interval(self) -> None:
-        self._play_timer.setInterval(
-            max(1, int(round(1000 * self._frame_period_s / self.playback.speed)))
-        )
-
-    def _on_play_tick(self) -> None:
-        n = self.playback.n_available
-        if n == 0:
-            return
-        if self.playback.frame + 1 < n:
-            self.playback.step(1)
-        elif self.cache.complete and self.playback.loop:
-            self.playback.set_frame(0)
-
-    def _update_frame_label(self) -> None:
-        total = self.cache.expected or len(self.cache)
-        t = self.playback.frame * self._frame_period_s
-        self.frame_label.setText(
-            f" frame {self.playback.frame + 1 if len(self.cache) else 0} / {len(self.cache)}"
-            f" (of {total}) · {t:5.2f} s"
-        )
 
     # ---- drawing ----
+    def _mark_dirty(self, *_args) -> None:
+        self._dirty = True
+
     def _on_view_options(self, *_args) -> None:
         self.top_view.set_colour_by(self.colour_combo.currentData())
         self.top_view.persistence = self.persistence_spin.value()
@@ -610,7 +436,8 @@ class MainWindow(QtWidgets.QMainWindow):
         except InputError as exc:
             self.show_error(str(exc))
         except Exception as exc:
-            self.show_error(f"cannot start study: {describe_error(exc)}")
+            log_exception("cannot start study", exc)
+            self.show_error(f"cannot start study: {one_line(exc)}")
 
     def enqueue_current(self) -> None:
         self.study.enqueue(
@@ -626,7 +453,8 @@ class MainWindow(QtWidgets.QMainWindow):
             self.show_error(str(exc))
             return
         except Exception as exc:
-            self.show_error(f"cannot start the dashboard: {describe_error(exc)}")
+            log_exception("cannot start the dashboard", exc)
+            self.show_error(f"cannot start the dashboard: {one_line(exc)}")
             return
         self.statusBar().showMessage(f"dashboard at {url}", 10000)
         QtCore.QTimer.singleShot(1500, lambda: webbrowser.open(url))
@@ -717,8 +545,8 @@ class MainWindow(QtWidgets.QMainWindow):
     def shutdown(self) -> None:
         """Stop timers and workers (close, tests)."""
         self._draw_timer.stop()
-        self._play_timer.stop()
-        self._scene_timer.stop()
+        self.playback_control.stop()
+        self.scene_control.stop()
         self.sim.wait()
         self.tracker.wait()
         self.study.shutdown()

@@ -8,11 +8,11 @@ from __future__ import annotations
 
 import threading
 import time
-import traceback
 
 from PySide6 import QtCore
 
 from app.data import TrackingResult
+from app.errors import log_exception, one_line
 from app.models import FrameCache, TrackerParamsModel, TrackingModel
 from core.errors import InputError
 
@@ -28,13 +28,6 @@ def freeze_heap() -> None:
     import gc
 
     gc.freeze()
-
-
-def describe_error(exc: BaseException) -> str:
-    """One line for the user: InputError as is, anything else with its type."""
-    from app.engine import describe
-
-    return describe(exc)
 
 
 class SimulationWorker(QtCore.QThread):
@@ -63,8 +56,8 @@ class SimulationWorker(QtCore.QThread):
             if not self._stop.is_set():
                 self.done.emit(self.generation)
         except Exception as exc:  # any failure becomes a message, never a crash
-            traceback.print_exc()
-            self.failed.emit(self.generation, describe_error(exc))
+            log_exception("simulation failed", exc)
+            self.failed.emit(self.generation, one_line(exc))
 
 
 class SimulationController(QtCore.QObject):
@@ -103,16 +96,25 @@ class SimulationController(QtCore.QObject):
             self._worker = None
 
     def _reap(self) -> None:
-        self._old = [w for w in self._old if w.isRunning()]
-
-    def wait(self, timeout_ms: int = 5000) -> bool:
-        """Stop and join every worker (used on close and in tests)."""
-        self.stop()
-        ok = True
         for w in self._old:
-            ok &= w.wait(timeout_ms)
-        self._old = []
-        return ok
+            if w.isFinished():
+                w.deleteLater()  # an abandoned worker that has ended: free its QThread
+        self._old = [w for w in self._old if not w.isFinished()]
+
+    def wait(self) -> bool:
+        """Stop every worker and join it (close, tests); returns True when all have ended.
+
+        There is no time-out: a worker checks its stop flag between frames, so this waits for at
+        most the frame in progress. That frame can take many seconds (the first call compiles the
+        numba kernels when their cache is cold, as for a new user, and the machine may be busy);
+        giving up earlier let the window, the thread's parent, be destroyed under a running thread,
+        which Qt answers with ``QThread: Destroyed while thread is still running`` and an abort.
+        """
+        self.stop()
+        for w in self._old:
+            w.wait()  # QDeadlineTimer.Forever
+        self._reap()
+        return not self._old
 
     @property
     def running(self) -> bool:
@@ -161,8 +163,8 @@ class _TrackJob(QtCore.QRunnable):
                 result = engine.track(frames, params, frame_period_s, key=key)
                 self._signals.result.emit(self._ticket, result)
         except Exception as exc:
-            traceback.print_exc()
-            self._signals.failed.emit(self._ticket, describe_error(exc))
+            log_exception("re-tracking failed", exc)
+            self._signals.failed.emit(self._ticket, one_line(exc))
         finally:
             self._signals.done.emit(self._ticket)
 
@@ -268,7 +270,9 @@ class TrackingController(QtCore.QObject):
     def idle(self) -> bool:
         return not self._busy and not self._timer.isActive() and not self._pending
 
-    def wait(self, timeout_ms: int = 10000) -> bool:
+    def wait(self, timeout_ms: int = -1) -> bool:
+        """Cancel pending requests and wait for the run in flight (default: without a time-out,
+        for the reason given at :meth:`SimulationController.wait`)."""
         self._timer.stop()
         self._pending = False
         return self._pool.waitForDone(timeout_ms)
