@@ -7,6 +7,9 @@
 - :mod:`~core.tracking.ipda` — existence, likelihood ratios, δ, ψ, β, PDA update
 - :mod:`~core.tracking.initiation`, :mod:`~core.tracking.management` — birth, confirmation,
   deletion, merging, cap, estimate
+- :mod:`~core.tracking.inputs` — measurement frames validated once, derived constants
+- :mod:`~core.tracking.results` — :class:`TrackerResult`, :class:`FrameTracks`, the kernel's
+  :class:`~core.tracking.results.TrackRecord`
 - :mod:`~core.tracking.tracker` — :func:`run_tracker` (readable reference, every track)
 - :mod:`~core.tracking.kernel` — the same algorithm compiled with numba (hot path)
 - :mod:`~core.tracking.batch` — :func:`track_dataset` over a :class:`core.dataset.Dataset`
@@ -15,7 +18,8 @@
 
 from core.tracking.batch import DatasetEstimates, track_dataset
 from core.tracking.params import SEARCH_SPACE, TrackerParams
-from core.tracking.tracker import FrameTracks, TrackerResult, run_tracker
+from core.tracking.results import FrameTracks, TrackerResult
+from core.tracking.tracker import run_tracker
 
 __all__ = [
     "SEARCH_SPACE",

@@ -12,76 +12,21 @@ from __future__ import annotations
 
 import functools
 import math
-from dataclasses import dataclass, replace
+from dataclasses import replace
 
 import numpy as np
 from numba import njit
 
+from core.tracking.ekf import MIN_RANGE_M
 from core.tracking.gating import gate_threshold
 from core.tracking.initiation import initial_covariance
+from core.tracking.inputs import Frames, TrackerConstants, packed_frames
 from core.tracking.ipda import LOG_2PI
 from core.tracking.models import process_noise, transition_matrix
 from core.tracking.params import TrackerParams
+from core.tracking.results import FrameTracks, TrackerResult, TrackRecord
 
-__all__ = ["TrackRecord", "run_tracker_compiled", "track_frames"]
-
-MIN_RANGE_M = 1e-2  # same as core.tracking.ekf.MIN_RANGE_M
-
-
-@dataclass(frozen=True, slots=True, kw_only=True)
-class TrackRecord:
-    """Every live track of every output frame, as the kernel recorded it (F frames, cap slots).
-
-    Slot ``t < n_tracks[f]`` of frame f holds the t-th live track in the tracker's order (the
-    order of :class:`core.tracking.tracker.FrameTracks`); the other slots are unspecified.
-
-    Attributes
-    ----------
-    n_tracks
-        (F,) live tracks per frame.
-    ids
-        (F, cap) int64 track ids (per trajectory, increasing with birth).
-    state, covariance
-        (F, cap, d) and (F, cap, d, d): [x, y, vx, vy(, ax, ay)] in m, m/s, m/s².
-    psi
-        (F, cap) existence probability ψ.
-    confirmed
-        (F, cap) bool status: True confirmed, False tentative.
-    birth_frame
-        (F, cap) int64 frame (index within the trajectory) in which the track was born.
-    gate_center_xy, gate_shape_xy
-        (F, cap, 2) and (F, cap, 2, 2): the gate in x–y (see ``FrameTracks``), from the
-        predicted covariance of the frame (for a newborn track: P₀).
-    estimate
-        (F,) slot of the single-person estimate, −1 when no track is confirmed.
-    """
-
-    n_tracks: np.ndarray
-    ids: np.ndarray
-    state: np.ndarray
-    covariance: np.ndarray
-    psi: np.ndarray
-    confirmed: np.ndarray
-    birth_frame: np.ndarray
-    gate_center_xy: np.ndarray
-    gate_shape_xy: np.ndarray
-    estimate: np.ndarray
-
-    @classmethod
-    def allocate(cls, n_frames: int, cap: int, d: int) -> TrackRecord:
-        """Preallocated arrays for ``n_frames`` frames of ``cap`` tracks (0, 0: recording off)."""
-        return cls(
-            n_tracks=np.zeros(n_frames, dtype=np.int64),
-            ids=np.full((n_frames, cap), -1, dtype=np.int64),
-            state=np.full((n_frames, cap, d), np.nan),
-            covariance=np.full((n_frames, cap, d, d), np.nan),
-            psi=np.full((n_frames, cap), np.nan),
-            confirmed=np.zeros((n_frames, cap), dtype=np.bool_),
-            birth_frame=np.full((n_frames, cap), -1, dtype=np.int64),
-            gate_center_xy=np.full((n_frames, cap, 2), np.nan),
-            gate_shape_xy=np.full((n_frames, cap, 2, 2), np.nan),
-            estimate=np.full(n_frames, -1, dtype=np.int64),
-        )
+__all__ = ["run_tracker_compiled", "track_frames"]
 
 
 @njit(cache=True)
@@ -787,7 +732,7 @@ def track_frames(
 
 
 def run_tracker_compiled(
-    frames,
+    frames: Frames,
     params: TrackerParams,
     frame_period_s: float = 0.08,
     *,
@@ -795,7 +740,7 @@ def run_tracker_compiled(
 ):
     """:func:`core.tracking.tracker.run_tracker` on the compiled kernel (every track recorded).
 
-    Same input and the same :class:`~core.tracking.tracker.TrackerResult` (estimates, ids, ψ,
+    Same input and the same :class:`~core.tracking.results.TrackerResult` (estimates, ids, ψ,
     status, states, covariances, birth frames and gates of every track per frame) as the
     readable tracker, equal to round-off; tracks one 250-frame scene in milliseconds.
 
@@ -816,26 +761,8 @@ def run_tracker_compiled(
     -------
     TrackerResult
     """
-    from core.errors import InputError
-    from core.tracking.tracker import FrameTracks, TrackerConstants, TrackerResult, frame_slices
-
     TrackerConstants.build(params, frame_period_s)  # validates the frame period
-    if isinstance(frames, tuple) and len(frames) == 2 and np.ndim(frames[1]) == 1:
-        z = np.asarray(frames[0], dtype=np.float64).reshape(-1, 3)
-        f_off = np.asarray(frames[1], dtype=np.int64)
-        if len(f_off) == 0 or f_off[0] != 0 or f_off[-1] != len(z) or np.any(np.diff(f_off) < 0):
-            raise InputError(
-                f"frame_offsets must rise from 0 to the {len(z)} measurements, "
-                f"got {f_off[:3].tolist()}…{f_off[-2:].tolist()}"
-            )
-    else:
-        zs = frame_slices(frames)
-        counts = np.array([len(zf) for zf in zs], dtype=np.int64)
-        z = np.concatenate(zs) if zs else np.zeros((0, 3))
-        f_off = np.concatenate(([0], np.cumsum(counts))).astype(np.int64)
-    if not np.all(np.isfinite(z)):
-        bad = int(np.flatnonzero(~np.all(np.isfinite(z), axis=1))[0])
-        raise InputError(f"measurement {bad} contains NaN or Inf")
+    z, f_off = packed_frames(frames)
     n_f = len(f_off) - 1
     t_off = np.array([0, n_f], dtype=np.int64)
     out = track_frames(
