@@ -10,6 +10,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import NamedTuple
 
 import numpy as np
 
@@ -99,9 +100,11 @@ class TrackerResult:
         return len(self.has_estimate)
 
 
-@dataclass(frozen=True, slots=True, kw_only=True)
-class TrackRecord:
+class TrackRecord(NamedTuple):
     """Every live track of every output frame, as the kernel recorded it (F frames, cap slots).
+
+    A :class:`typing.NamedTuple` (immutable like the frozen dataclasses) so that the compiled
+    kernel takes it as one argument and writes into its arrays.
 
     Slot ``t < n_tracks[f]`` of frame f holds the t-th live track in the tracker's order (the
     order of :class:`FrameTracks`); the other slots are unspecified.
