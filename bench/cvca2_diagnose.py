@@ -7,7 +7,7 @@ Run from the repository root::
 On the cached paper data set (seed 0) with ``docs/report/best_cv.json`` / ``best_ca.json``:
 
 1. per class, the loss split into transient / manoeuvre / steady frames
-   (:func:`core.model_comparison.loss_breakdown`), N_c, SSE, first confirmation, lag;
+   (:func:`core.evaluation.loss_breakdown`), N_c, SSE, first confirmation, lag;
 2. the 2.2 % radial-velocity bias of the chain (decision sim-01): both parameter sets tracked on
    a copy of the data set whose v_r is divided by the bias factor (a diagnostic of the tracker's
    sensitivity; the simulation is unchanged);
@@ -34,8 +34,8 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from core.dataset import Dataset  # noqa: E402
-from core.evaluation import evaluate  # noqa: E402
-from core.model_comparison import (  # noqa: E402
+from core.evaluation import (  # noqa: E402
+    evaluate,
     loss_breakdown,
     paired_comparison,
     track_with_ids,

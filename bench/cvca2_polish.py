@@ -12,7 +12,7 @@ the search space is log-scaled) with the others held, and the best value is kept
 until one changes nothing or ``--sweeps`` is reached. The same procedure and grid for both
 models; the evaluation budget (tracker runs over the 35 trajectories) is recorded. The polished
 parameters are then re-tracked on the independent set paper:1 (nothing is selected there) and
-compared trajectory by trajectory (:func:`core.model_comparison.paired_comparison`).
+compared trajectory by trajectory (:func:`core.evaluation.paired_comparison`).
 """
 
 from __future__ import annotations
@@ -29,8 +29,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from core.dataset import Dataset  # noqa: E402
-from core.evaluation import trajectory_losses  # noqa: E402
-from core.model_comparison import paired_comparison  # noqa: E402
+from core.evaluation import paired_comparison, trajectory_losses  # noqa: E402
 from core.optimization.space import flat_params, search_space, tracker_params_dict  # noqa: E402
 from core.pipeline import paper_dataset_file  # noqa: E402
 from core.tracking import TrackerParams, track_dataset  # noqa: E402

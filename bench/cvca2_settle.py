@@ -9,7 +9,7 @@ Run from the repository root after the studies (docs/report/cv-vs-ca.md has the 
 Per study (named ``<model>-...-s<seed>``): trials, best L_t, best L_t within the first 300
 trials (the sampler does not know the budget, so this is a 300-trial study of the same seed,
 up to the two workers' interleaving), and the best parameters' L_t on both data sets. Per model:
-median, min and max over seeds. Comparisons (:func:`core.model_comparison.paired_comparison`,
+median, min and max over seeds. Comparisons (:func:`core.evaluation.paired_comparison`,
 class-stratified paired bootstrap over the 35 trajectories): CV vs CA for every seed pair, for
 the best of all seeds, on both data sets; and the ratio of the per-model medians.
 """
@@ -30,8 +30,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from core.dataset import Dataset  # noqa: E402
-from core.evaluation import evaluate  # noqa: E402
-from core.model_comparison import paired_comparison  # noqa: E402
+from core.evaluation import evaluate, paired_comparison  # noqa: E402
 from core.optimization.report import load_studies  # noqa: E402
 from core.pipeline import paper_dataset_file  # noqa: E402
 from core.tracking import TrackerParams, track_dataset  # noqa: E402

@@ -6,7 +6,7 @@ Usage (from the repository root)::
 
 For each parameter pair (CV, CA) and each data set (paper:0, paper:1, simulated by the current
 code and cached): L_t of both models (eq. 14) and the paired comparison over the 35 trajectories
-(:func:`core.model_comparison.paired_comparison`: ratio of the totals with a class-stratified
+(:func:`core.evaluation.paired_comparison`: ratio of the totals with a class-stratified
 bootstrap interval, wins, Wilcoxon). Tracking only; nothing is tuned.
 """
 
@@ -18,8 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
-from core.evaluation import trajectory_losses
-from core.model_comparison import paired_comparison
+from core.evaluation import paired_comparison, trajectory_losses
 from core.pipeline import paper_dataset
 from core.tracking import TrackerParams
 from core.tracking.batch import track_dataset

@@ -16,7 +16,7 @@
 - :mod:`~core.tracking.synthetic` — synthetic measurements for tests and the stability sweep
 """
 
-from core.tracking.batch import DatasetEstimates, track_dataset
+from core.tracking.batch import DatasetEstimates, estimate_track_ids, track_dataset
 from core.tracking.params import SEARCH_SPACE, TrackerParams
 from core.tracking.results import FrameTracks, TrackerResult
 from core.tracking.tracker import run_tracker
@@ -27,6 +27,7 @@ __all__ = [
     "FrameTracks",
     "TrackerParams",
     "TrackerResult",
+    "estimate_track_ids",
     "run_tracker",
     "track_dataset",
 ]

@@ -1,12 +1,9 @@
-"""Evaluation of tracker output (SPEC §5): the paper's loss and the usual tracking metrics.
+"""Evaluation of one tracker run over a data set (SPEC §5): the paper's loss table (Table I) and
+the usual tracking metrics.
 
-Per trajectory k (eqs. 12–13): N_c(k) = frames with a confirmed track (a single-person
-estimate), ``MSE(k) = (1/N_c) Σ |x̂ − x_gt|²`` over those frames, ``L(k) = MSE(k)/N_c(k)``;
-a trajectory with N_c = 0 scores L = 1.0 m² (the paper is silent). Total (eq. 14):
-``L_t = mean_k L(k)``. Table I lists the per-class means ×10⁻³.
-
-Besides: position RMSE, fraction of frames confirmed, time to first confirmation, frames with a
-confirmed track farther than 1 m from the person, OSPA (c = 1 m, p = 2).
+Besides the loss (:mod:`core.evaluation.loss`): position RMSE, fraction of frames confirmed, time
+to first confirmation, frames with a confirmed track farther than 1 m from the person, OSPA
+(c = 1 m, p = 2; :mod:`core.evaluation.metrics`).
 """
 
 from __future__ import annotations
@@ -15,103 +12,12 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.optimize import linear_sum_assignment
 
 from core.dataset import Dataset
+from core.evaluation.loss import CLASSES, trajectory_loss
+from core.evaluation.metrics import FAR_DISTANCE_M, ospa
 
-__all__ = [
-    "NO_CONFIRMATION_LOSS",
-    "CLASSES",
-    "trajectory_loss",
-    "ospa",
-    "trajectory_losses",
-    "ClassRow",
-    "Evaluation",
-    "evaluate",
-    "PointSpread",
-    "person_point_spread",
-]
-
-#: L(k) of a trajectory without any confirmed frame (m²).
-NO_CONFIRMATION_LOSS = 1.0
-#: Trajectory classes of the paper's Table I.
-CLASSES = ("a", "b", "c", "d", "e")
-#: Distance (m) beyond which a confirmed track counts as far from the person.
-FAR_DISTANCE_M = 1.0
-OSPA_C_M = 1.0
-OSPA_P = 2
-
-
-def trajectory_loss(
-    estimate_xy: np.ndarray, has_estimate: np.ndarray, truth_xy: np.ndarray
-) -> tuple[float, float, int]:
-    """The paper's loss of one trajectory, eqs. (12)–(13).
-
-    Parameters
-    ----------
-    estimate_xy
-        Estimated position (N, 2) in m (ignored where ``has_estimate`` is False).
-    has_estimate
-        (N,) bool, a confirmed track exists in the frame.
-    truth_xy
-        Ground-truth position (N, 2) in m.
-
-    Returns
-    -------
-    L, MSE, N_c
-        ``L = MSE/N_c`` (m²), MSE (m², NaN when N_c = 0) and N_c; N_c = 0 gives L = 1.0.
-    """
-    has = np.asarray(has_estimate, dtype=bool)
-    n_c = int(has.sum())
-    if n_c == 0:
-        return NO_CONFIRMATION_LOSS, math.nan, 0
-    e = np.asarray(estimate_xy)[has] - np.asarray(truth_xy)[has]
-    # MSE(k) = (1/N_c) Σ |x̂ − x_gt|²   (12)
-    mse = float(np.sum(e * e) / n_c)
-    # L(k) = MSE(k) / N_c(k)   (13)
-    return mse / n_c, mse, n_c
-
-
-def ospa(tracks_xy: np.ndarray, truth_xy: np.ndarray, c: float = OSPA_C_M, p: int = OSPA_P):
-    """OSPA distance (Schuhmacher et al. 2008) between two finite sets of 2-D points (m).
-
-    ``d = ((1/n) (min_π Σ min(d_i,π(i), c)^p + c^p (n − m)))^{1/p}``, n ≥ m the larger set
-    size; 0 when both sets are empty. tracks_xy (m, 2), truth_xy (n, 2).
-    """
-    a = np.asarray(tracks_xy, dtype=np.float64).reshape(-1, 2)
-    b = np.asarray(truth_xy, dtype=np.float64).reshape(-1, 2)
-    if len(a) > len(b):
-        a, b = b, a
-    m, n = len(a), len(b)
-    if n == 0:
-        return 0.0
-    if m == 0:
-        return float(c)
-    d = np.minimum(np.linalg.norm(a[:, None, :] - b[None, :, :], axis=2), c) ** p
-    if m == 1:
-        cost = float(d.min())
-    else:
-        rows, cols = linear_sum_assignment(d)
-        cost = float(d[rows, cols].sum())
-    return float(((cost + c**p * (n - m)) / n) ** (1.0 / p))
-
-
-def _truth(dataset: Dataset, frame_index: np.ndarray) -> np.ndarray:
-    return dataset.truth_xy_m[frame_index]  # (F_sel, n_persons, 2)
-
-
-def trajectory_losses(dataset: Dataset, estimates) -> np.ndarray:
-    """L(k) of every tracked trajectory, in the order tracked, shape (K_sel,) in m².
-
-    The cheap path for the optimiser (person 0 is the tracked person).
-    """
-    truth = _truth(dataset, estimates.frame_index)[:, 0, :]
-    off = estimates.offsets
-    out = np.empty(len(estimates.trajectories))
-    for i in range(len(out)):
-        s = slice(off[i], off[i + 1])
-        out[i] = trajectory_loss(estimates.estimate_xy[s], estimates.has_estimate[s], truth[s])[0]
-    return out
+__all__ = ["ClassRow", "Evaluation", "evaluate"]
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -254,7 +160,7 @@ def evaluate(dataset: Dataset, estimates) -> Evaluation:
     The single-person estimate is scored against person 0; far frames and OSPA use all
     confirmed tracks and all persons.
     """
-    truth_all = _truth(dataset, estimates.frame_index)  # (F_sel, n_persons, 2)
+    truth_all = dataset.truth_xy_m[estimates.frame_index]  # (F_sel, n_persons, 2)
     truth = truth_all[:, 0, :]
     t_s = dataset.truth_t_s[estimates.frame_index]
     off = estimates.offsets
@@ -310,69 +216,4 @@ def evaluate(dataset: Dataset, estimates) -> Evaluation:
         far_fraction=float(far.sum() / total_frames) if total_frames else math.nan,
         ospa_mean_m=float(ospa_f.mean()) if total_frames else math.nan,
         table=tuple(table),
-    )
-
-
-@dataclass(frozen=True, slots=True, kw_only=True)
-class PointSpread:
-    """Measurement spread of the person-labelled points of a data set (SI units).
-
-    ``rms_position_m``: RMS of |p − x_gt| (x-y plane) over the points whose ``source`` is a
-    person; ``median_position_m``, ``p90_position_m`` its percentiles; ``rms_range_m`` and
-    ``rms_cross_range_m`` its components along and across the line of sight;
-    ``rms_radial_velocity_mps``: RMS of v_r − v_gt·r̂; ``points_per_frame``: mean number of
-    person points per frame with at least one.
-    """
-
-    n_points: int
-    points_per_frame: float
-    rms_position_m: float
-    median_position_m: float
-    p90_position_m: float
-    rms_range_m: float
-    rms_cross_range_m: float
-    rms_radial_velocity_mps: float
-
-    def to_dict(self) -> dict[str, float]:
-        return {k: getattr(self, k) for k in self.__slots__}
-
-
-def person_point_spread(dataset: Dataset) -> PointSpread:
-    """Error of the person-labelled points against the person's true position and velocity.
-
-    Parameters
-    ----------
-    dataset
-        A simulated data set; a point with ``source = i >= 0`` came from person ``i``.
-
-    Returns
-    -------
-    PointSpread
-        Spread over all person points of all frames (m, m/s).
-    """
-    sel = np.flatnonzero(dataset.source >= 0)
-    if sel.size == 0:
-        raise ValueError("the data set has no person-labelled points")
-    f = dataset.frame[sel]
-    person = dataset.source[sel]
-    truth = dataset.truth_xy_m[f, person]  # (P, 2) m
-    v_truth = dataset.truth_v_mps[f, person]  # (P, 2) m/s
-    d = np.stack([dataset.x_m[sel], dataset.y_m[sel]], axis=1) - truth  # (P, 2) m
-    # r̂ = x_gt / |x_gt|: line of sight to the true position
-    u = truth / np.linalg.norm(truth, axis=1, keepdims=True)
-    e_range = np.sum(d * u, axis=1)
-    e_cross = d[:, 0] * u[:, 1] - d[:, 1] * u[:, 0]
-    # v_r,gt = v_gt · r̂
-    e_vr = dataset.radial_velocity_mps[sel] - np.sum(v_truth * u, axis=1)
-    e = np.hypot(d[:, 0], d[:, 1])
-    _, per_frame = np.unique(f, return_counts=True)
-    return PointSpread(
-        n_points=int(sel.size),
-        points_per_frame=float(per_frame.mean()),
-        rms_position_m=float(np.sqrt(np.mean(e**2))),
-        median_position_m=float(np.median(e)),
-        p90_position_m=float(np.percentile(e, 90)),
-        rms_range_m=float(np.sqrt(np.mean(e_range**2))),
-        rms_cross_range_m=float(np.sqrt(np.mean(e_cross**2))),
-        rms_radial_velocity_mps=float(np.sqrt(np.mean(e_vr**2))),
     )

@@ -1,4 +1,4 @@
-"""Loss breakdown and paired comparison (core.model_comparison) against hand-built cases."""
+"""Loss breakdown and paired comparison (core.evaluation) against hand-built cases."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from core.dataset import Dataset
-from core.model_comparison import loss_breakdown, paired_comparison
+from core.evaluation import loss_breakdown, paired_comparison
 
 T = 0.08
 
@@ -146,7 +146,7 @@ def test_paired_comparison_rejects_bad_input() -> None:
 
 
 def test_track_with_ids_matches_track_dataset() -> None:
-    from core.model_comparison import track_with_ids
+    from core.evaluation import track_with_ids
     from core.tracking import TrackerParams, track_dataset
     from core.tracking.synthetic import SyntheticScene, synthetic_dataset
 

@@ -23,6 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from core.dataset import Dataset
+from core.evaluation.loss import NO_CONFIRMATION_LOSS
 
 __all__ = [
     "CATEGORIES",
@@ -140,18 +141,9 @@ def track_with_ids(dataset: Dataset, params) -> tuple:
         (F,) int64 id of the track giving the estimate in each frame (−1: no estimate; ids
         count per trajectory from 0 in order of birth).
     """
-    from core.tracking import track_dataset
-    from core.tracking.batch import _prepare
-    from core.tracking.kernel import track_frames
+    from core.tracking import estimate_track_ids, track_dataset
 
-    est = track_dataset(dataset, params)
-    z, f_off, t_off, period = _prepare(dataset)
-    sel = np.arange(dataset.n_trajectories, dtype=np.int64)
-    rec = track_frames(z, f_off, t_off, sel, params, period, record=True)[-1]
-    ids = np.full(len(rec.estimate), -1, np.int64)
-    rows = np.flatnonzero(rec.estimate >= 0)
-    ids[rows] = rec.ids[rows, rec.estimate[rows]]
-    return est, ids
+    return track_dataset(dataset, params), estimate_track_ids(dataset, params)
 
 
 def _manoeuvring(truth_v: np.ndarray, period_s: float, accel: float, window: int) -> np.ndarray:
@@ -230,7 +222,7 @@ def loss_breakdown(
         n_c = int(has.sum())
         out["n_c"][i] = n_c
         if n_c == 0:
-            out["loss"][i] = 1.0  # SPEC §5: a trajectory that never confirms scores 1 m²
+            out["loss"][i] = NO_CONFIRMATION_LOSS  # SPEC §5: never confirmed scores 1 m²
             continue
         out["first"][i] = int(np.argmax(has))
         e = estimates.estimate_xy[s] - truth[s]  # (N, 2) m
