@@ -17,7 +17,13 @@ from core.evaluation.comparison import (
     paired_comparison,
     track_with_ids,
 )
-from core.evaluation.loss import CLASSES, NO_CONFIRMATION_LOSS, trajectory_loss, trajectory_losses
+from core.evaluation.loss import (
+    CLASSES,
+    NO_CONFIRMATION_LOSS,
+    tracked_person_xy,
+    trajectory_loss,
+    trajectory_losses,
+)
 from core.evaluation.metrics import FAR_DISTANCE_M, OSPA_C_M, OSPA_P, ospa
 from core.evaluation.spread import PointSpread, person_point_spread
 from core.evaluation.table import ClassRow, Evaluation, evaluate
@@ -40,6 +46,7 @@ __all__ = [
     "paired_comparison",
     "person_point_spread",
     "track_with_ids",
+    "tracked_person_xy",
     "trajectory_loss",
     "trajectory_losses",
 ]

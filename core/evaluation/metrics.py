@@ -1,7 +1,9 @@
 """Tracking metrics besides the paper's loss: OSPA and the thresholds of the far-frame count.
 
 OSPA (Schuhmacher et al. 2008) with cut-off c = 1 m and order p = 2 compares the set of
-confirmed track positions with the set of persons in a frame.
+confirmed track positions with the set of persons present in a frame; it is defined for every
+pair of sets, empty or not, so for frames without a track, without a person and with several
+persons (rows that are NaN — an absent person, a padded track slot — are not in the set).
 """
 
 from __future__ import annotations
@@ -22,10 +24,13 @@ def ospa(tracks_xy: np.ndarray, truth_xy: np.ndarray, c: float = OSPA_C_M, p: in
     """OSPA distance (Schuhmacher et al. 2008) between two finite sets of 2-D points (m).
 
     ``d = ((1/n) (min_π Σ min(d_i,π(i), c)^p + c^p (n − m)))^{1/p}``, n ≥ m the larger set
-    size; 0 when both sets are empty. tracks_xy (m, 2), truth_xy (n, 2).
+    size; 0 when both sets are empty, c when exactly one is. tracks_xy (m, 2), truth_xy (n, 2);
+    rows with a NaN or infinite coordinate are left out of their set.
     """
     a = np.asarray(tracks_xy, dtype=np.float64).reshape(-1, 2)
     b = np.asarray(truth_xy, dtype=np.float64).reshape(-1, 2)
+    a = a[np.all(np.isfinite(a), axis=1)]
+    b = b[np.all(np.isfinite(b), axis=1)]
     if len(a) > len(b):
         a, b = b, a
     m, n = len(a), len(b)

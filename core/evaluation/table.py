@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from core.dataset import Dataset
-from core.evaluation.loss import CLASSES, trajectory_loss
+from core.evaluation.loss import CLASSES, tracked_person_xy, trajectory_loss
 from core.evaluation.metrics import FAR_DISTANCE_M, ospa
 
 __all__ = ["ClassRow", "Evaluation", "evaluate"]
@@ -43,11 +43,17 @@ class Evaluation:
 
     Per trajectory (K_sel,): ``loss``, ``mse``, ``n_c``, ``n_frames``, ``classes``,
     ``first_confirmation_s`` (NaN when never confirmed), ``far_frames``, ``ospa_mean``.
-    Totals: ``loss_total`` (L_t, eq. 14, m²), ``rmse_m`` (position RMSE over all frames with an
-    estimate), ``confirmed_fraction``, ``mean_first_confirmation_s`` (over trajectories that
-    confirm), ``far_frames`` (frames with a confirmed track farther than 1 m from every person)
-    and ``far_fraction``, ``ospa_mean_m`` (OSPA c = 1 m, p = 2, mean over frames, all confirmed
-    tracks against all persons).
+    Totals: ``loss_total`` (L_t, eq. 14, m²), ``rmse_m`` (position RMSE of the estimate over all
+    frames with an estimate in which the tracked person is present), ``confirmed_fraction``,
+    ``mean_first_confirmation_s`` (over trajectories that confirm), ``far_frames`` (frames with
+    a confirmed track farther than 1 m from every person present — with nobody present, every
+    confirmed track is far) and ``far_fraction``, ``ospa_mean_m`` (OSPA c = 1 m, p = 2, mean
+    over frames, all confirmed tracks against the persons present in the frame).
+
+    Undefined values are NaN here, ``None`` in :meth:`to_dict` and "–" with the reason in
+    :meth:`format_table`, never printed as ``nan``: ``mse`` and ``rmse_m`` without a scored
+    frame (no track confirmed, or the tracked person absent in every confirmed frame),
+    ``first_confirmation_s`` when never confirmed, and the totals of an empty selection.
     """
 
     trajectories: np.ndarray
@@ -69,22 +75,32 @@ class Evaluation:
     table: tuple[ClassRow, ...] = field(default=())
 
     def format_table(self) -> str:
-        """The paper's Table I layout (×10⁻³) with MSE and N_c beside L, and the other metrics."""
+        """The paper's Table I layout (×10⁻³) with MSE and N_c beside L, and the other metrics.
+
+        An undefined value prints as "–" (in the table) or "– (reason)" (below it).
+        """
         head = ("class", "L x1e-3", "MSE m2", "mean N_c", "traj", "no conf")
         lines = [" ".join(f"{h:>{w}}" for h, w in zip(head, (6, 10, 10, 9, 5, 8)))]
         for r in self.table:
-            mse = f"{r.mse:10.5f}" if math.isfinite(r.mse) else f"{'-':>10}"
             lines.append(
-                f"{r.name:>6} {r.loss * 1e3:10.4f} {mse} {r.n_c:9.1f} {r.n_trajectories:5d} "
-                f"{r.n_unconfirmed:8d}"
+                f"{r.name:>6} {_cell(r.loss * 1e3, 10, '.4f')} {_cell(r.mse, 10, '.5f')} "
+                f"{_cell(r.n_c, 9, '.1f')} {r.n_trajectories:5d} {r.n_unconfirmed:8d}"
             )
+        no_frames = "no frames tracked"
+        if not int(np.sum(self.n_frames)):
+            no_rmse = no_frames
+        elif not np.isfinite(self.first_confirmation_s).any():
+            no_rmse = "no track confirmed"
+        else:
+            no_rmse = "no person present in a confirmed frame"
         fc = self.mean_first_confirmation_s
         lines += [
-            f"position RMSE        {self.rmse_m:.4f} m",
-            f"frames confirmed     {100 * self.confirmed_fraction:.1f} %",
+            f"position RMSE        {_text(self.rmse_m, '.4f', ' m', no_rmse)}",
+            f"frames confirmed     {_text(100 * self.confirmed_fraction, '.1f', ' %', no_frames)}",
             "first confirmation   " + (f"{fc:.3f} s (mean)" if math.isfinite(fc) else "never"),
-            f"far frames (> 1 m)   {self.far_frames_total} ({100 * self.far_fraction:.2f} %)",
-            f"OSPA (c=1 m, p=2)    {self.ospa_mean_m:.4f} m",
+            f"far frames (> 1 m)   {self.far_frames_total} "
+            f"({_text(100 * self.far_fraction, '.2f', ' %', no_frames)})",
+            f"OSPA (c=1 m, p=2)    {_text(self.ospa_mean_m, '.4f', ' m', no_frames)}",
         ]
         return "\n".join(lines)
 
@@ -142,6 +158,16 @@ class Evaluation:
         }
 
 
+def _cell(value: float, width: int, fmt: str) -> str:
+    """A table cell: the value, or "–" when it is undefined (NaN)."""
+    return f"{value:{width}{fmt}}" if math.isfinite(value) else f"{'–':>{width}}"
+
+
+def _text(value: float, fmt: str, unit: str, reason: str) -> str:
+    """A value with its unit, or "– (reason)" when it is undefined (NaN)."""
+    return f"{value:{fmt}}{unit}" if math.isfinite(value) else f"– ({reason})"
+
+
 def _row(name: str, loss, mse, n_c) -> ClassRow:
     ok = n_c > 0
     return ClassRow(
@@ -157,21 +183,24 @@ def _row(name: str, loss, mse, n_c) -> ClassRow:
 def evaluate(dataset: Dataset, estimates) -> Evaluation:
     """Loss table and metrics of :class:`core.tracking.DatasetEstimates` against the truth.
 
-    The single-person estimate is scored against person 0; far frames and OSPA use all
-    confirmed tracks and all persons.
+    The single-person estimate is scored against person 0 in the frames in which it is present;
+    far frames and OSPA use all confirmed tracks and the persons present in each frame (a
+    person is absent where its truth is NaN). See :class:`Evaluation` for undefined values.
     """
     truth_all = dataset.truth_xy_m[estimates.frame_index]  # (F_sel, n_persons, 2)
-    truth = truth_all[:, 0, :]
+    truth = tracked_person_xy(truth_all)  # (F_sel, 2), NaN where absent
     t_s = dataset.truth_t_s[estimates.frame_index]
     off = estimates.offsets
     n_sel = len(estimates.trajectories)
     loss, mse = np.empty(n_sel), np.empty(n_sel)
     n_c, n_frames, far = (np.zeros(n_sel, dtype=np.int64) for _ in range(3))
     first, ospa_m = np.full(n_sel, math.nan), np.empty(n_sel)
-    # per frame: distance of every confirmed track to the nearest person; OSPA
+    # per frame: distance of every confirmed track to the nearest person present (∞: nobody)
     conf = estimates.confirmed_xy  # (F_sel, C, 2), NaN padded
     valid = np.isfinite(conf[..., 0])
-    dist = np.linalg.norm(conf[:, :, None, :] - truth_all[:, None, :, :], axis=3).min(axis=2)
+    present = np.all(np.isfinite(truth_all), axis=2)  # (F_sel, n_persons)
+    gap = np.linalg.norm(conf[:, :, None, :] - truth_all[:, None, :, :], axis=3)
+    dist = np.where(present[:, None, :], gap, np.inf).min(axis=2, initial=np.inf)
     far_frame = np.any(valid & (dist > FAR_DISTANCE_M), axis=1)
     ospa_f = np.array(
         [ospa(conf[f][valid[f]], truth_all[f]) for f in range(len(conf))], dtype=np.float64
@@ -193,7 +222,8 @@ def evaluate(dataset: Dataset, estimates) -> Evaluation:
     ]
     table.append(_row("total", loss, mse, n_c))
     has = estimates.has_estimate
-    e = estimates.estimate_xy[has] - truth[has]
+    scored = has & np.all(np.isfinite(truth), axis=1)  # an estimate and the person present
+    e = estimates.estimate_xy[scored] - truth[scored]
     total_frames = int(n_frames.sum())
     return Evaluation(
         trajectories=estimates.trajectories,
@@ -207,7 +237,7 @@ def evaluate(dataset: Dataset, estimates) -> Evaluation:
         ospa_mean=ospa_m,
         # L_t = (1/N_t) Σ L(k)   (14)
         loss_total=float(loss.mean()) if n_sel else math.nan,
-        rmse_m=float(np.sqrt(np.mean(np.sum(e * e, axis=1)))) if has.any() else math.nan,
+        rmse_m=float(np.sqrt(np.mean(np.sum(e * e, axis=1)))) if scored.any() else math.nan,
         confirmed_fraction=float(has.mean()) if total_frames else math.nan,
         mean_first_confirmation_s=(
             float(np.nanmean(first)) if np.isfinite(first).any() else math.nan
