@@ -23,7 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from core.dataset import Dataset
-from core.evaluation.loss import NO_CONFIRMATION_LOSS
+from core.evaluation.loss import NO_CONFIRMATION_LOSS, tracked_person_xy
 
 __all__ = [
     "CATEGORIES",
@@ -177,7 +177,8 @@ def loss_breakdown(
     Parameters
     ----------
     dataset
-        The tracked data set (truth: person 0).
+        The tracked data set (truth: person 0; frames in which it is absent are not scored,
+        as in :func:`core.evaluation.trajectory_loss`).
     estimates
         :class:`core.tracking.DatasetEstimates` of that data set.
     estimate_ids
@@ -196,8 +197,10 @@ def loss_breakdown(
     -------
     LossBreakdown
     """
-    truth = dataset.truth_xy_m[estimates.frame_index][:, 0, :]  # (F_sel, 2) m
-    truth_v = dataset.truth_v_mps[estimates.frame_index][:, 0, :]  # (F_sel, 2) m/s
+    # person 0, NaN where absent; like the loss, only frames in which it is present are scored
+    truth = tracked_person_xy(dataset.truth_xy_m[estimates.frame_index])  # (F_sel, 2) m
+    truth_v = tracked_person_xy(dataset.truth_v_mps[estimates.frame_index])  # (F_sel, 2) m/s
+    present = np.all(np.isfinite(truth), axis=1)
     off = estimates.offsets
     k_sel = len(estimates.trajectories)
     n_cat = len(CATEGORIES)
@@ -216,7 +219,7 @@ def loss_breakdown(
     }
     for i in range(k_sel):
         s = slice(off[i], off[i + 1])
-        has = np.asarray(estimates.has_estimate[s], dtype=bool)
+        has = np.asarray(estimates.has_estimate[s], dtype=bool) & present[s]
         n = len(has)
         out["n_frames"][i] = n
         n_c = int(has.sum())
