@@ -7,7 +7,8 @@ scratch buffers (no allocation per track and frame), and one call tracks every s
 trajectory of a data set. ``tests/core/tracking/test_kernel.py`` checks that both paths agree to
 1e-10. See docs/decisions/tracker-01-numba-kernel.md for why numba.
 
-One call takes four groups (named tuples, which numba compiles like separate arguments):
+One call takes four groups (named tuples; they cross into numba as plain tuples, the cheaper
+argument to type, and are named again inside the kernel):
 :class:`KernelFrames` (measurements, trajectories), :class:`KernelConstants` (from the
 parameters and the frame period, cached per parameter set), :class:`KernelOutputs` (per-frame
 estimates) and :class:`~core.tracking.results.TrackRecord` (every track, when recording). The
