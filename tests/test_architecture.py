@@ -114,15 +114,6 @@ def test_no_qt_import_statement_in_core_sources() -> None:
     assert offenders == []
 
 
-# Import cycles that exist today and are being removed; each entry is the exact set of modules
-# of one cycle (strongly connected component). A listed cycle that no longer exists fails
-# `test_known_cycles_still_exist`, so the entry is removed with the fix.
-KNOWN_CYCLES: dict[frozenset[str], str] = {
-    # branch `tracking`: result types, constants and the input validator get their own module
-    frozenset({"core.tracking.tracker", "core.tracking.kernel"}): "tracker.py <-> kernel.py",
-}
-
-
 def import_cycles(imports: Mapping[str, Iterable[str]]) -> list[frozenset[str]]:
     """Every import cycle: the strongly connected components with more than one module, and
     single modules that import themselves (Tarjan's algorithm, iterative)."""
@@ -201,21 +192,7 @@ def test_graph_sees_lazy_imports_and_namespace_free_packages() -> None:
 
 
 def test_no_import_cycle_in_core_or_app(cycles: list[frozenset[str]]) -> None:
-    new = [sorted(c) for c in cycles if c not in KNOWN_CYCLES]
-    assert new == [], f"import cycles: {new}"
-
-
-def test_known_cycles_still_exist(cycles: list[frozenset[str]]) -> None:
-    fixed = [name for c, name in KNOWN_CYCLES.items() if c not in cycles]
-    assert fixed == [], f"fixed, remove from KNOWN_CYCLES: {fixed}"
-
-
-# Private names (`_x`) imported from another module; each is being removed. A fixed entry
-# fails `test_known_private_imports_still_exist`, so the entry goes with the fix.
-KNOWN_PRIVATE_IMPORTS: dict[tuple[str, str, str], str] = {
-    # branch `tracking`: the model comparison moves into core/evaluation/ without it
-    ("core/model_comparison.py", "core.tracking.batch", "_prepare"): "branch tracking",
-}
+    assert [sorted(c) for c in cycles] == [], "import cycles"
 
 
 def private_imports() -> set[tuple[str, str, str]]:
@@ -236,10 +213,4 @@ def private_imports() -> set[tuple[str, str, str]]:
 
 
 def test_no_private_name_imported_across_modules() -> None:
-    new = sorted(private_imports() - set(KNOWN_PRIVATE_IMPORTS))
-    assert new == [], f"private names imported from another module: {new}"
-
-
-def test_known_private_imports_still_exist() -> None:
-    fixed = sorted(set(KNOWN_PRIVATE_IMPORTS) - private_imports())
-    assert fixed == [], f"fixed, remove from KNOWN_PRIVATE_IMPORTS: {fixed}"
+    assert sorted(private_imports()) == [], "private names imported from another module"

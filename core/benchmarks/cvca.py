@@ -6,13 +6,13 @@
 (:data:`PAIRS`, those whose files exist):
 
 - ``L_t`` of both models (eq. 14) and the paired comparison over the trajectories
-  (:func:`core.model_comparison.paired_comparison`: ratio of the totals with a class-stratified
+  (:func:`core.evaluation.paired_comparison`: ratio of the totals with a class-stratified
   bootstrap interval, wins, Wilcoxon);
 - the motion model isolated: CA's parameters with the CV model (the acceleration entries of
   p0 dropped) and q_coeff re-scanned (:data:`Q_GRID` and CA's own q), the best against CA's
   own, paired (decision cvca2-01, item 4);
 - per class, each model's loss split into transient, manoeuvre and steady frames
-  (:func:`core.model_comparison.loss_breakdown`), with N_c, the first confirmed frame and the
+  (:func:`core.evaluation.loss_breakdown`), with N_c, the first confirmed frame and the
   mean along-track error;
 
 and per data set the spread of its person-labelled points against the truth
@@ -39,8 +39,14 @@ from typing import Any
 import numpy as np
 
 from core.dataset import Dataset
-from core.evaluation import evaluate, person_point_spread, trajectory_losses
-from core.model_comparison import loss_breakdown, paired_comparison, track_with_ids
+from core.evaluation import (
+    evaluate,
+    loss_breakdown,
+    paired_comparison,
+    person_point_spread,
+    track_with_ids,
+    trajectory_losses,
+)
 from core.pipeline import paper_dataset
 from core.tracking import TrackerParams, track_dataset
 
@@ -102,7 +108,7 @@ def available_pairs(root: Path = Path(".")) -> dict[str, tuple[TrackerParams, Tr
 
 def track_model(dataset: Dataset, params: TrackerParams) -> ModelRun:
     """Track ``dataset`` with ``params``; losses from :func:`core.evaluation.evaluate` and
-    their split by frame kind from :func:`core.model_comparison.loss_breakdown`."""
+    their split by frame kind from :func:`core.evaluation.loss_breakdown`."""
     estimates, ids = track_with_ids(dataset, params)
     ev = evaluate(dataset, estimates)
     period = float(json.loads(dataset.radar_json)["frame_period_s"])

@@ -10,7 +10,7 @@ studies of 1000 trials (about 1–4 min each on the 2-core machine) and the poli
    (nothing is selected there); per model the median, min and max over seeds, and the best
    value within the first 300 trials (a 300-trial study of the same seed, up to the workers'
    interleaving).
-3. CV against CA trajectory by trajectory (:func:`core.model_comparison.paired_comparison`) for
+3. CV against CA trajectory by trajectory (:func:`core.evaluation.paired_comparison`) for
    every seed and for the best of all seeds, on both sets.
 4. Each model's best of all seeds polished by coordinate search inside eq. (15)
    (:func:`polish`) on paper:0, then compared again on both sets.
@@ -33,8 +33,7 @@ from typing import Any
 import numpy as np
 
 from core.dataset import Dataset
-from core.evaluation import trajectory_losses
-from core.model_comparison import paired_comparison
+from core.evaluation import paired_comparison, trajectory_losses
 from core.optimization.space import flat_params, search_space, tracker_params_dict
 from core.pipeline import paper_dataset
 from core.tracking import TrackerParams, track_dataset

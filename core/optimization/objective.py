@@ -133,15 +133,15 @@ class TrackerLosses:
         self.losses(tracker_params_dict(flat, model), [0])
 
     def losses(self, params: dict[str, Any], ks: Sequence[int]) -> list[tuple[float, float, int]]:
-        from core.evaluation import trajectory_loss
+        from core.evaluation import tracked_person_xy, trajectory_loss
         from core.tracking import TrackerParams, track_dataset
 
         if not len(ks):
             return []
         tp = TrackerParams.from_dict({**self.base_params, **params})
         est = track_dataset(self.dataset, tp, trajectories=list(ks))
-        # person 0 is the tracked person; est.frame_index are the tracked global frames
-        truth = self.dataset.truth_xy_m[est.frame_index, 0, :]
+        # person 0 is the tracked person (NaN where absent); est.frame_index: the tracked frames
+        truth = tracked_person_xy(self.dataset.truth_xy_m[est.frame_index])
         out = []
         for i in range(len(ks)):
             s = slice(int(est.offsets[i]), int(est.offsets[i + 1]))

@@ -9,16 +9,20 @@
 - :mod:`~core.tracking.ipda` — existence, likelihood ratios, δ, ψ, β, PDA update
 - :mod:`~core.tracking.initiation`, :mod:`~core.tracking.management` — birth, confirmation,
   deletion, merging, cap, estimate
+- :mod:`~core.tracking.inputs` — measurement frames validated once, derived constants
+- :mod:`~core.tracking.results` — :class:`TrackerResult`, :class:`FrameTracks`, the kernel's
+  :class:`~core.tracking.results.TrackRecord`
 - :mod:`~core.tracking.tracker` — :func:`run_tracker` (readable reference, every track)
 - :mod:`~core.tracking.kernel` — the same algorithm compiled with numba (hot path)
 - :mod:`~core.tracking.batch` — :func:`track_dataset` over a :class:`core.dataset.Dataset`
 - :mod:`~core.tracking.synthetic` — synthetic measurements for tests and the stability sweep
 """
 
-from core.tracking.batch import DatasetEstimates, track_dataset
+from core.tracking.batch import DatasetEstimates, estimate_track_ids, track_dataset
 from core.tracking.params import TrackerParams
+from core.tracking.results import FrameTracks, TrackerResult
 from core.tracking.space import SEARCH_SPACE
-from core.tracking.tracker import FrameTracks, TrackerResult, run_tracker
+from core.tracking.tracker import run_tracker
 
 __all__ = [
     "SEARCH_SPACE",
@@ -26,6 +30,7 @@ __all__ = [
     "FrameTracks",
     "TrackerParams",
     "TrackerResult",
+    "estimate_track_ids",
     "run_tracker",
     "track_dataset",
 ]

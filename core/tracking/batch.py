@@ -19,7 +19,7 @@ from core.dataset import Dataset
 from core.errors import InputError
 from core.tracking.params import TrackerParams
 
-__all__ = ["DatasetEstimates", "track_dataset", "dataset_frame_period_s"]
+__all__ = ["DatasetEstimates", "track_dataset", "estimate_track_ids", "dataset_frame_period_s"]
 
 DEFAULT_FRAME_PERIOD_S = 0.08
 
@@ -184,3 +184,28 @@ def track_dataset(
         n_tracks=n_tr,
         model=params.model,
     )
+
+
+def estimate_track_ids(
+    dataset: Dataset, params: TrackerParams, *, trajectories: Sequence[int] | None = None
+) -> np.ndarray:
+    """Id of the track that gives the single-person estimate, per output frame.
+
+    Same selection and frame order as :func:`track_dataset`; runs the compiled kernel with every
+    track recorded.
+
+    Returns
+    -------
+    numpy.ndarray
+        (F_sel,) int64: the estimate's track id (ids count per trajectory from 0 in order of
+        birth), −1 where there is no estimate.
+    """
+    from core.tracking.kernel import track_frames
+
+    sel = _selection(dataset, trajectories)
+    z, f_off, t_off, period = _prepare(dataset)
+    rec = track_frames(z, f_off, t_off, sel, params, period, record=True)[-1]
+    ids = np.full(len(rec.estimate), -1, np.int64)
+    rows = np.flatnonzero(rec.estimate >= 0)
+    ids[rows] = rec.ids[rows, rec.estimate[rows]]
+    return ids

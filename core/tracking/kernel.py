@@ -6,82 +6,32 @@ speed: the tracks live in preallocated arrays, the small matrix products are exp
 scratch buffers (no allocation per track and frame), and one call tracks every selected
 trajectory of a data set. ``tests/core/tracking/test_kernel.py`` checks that both paths agree to
 1e-10. See docs/decisions/tracker-01-numba-kernel.md for why numba.
+
+One call takes four groups (named tuples; they cross into numba as plain tuples, the cheaper
+argument to type, and are named again inside the kernel):
+:class:`KernelFrames` (measurements, trajectories), :class:`KernelConstants` (from the
+parameters and the frame period, cached per parameter set), :class:`KernelOutputs` (per-frame
+estimates) and :class:`~core.tracking.results.TrackRecord` (every track, when recording). The
+file is longer than the house's ~600 lines because the kernel is one compiled unit with its
+helpers.
 """
 
 from __future__ import annotations
 
 import functools
 import math
-from dataclasses import dataclass, replace
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit
 
-from core.tracking.gating import gate_threshold
-from core.tracking.initiation import initial_covariance
+from core.tracking.ekf import MIN_RANGE_M
+from core.tracking.inputs import Frames, TrackerConstants, packed_frames
 from core.tracking.ipda import LOG_2PI
-from core.tracking.models import process_noise, transition_matrix
 from core.tracking.params import TrackerParams
+from core.tracking.results import FrameTracks, TrackerResult, TrackRecord
 
-__all__ = ["TrackRecord", "run_tracker_compiled", "track_frames"]
-
-MIN_RANGE_M = 1e-2  # same as core.tracking.ekf.MIN_RANGE_M
-
-
-@dataclass(frozen=True, slots=True, kw_only=True)
-class TrackRecord:
-    """Every live track of every output frame, as the kernel recorded it (F frames, cap slots).
-
-    Slot ``t < n_tracks[f]`` of frame f holds the t-th live track in the tracker's order (the
-    order of :class:`core.tracking.tracker.FrameTracks`); the other slots are unspecified.
-
-    Attributes
-    ----------
-    n_tracks
-        (F,) live tracks per frame.
-    ids
-        (F, cap) int64 track ids (per trajectory, increasing with birth).
-    state, covariance
-        (F, cap, d) and (F, cap, d, d): [x, y, vx, vy(, ax, ay)] in m, m/s, m/s².
-    psi
-        (F, cap) existence probability ψ.
-    confirmed
-        (F, cap) bool status: True confirmed, False tentative.
-    birth_frame
-        (F, cap) int64 frame (index within the trajectory) in which the track was born.
-    gate_center_xy, gate_shape_xy
-        (F, cap, 2) and (F, cap, 2, 2): the gate in x–y (see ``FrameTracks``), from the
-        predicted covariance of the frame (for a newborn track: P₀).
-    estimate
-        (F,) slot of the single-person estimate, −1 when no track is confirmed.
-    """
-
-    n_tracks: np.ndarray
-    ids: np.ndarray
-    state: np.ndarray
-    covariance: np.ndarray
-    psi: np.ndarray
-    confirmed: np.ndarray
-    birth_frame: np.ndarray
-    gate_center_xy: np.ndarray
-    gate_shape_xy: np.ndarray
-    estimate: np.ndarray
-
-    @classmethod
-    def allocate(cls, n_frames: int, cap: int, d: int) -> TrackRecord:
-        """Preallocated arrays for ``n_frames`` frames of ``cap`` tracks (0, 0: recording off)."""
-        return cls(
-            n_tracks=np.zeros(n_frames, dtype=np.int64),
-            ids=np.full((n_frames, cap), -1, dtype=np.int64),
-            state=np.full((n_frames, cap, d), np.nan),
-            covariance=np.full((n_frames, cap, d, d), np.nan),
-            psi=np.full((n_frames, cap), np.nan),
-            confirmed=np.zeros((n_frames, cap), dtype=np.bool_),
-            birth_frame=np.full((n_frames, cap), -1, dtype=np.int64),
-            gate_center_xy=np.full((n_frames, cap, 2), np.nan),
-            gate_shape_xy=np.full((n_frames, cap, 2, 2), np.nan),
-            estimate=np.full(n_frames, -1, dtype=np.int64),
-        )
+__all__ = ["run_tracker_compiled", "track_frames"]
 
 
 @njit(cache=True)
@@ -369,54 +319,30 @@ def _rank(nt, psi, ids, order):
 
 
 @njit(cache=True)
-def _track_kernel(
-    z,
-    f_off,
-    t_off,
-    sel,
-    out_offsets,
-    F,
-    f_cols,
-    f_nnz,
-    Q,
-    R,
-    P0,
-    gamma,
-    gamma2,
-    p_d,
-    p_g,
-    p_te,
-    p11,
-    p21,
-    rho_given,
-    nonparam,
-    confirm_th,
-    delete_th,
-    max_tracks,
-    est_xy,
-    has,
-    est_psi,
-    est_x,
-    est_P,
-    conf_xy,
-    n_conf,
-    n_tr,
-    check,
-    n_bad,
-    chol,
-    record,
-    rec_ids,
-    rec_x,
-    rec_P,
-    rec_psi,
-    rec_conf,
-    rec_birth,
-    rec_gc,
-    rec_gs,
-    rec_best,
-):
+def _track_kernel(frames_, c_, out_, check, record, rec_):
+    """Track the frames (:class:`KernelFrames`) with the constants (:class:`KernelConstants`)
+    into the outputs (:class:`KernelOutputs`); with ``check`` count unhealthy tracks, with
+    ``record`` write every live track into the record
+    (:class:`~core.tracking.results.TrackRecord`).
+
+    The four groups arrive as plain tuples and are named again here: numba types a NamedTuple
+    argument about 1 µs slower per call than a plain tuple.
+    """
+    frames, c, out = KernelFrames(*frames_), KernelConstants(*c_), KernelOutputs(*out_)
+    rec = TrackRecord(*rec_)
+    # local names for the hot loops (the maths below reads like the readable tracker)
+    z, f_off, t_off = frames.z, frames.frame_offsets, frames.trajectory_offsets
+    sel, out_offsets = frames.trajectories, frames.output_offsets
+    F, f_cols, f_nnz, Q, R, P0 = c.F, c.f_cols, c.f_nnz, c.Q, c.R, c.P0
+    gamma, gamma2, p_g, pdpg = c.gamma, c.gamma2, c.p_g, c.pdpg
+    p_te, p11, p21 = c.p_te, c.p11, c.p21
+    rho_given, nonparam = c.clutter_density, c.nonparametric
+    confirm_th, delete_th, max_tracks = c.confirm_threshold, c.delete_threshold, c.max_tracks
+    est_xy, has, est_psi = out.estimate_xy, out.has_estimate, out.estimate_psi
+    est_x, est_P, conf_xy = out.estimate_state, out.estimate_covariance, out.confirmed_xy
+    n_conf, n_tr, n_bad = out.n_confirmed, out.n_tracks, out.n_unhealthy
     n = F.shape[0]
-    pdpg = p_d * p_g
+    chol = np.zeros((n, n))
     log_pg = math.log(p_g)
     log_pdpg = math.log(pdpg)
     a0 = math.log1p(-pdpg) if pdpg < 1.0 else -math.inf
@@ -638,39 +564,112 @@ def _track_kernel(
                 est_P[o, :, :] = P[best]
             if record:
                 # every live track of this frame (nt <= max_tracks after the cap)
-                rec_best[o] = best
+                rec.estimate[o] = best
                 for t in range(nt):
-                    rec_ids[o, t] = ids[t]
-                    rec_x[o, t, :] = X[t]
-                    rec_P[o, t, :, :] = P[t]
-                    rec_psi[o, t] = psi[t]
-                    rec_conf[o, t] = conf[t]
-                    rec_birth[o, t] = birth[t]
-                    rec_gc[o, t, :] = gc[t]
-                    rec_gs[o, t, :, :] = gs[t]
+                    rec.ids[o, t] = ids[t]
+                    rec.state[o, t, :] = X[t]
+                    rec.covariance[o, t, :, :] = P[t]
+                    rec.psi[o, t] = psi[t]
+                    rec.confirmed[o, t] = conf[t]
+                    rec.birth_frame[o, t] = birth[t]
+                    rec.gate_center_xy[o, t, :] = gc[t]
+                    rec.gate_shape_xy[o, t, :, :] = gs[t]
             o += 1
 
 
+class KernelFrames(NamedTuple):
+    """The measurements of one kernel call and which trajectories to track."""
+
+    z: np.ndarray  # (P, 3) float64 [r (m), az (rad), vr (m/s)], sorted by frame
+    frame_offsets: np.ndarray  # (F + 1,) int64 point ranges per global frame
+    trajectory_offsets: np.ndarray  # (K + 1,) int64 frame ranges per trajectory
+    trajectories: np.ndarray  # (K_sel,) int64 the trajectories to track, in order
+    output_offsets: np.ndarray  # (K_sel + 1,) int64 output-frame ranges per tracked trajectory
+
+
+class KernelConstants(NamedTuple):
+    """Everything the kernel reads from the parameters and the frame period."""
+
+    F: np.ndarray  # (d, d) transition matrix
+    f_cols: np.ndarray  # (d, k) int64: row i of F is non-zero in columns f_cols[i, :f_nnz[i]]
+    f_nnz: np.ndarray  # (d,) int64 non-zeros per row of F
+    Q: np.ndarray  # (d, d) process noise
+    R: np.ndarray  # (3, 3) measurement noise
+    P0: np.ndarray  # (d, d) initial covariance
+    gamma: float  # gate threshold χ²⁻¹₃(P_G)
+    gamma2: float  # merge threshold χ²⁻¹₂(P_G)
+    p_g: float  # P_G
+    pdpg: float  # P_D·P_G
+    p_te: float  # ψ of a new track
+    p11: float  # Markov chain 1: P(exists | existed)
+    p21: float  # Markov chain 1: P(exists | did not exist)
+    clutter_density: float  # ρ (given; 1.0 and unused when non-parametric)
+    nonparametric: bool  # ρ̂ = m̂/V per gate instead of ρ
+    confirm_threshold: float
+    delete_threshold: float
+    max_tracks: int
+
+
+class KernelOutputs(NamedTuple):
+    """What the kernel writes per output frame (F_sel frames, NaN where no estimate)."""
+
+    estimate_xy: np.ndarray  # (F_sel, 2)
+    has_estimate: np.ndarray  # (F_sel,) bool
+    estimate_psi: np.ndarray  # (F_sel,)
+    estimate_state: np.ndarray  # (F_sel, d)
+    estimate_covariance: np.ndarray  # (F_sel, d, d)
+    confirmed_xy: np.ndarray  # (F_sel, max_tracks, 2), NaN-padded
+    n_confirmed: np.ndarray  # (F_sel,) int64
+    n_tracks: np.ndarray  # (F_sel,) int64
+    n_unhealthy: np.ndarray  # (F_sel,) int64, counted only when checking
+
+    @classmethod
+    def allocate(cls, n_out: int, d: int, max_tracks: int) -> KernelOutputs:
+        return cls(
+            estimate_xy=np.full((n_out, 2), np.nan),
+            has_estimate=np.zeros(n_out, dtype=np.bool_),
+            estimate_psi=np.full(n_out, np.nan),
+            estimate_state=np.full((n_out, d), np.nan),
+            estimate_covariance=np.full((n_out, d, d), np.nan),
+            confirmed_xy=np.full((n_out, max_tracks, 2), np.nan),
+            n_confirmed=np.zeros(n_out, dtype=np.int64),
+            n_tracks=np.zeros(n_out, dtype=np.int64),
+            n_unhealthy=np.zeros(n_out, dtype=np.int64),
+        )
+
+
 @functools.lru_cache(maxsize=256)
-def _matrices(params: TrackerParams, frame_period_s: float):
-    """F, its sparsity (columns and counts per row), Q, R and P0, cached per parameter set."""
+def kernel_constants(params: TrackerParams, frame_period_s: float) -> KernelConstants:
+    """The kernel's constants, cached per parameter set (shared between calls: never written;
+    read-only flags would force a recompile)."""
+    c = TrackerConstants.build(params, frame_period_s)
     d = params.state_dim
-    F = transition_matrix(params.model, frame_period_s)
-    f_nnz = np.count_nonzero(F, axis=1).astype(np.int64)
+    f_nnz = np.count_nonzero(c.F, axis=1).astype(np.int64)
     f_cols = np.zeros((d, max(1, int(f_nnz.max()))), dtype=np.int64)
     for i in range(d):
-        nz = np.flatnonzero(F[i])
+        nz = np.flatnonzero(c.F[i])
         f_cols[i, : len(nz)] = nz
-    out = (
-        F,
-        f_cols,
-        f_nnz,
-        process_noise(params.model, frame_period_s, params.q_coeff),
-        # R = diag(r11², r22², r33²)
-        np.diag([params.r11**2, params.r22**2, params.r33**2]),
-        initial_covariance(params.p0),
+    nonparametric = params.nonparametric
+    return KernelConstants(
+        F=c.F,
+        f_cols=f_cols,
+        f_nnz=f_nnz,
+        Q=c.Q,
+        R=c.R,
+        P0=c.P0,
+        gamma=float(c.gamma),
+        gamma2=float(c.gamma2),
+        p_g=float(params.p_g),
+        pdpg=float(params.p_d) * float(params.p_g),
+        p_te=float(params.p_te),
+        p11=float(params.p11),
+        p21=float(params.p21),
+        clutter_density=1.0 if nonparametric else float(params.clutter_density),
+        nonparametric=bool(nonparametric),
+        confirm_threshold=float(params.confirm_threshold),
+        delete_threshold=float(params.delete_threshold),
+        max_tracks=int(params.max_tracks),
     )
-    return out  # shared between calls: never written (read-only flags would force a recompile)
 
 
 def track_frames(
@@ -720,74 +719,29 @@ def track_frames(
     out_off = np.concatenate(([0], np.cumsum(lengths))).astype(np.int64)
     n_out = int(out_off[-1])
     d = params.state_dim
-    est_xy = np.full((n_out, 2), np.nan)
-    has = np.zeros(n_out, dtype=np.bool_)
-    est_psi = np.full(n_out, np.nan)
-    est_x = np.full((n_out, d), np.nan)
-    est_P = np.full((n_out, d, d), np.nan)
-    conf_xy = np.full((n_out, params.max_tracks, 2), np.nan)
-    n_conf = np.zeros(n_out, dtype=np.int64)
-    n_tr = np.zeros(n_out, dtype=np.int64)
-    n_bad = np.zeros(n_out, dtype=np.int64)
-    nonparam = params.nonparametric
-    F, f_cols, f_nnz, Q, R, P0 = _matrices(params, float(frame_period_s))
-    rec = TrackRecord.allocate(n_out if record else 0, params.max_tracks if record else 0, d)
-    _track_kernel(
-        np.ascontiguousarray(z, dtype=np.float64),
-        np.ascontiguousarray(frame_offsets, dtype=np.int64),
-        t_off,
-        sel,
-        out_off,
-        F,
-        f_cols,
-        f_nnz,
-        Q,
-        R,
-        P0,
-        gate_threshold(params.p_g, 3),
-        gate_threshold(params.p_g, 2),
-        float(params.p_d),
-        float(params.p_g),
-        float(params.p_te),
-        float(params.p11),
-        float(params.p21),
-        1.0 if nonparam else float(params.clutter_density),
-        nonparam,
-        float(params.confirm_threshold),
-        float(params.delete_threshold),
-        int(params.max_tracks),
-        est_xy,
-        has,
-        est_psi,
-        est_x,
-        est_P,
-        conf_xy,
-        n_conf,
-        n_tr,
-        bool(check),
-        n_bad,
-        np.zeros((d, d)),
-        bool(record),
-        rec.ids,
-        rec.state,
-        rec.covariance,
-        rec.psi,
-        rec.confirmed,
-        rec.birth_frame,
-        rec.gate_center_xy,
-        rec.gate_shape_xy,
-        rec.estimate,
+    frames = KernelFrames(
+        z=np.ascontiguousarray(z, dtype=np.float64),
+        frame_offsets=np.ascontiguousarray(frame_offsets, dtype=np.int64),
+        trajectory_offsets=t_off,
+        trajectories=sel,
+        output_offsets=out_off,
     )
+    out = KernelOutputs.allocate(n_out, d, params.max_tracks)
+    rec = TrackRecord.allocate(n_out if record else 0, params.max_tracks if record else 0, d)
+    c = kernel_constants(params, float(frame_period_s))
+    # plain tuples cross into numba: it types a NamedTuple argument ~1 µs slower than a tuple
+    _track_kernel(tuple(frames), tuple(c), tuple(out), bool(check), bool(record), tuple(rec))
+    est_xy, has, est_psi, est_x, est_P, conf_xy, n_conf, n_tr, n_bad = out
     out = (est_xy, has, est_psi, conf_xy, n_conf, n_tr, est_x, est_P)
     if check:
         out = (*out, n_bad)
     if record:
-        out = (*out, replace(rec, n_tracks=n_tr))
+        out = (*out, rec._replace(n_tracks=n_tr))
     return out
 
 
 def run_tracker_compiled(
-    frames,
+    frames: Frames,
     params: TrackerParams,
     frame_period_s: float = 0.08,
     *,
@@ -795,7 +749,7 @@ def run_tracker_compiled(
 ):
     """:func:`core.tracking.tracker.run_tracker` on the compiled kernel (every track recorded).
 
-    Same input and the same :class:`~core.tracking.tracker.TrackerResult` (estimates, ids, ψ,
+    Same input and the same :class:`~core.tracking.results.TrackerResult` (estimates, ids, ψ,
     status, states, covariances, birth frames and gates of every track per frame) as the
     readable tracker, equal to round-off; tracks one 250-frame scene in milliseconds.
 
@@ -816,26 +770,8 @@ def run_tracker_compiled(
     -------
     TrackerResult
     """
-    from core.errors import InputError
-    from core.tracking.tracker import FrameTracks, TrackerConstants, TrackerResult, frame_slices
-
     TrackerConstants.build(params, frame_period_s)  # validates the frame period
-    if isinstance(frames, tuple) and len(frames) == 2 and np.ndim(frames[1]) == 1:
-        z = np.asarray(frames[0], dtype=np.float64).reshape(-1, 3)
-        f_off = np.asarray(frames[1], dtype=np.int64)
-        if len(f_off) == 0 or f_off[0] != 0 or f_off[-1] != len(z) or np.any(np.diff(f_off) < 0):
-            raise InputError(
-                f"frame_offsets must rise from 0 to the {len(z)} measurements, "
-                f"got {f_off[:3].tolist()}…{f_off[-2:].tolist()}"
-            )
-    else:
-        zs = frame_slices(frames)
-        counts = np.array([len(zf) for zf in zs], dtype=np.int64)
-        z = np.concatenate(zs) if zs else np.zeros((0, 3))
-        f_off = np.concatenate(([0], np.cumsum(counts))).astype(np.int64)
-    if not np.all(np.isfinite(z)):
-        bad = int(np.flatnonzero(~np.all(np.isfinite(z), axis=1))[0])
-        raise InputError(f"measurement {bad} contains NaN or Inf")
+    z, f_off = packed_frames(frames)
     n_f = len(f_off) - 1
     t_off = np.array([0, n_f], dtype=np.int64)
     out = track_frames(

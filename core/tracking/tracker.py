@@ -5,143 +5,23 @@ update of every track with its validated measurements → initiate tentative tra
 measurements outside all gates → confirm → delete → merge → cap → single-person estimate.
 
 This path is plain numpy (one track at a time) and serves the GUI (every track per frame) and the
-tests; :func:`core.tracking.fast.track_dataset` runs the same algorithm compiled for Optuna.
+tests; :mod:`core.tracking.kernel` runs the same algorithm compiled for Optuna. Result types:
+:mod:`core.tracking.results`; input validation and derived constants: :mod:`core.tracking.inputs`.
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from core.errors import InputError
 from core.tracking import ekf, gating, initiation, ipda, management
-from core.tracking.models import process_noise, transition_matrix
+from core.tracking.inputs import Frames, TrackerConstants, frame_slices
 from core.tracking.params import TrackerParams
+from core.tracking.results import FrameTracks, TrackerResult
 
-__all__ = [
-    "FrameTracks",
-    "TrackerResult",
-    "run_tracker",
-    "frame_slices",
-    "TrackerConstants",
-    "gate_ellipses_xy",
-]
-
-TENTATIVE = 0
-CONFIRMED = 1
-
-
-@dataclass(frozen=True, slots=True, kw_only=True)
-class FrameTracks:
-    """Every live track after one frame (struct of arrays, n tracks, state dimension d).
-
-    Attributes
-    ----------
-    ids
-        Track ids (n,), increasing with birth.
-    state
-        States (n, d): [x, y, vx, vy(, ax, ay)] in m, m/s, m/s².
-    covariance
-        Covariances (n, d, d).
-    psi
-        Existence probabilities (n,).
-    confirmed
-        Status (n,) bool: True confirmed, False tentative.
-    gate_center_xy
-        Centre of each track's gate in x–y (m), (n, 2): the predicted position (for a track
-        born in this frame: its initial position).
-    gate_shape_xy
-        Gate ellipse in x–y (n, 2, 2): the points d with dᵀ G⁻¹ d ≤ 1, G = γ·J S_ra Jᵀ, where
-        S_ra is the (r, az) block of S and J = ∂(x, y)/∂(r, az) (the gate's projection on the
-        r–az plane, linearised into x–y).
-    birth_frame
-        Frame (index within the run) in which each track was born (n,), int64.
-    estimate
-        Index into these arrays of the single-person estimate, or −1.
-    """
-
-    ids: np.ndarray
-    state: np.ndarray
-    covariance: np.ndarray
-    psi: np.ndarray
-    confirmed: np.ndarray
-    gate_center_xy: np.ndarray
-    gate_shape_xy: np.ndarray
-    birth_frame: np.ndarray
-    estimate: int = -1
-
-    def __len__(self) -> int:
-        return len(self.ids)
-
-
-@dataclass(frozen=True, slots=True, kw_only=True)
-class TrackerResult:
-    """Tracker output over F frames.
-
-    Attributes
-    ----------
-    estimate_xy
-        Single-person estimate position (F, 2) in m, NaN where no track is confirmed.
-    has_estimate
-        (F,) bool, a confirmed track exists.
-    estimate_id
-        (F,) id of the estimate track, −1 when none.
-    estimate_psi
-        (F,) ψ of the estimate track, NaN when none.
-    estimate_state, estimate_covariance
-        (F, d) and (F, d, d) of the estimate track, NaN when none.
-    confirmed_xy
-        (F, max_tracks, 2) positions of all confirmed tracks, NaN-padded.
-    n_tracks, n_confirmed
-        (F,) live and confirmed track counts.
-    frames
-        Every track per frame (:class:`FrameTracks`), or None when ``keep_tracks=False``.
-    """
-
-    estimate_xy: np.ndarray
-    has_estimate: np.ndarray
-    estimate_id: np.ndarray
-    estimate_psi: np.ndarray
-    estimate_state: np.ndarray
-    estimate_covariance: np.ndarray
-    confirmed_xy: np.ndarray
-    n_tracks: np.ndarray
-    n_confirmed: np.ndarray
-    frames: tuple[FrameTracks, ...] | None = field(default=None, repr=False)
-
-    @property
-    def n_frames(self) -> int:
-        return len(self.has_estimate)
-
-
-@dataclass(frozen=True, slots=True, kw_only=True)
-class TrackerConstants:
-    """Matrices and thresholds derived once from the parameters and the frame period."""
-
-    F: np.ndarray
-    Q: np.ndarray
-    R: np.ndarray
-    P0: np.ndarray
-    gamma: float
-    gamma2: float
-    pdpg: float
-
-    @classmethod
-    def build(cls, params: TrackerParams, frame_period_s: float) -> TrackerConstants:
-        if not (np.isfinite(frame_period_s) and frame_period_s > 0):
-            raise InputError(f"frame_period_s must be positive, got {frame_period_s=}")
-        return cls(
-            F=transition_matrix(params.model, frame_period_s),
-            Q=process_noise(params.model, frame_period_s, params.q_coeff),
-            # R = diag(r11², r22², r33²)
-            R=np.diag([params.r11**2, params.r22**2, params.r33**2]),
-            P0=initiation.initial_covariance(params.p0),
-            gamma=gating.gate_threshold(params.p_g, 3),
-            gamma2=gating.gate_threshold(params.p_g, 2),
-            pdpg=params.p_d * params.p_g,
-        )
+__all__ = ["run_tracker", "gate_ellipses_xy"]
 
 
 @dataclass(slots=True)
@@ -164,22 +44,6 @@ def _gate_xy(x: np.ndarray, S: np.ndarray, gamma: float) -> tuple[np.ndarray, np
     J = np.array([[np.sin(az), r * np.cos(az)], [np.cos(az), -r * np.sin(az)]])
     # G = γ J S_ra Jᵀ
     return np.array([px, py]), gamma * (J @ S[:2, :2] @ J.T)
-
-
-def frame_slices(frames) -> list[np.ndarray]:
-    """Normalise the measurement input to a list of (m_f, 3) arrays [r, az, vr]."""
-    if isinstance(frames, tuple) and len(frames) == 2 and np.ndim(frames[1]) == 1:
-        z, offsets = frames
-        z = np.asarray(z, dtype=np.float64).reshape(-1, 3)
-        offsets = np.asarray(offsets, dtype=np.int64)
-        return [z[offsets[f] : offsets[f + 1]] for f in range(len(offsets) - 1)]
-    out = []
-    for f, z in enumerate(frames):
-        z = np.asarray(z, dtype=np.float64).reshape(-1, 3)
-        if not np.all(np.isfinite(z)):
-            raise InputError(f"measurements of frame {f} contain NaN or Inf")
-        out.append(z)
-    return out
 
 
 def _step(
@@ -261,7 +125,7 @@ def _step(
 
 
 def run_tracker(
-    frames: Sequence[np.ndarray] | tuple[np.ndarray, np.ndarray],
+    frames: Frames,
     params: TrackerParams,
     frame_period_s: float = 0.08,
     *,

@@ -2,7 +2,7 @@
 
 The quick data set (the first five paper:0 trajectories, one per class) is tracked with the
 default CV and CA parameters and with CV against itself. The loss of eq. (14) comes out of two
-independent implementations (core.evaluation and core.model_comparison.loss_breakdown); they
+independent implementations (core.evaluation and core.evaluation.loss_breakdown); they
 must agree, the breakdown's parts must add up, and the paired ratio is the ratio of the totals.
 """
 

@@ -23,6 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from core.dataset import Dataset
+from core.evaluation.loss import NO_CONFIRMATION_LOSS, tracked_person_xy
 
 __all__ = [
     "CATEGORIES",
@@ -140,18 +141,9 @@ def track_with_ids(dataset: Dataset, params) -> tuple:
         (F,) int64 id of the track giving the estimate in each frame (−1: no estimate; ids
         count per trajectory from 0 in order of birth).
     """
-    from core.tracking import track_dataset
-    from core.tracking.batch import _prepare
-    from core.tracking.kernel import track_frames
+    from core.tracking import estimate_track_ids, track_dataset
 
-    est = track_dataset(dataset, params)
-    z, f_off, t_off, period = _prepare(dataset)
-    sel = np.arange(dataset.n_trajectories, dtype=np.int64)
-    rec = track_frames(z, f_off, t_off, sel, params, period, record=True)[-1]
-    ids = np.full(len(rec.estimate), -1, np.int64)
-    rows = np.flatnonzero(rec.estimate >= 0)
-    ids[rows] = rec.ids[rows, rec.estimate[rows]]
-    return est, ids
+    return track_dataset(dataset, params), estimate_track_ids(dataset, params)
 
 
 def _manoeuvring(truth_v: np.ndarray, period_s: float, accel: float, window: int) -> np.ndarray:
@@ -185,7 +177,8 @@ def loss_breakdown(
     Parameters
     ----------
     dataset
-        The tracked data set (truth: person 0).
+        The tracked data set (truth: person 0; frames in which it is absent are not scored,
+        as in :func:`core.evaluation.trajectory_loss`).
     estimates
         :class:`core.tracking.DatasetEstimates` of that data set.
     estimate_ids
@@ -204,8 +197,10 @@ def loss_breakdown(
     -------
     LossBreakdown
     """
-    truth = dataset.truth_xy_m[estimates.frame_index][:, 0, :]  # (F_sel, 2) m
-    truth_v = dataset.truth_v_mps[estimates.frame_index][:, 0, :]  # (F_sel, 2) m/s
+    # person 0, NaN where absent; like the loss, only frames in which it is present are scored
+    truth = tracked_person_xy(dataset.truth_xy_m[estimates.frame_index])  # (F_sel, 2) m
+    truth_v = tracked_person_xy(dataset.truth_v_mps[estimates.frame_index])  # (F_sel, 2) m/s
+    present = np.all(np.isfinite(truth), axis=1)
     off = estimates.offsets
     k_sel = len(estimates.trajectories)
     n_cat = len(CATEGORIES)
@@ -224,13 +219,13 @@ def loss_breakdown(
     }
     for i in range(k_sel):
         s = slice(off[i], off[i + 1])
-        has = np.asarray(estimates.has_estimate[s], dtype=bool)
+        has = np.asarray(estimates.has_estimate[s], dtype=bool) & present[s]
         n = len(has)
         out["n_frames"][i] = n
         n_c = int(has.sum())
         out["n_c"][i] = n_c
         if n_c == 0:
-            out["loss"][i] = 1.0  # SPEC §5: a trajectory that never confirms scores 1 m²
+            out["loss"][i] = NO_CONFIRMATION_LOSS  # SPEC §5: never confirmed scores 1 m²
             continue
         out["first"][i] = int(np.argmax(has))
         e = estimates.estimate_xy[s] - truth[s]  # (N, 2) m

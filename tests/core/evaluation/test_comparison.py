@@ -1,4 +1,4 @@
-"""Loss breakdown and paired comparison (core.model_comparison) against hand-built cases."""
+"""Loss breakdown and paired comparison (core.evaluation) against hand-built cases."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from core.dataset import Dataset
-from core.model_comparison import loss_breakdown, paired_comparison
+from core.evaluation import loss_breakdown, paired_comparison
 
 T = 0.08
 
@@ -146,7 +146,7 @@ def test_paired_comparison_rejects_bad_input() -> None:
 
 
 def test_track_with_ids_matches_track_dataset() -> None:
-    from core.model_comparison import track_with_ids
+    from core.evaluation import track_with_ids
     from core.tracking import TrackerParams, track_dataset
     from core.tracking.synthetic import SyntheticScene, synthetic_dataset
 
@@ -159,3 +159,28 @@ def test_track_with_ids_matches_track_dataset() -> None:
     np.testing.assert_array_equal(est.has_estimate, ref.has_estimate)
     np.testing.assert_array_equal(ids >= 0, ref.has_estimate)
     assert ref.has_estimate.any()
+
+
+def test_breakdown_scores_only_frames_with_the_person_present() -> None:
+    p, v = _walk(turn_at=30)  # no manoeuvre
+    gone = p.copy()
+    gone[20:25] = np.nan  # the person is absent for frames 20–24
+    has = np.ones(30, bool)
+    est = p + [0.01, 0.0]
+    bd = loss_breakdown(_dataset(gone, v), _estimates(est, has), n_transient=5)
+    assert bd.n_c[0] == 25 and bd.sse[0] == pytest.approx(25e-4)
+    assert bd.loss[0] == pytest.approx(25e-4 / 25**2)
+    # the estimate "reappears" at frame 25: a second transient of 5 frames
+    np.testing.assert_array_equal(bd.frames_by_category[0], [10, 0, 15])
+    json.dumps(bd.class_table(), allow_nan=False)
+
+
+def test_breakdown_without_any_person_scores_one() -> None:
+    p, v = _walk()
+    ds = _dataset(p, v)
+    from dataclasses import replace
+
+    nobody = replace(ds, truth_xy_m=np.zeros((30, 0, 2)), truth_v_mps=np.zeros((30, 0, 2)))
+    bd = loss_breakdown(nobody, _estimates(p.copy(), np.ones(30, bool)))
+    assert bd.loss[0] == 1.0 and bd.n_c[0] == 0
+    json.dumps(bd.class_table(), allow_nan=False)

@@ -1,0 +1,52 @@
+"""Evaluation of tracker output against the truth (SPEC §5), one role per module.
+
+- :mod:`~core.evaluation.loss` — the paper's loss L(k) and L_t (eqs. 12–14)
+- :mod:`~core.evaluation.metrics` — OSPA and the far-frame threshold
+- :mod:`~core.evaluation.table` — :func:`evaluate`: the loss table (Table I) and every metric of
+  one run (:class:`Evaluation`)
+- :mod:`~core.evaluation.comparison` — two runs compared: loss breakdown by kind of frame,
+  paired bootstrap ratio and Wilcoxon test
+- :mod:`~core.evaluation.spread` — spread of the person-labelled points around the truth
+"""
+
+from core.evaluation.comparison import (
+    CATEGORIES,
+    LossBreakdown,
+    PairedComparison,
+    loss_breakdown,
+    paired_comparison,
+    track_with_ids,
+)
+from core.evaluation.loss import (
+    CLASSES,
+    NO_CONFIRMATION_LOSS,
+    tracked_person_xy,
+    trajectory_loss,
+    trajectory_losses,
+)
+from core.evaluation.metrics import FAR_DISTANCE_M, OSPA_C_M, OSPA_P, ospa
+from core.evaluation.spread import PointSpread, person_point_spread
+from core.evaluation.table import ClassRow, Evaluation, evaluate
+
+__all__ = [
+    "CATEGORIES",
+    "CLASSES",
+    "FAR_DISTANCE_M",
+    "NO_CONFIRMATION_LOSS",
+    "OSPA_C_M",
+    "OSPA_P",
+    "ClassRow",
+    "Evaluation",
+    "LossBreakdown",
+    "PairedComparison",
+    "PointSpread",
+    "evaluate",
+    "loss_breakdown",
+    "ospa",
+    "paired_comparison",
+    "person_point_spread",
+    "track_with_ids",
+    "tracked_person_xy",
+    "trajectory_loss",
+    "trajectory_losses",
+]
