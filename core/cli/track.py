@@ -25,15 +25,13 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    import json
-    import os
-    import tempfile
     import time
     from pathlib import Path
 
     from core.dataset import Dataset
     from core.errors import InputError
     from core.evaluation import evaluate
+    from core.files import write_json_atomic
     from core.tracking import TrackerParams, track_dataset
 
     if args.params and args.model:
@@ -63,7 +61,6 @@ def run(args: argparse.Namespace) -> int:
     print(ev.format_table())
     if args.out:
         out = Path(args.out)
-        out.parent.mkdir(parents=True, exist_ok=True)
         doc = {
             "data": str(args.data),
             "params": params.to_dict(),
@@ -71,14 +68,6 @@ def run(args: argparse.Namespace) -> int:
             "elapsed_s": elapsed,
             **ev.to_dict(),
         }
-        fd, tmp = tempfile.mkstemp(dir=out.parent, prefix=f".{out.name}.", suffix=".tmp")
-        try:
-            with os.fdopen(fd, "w") as fh:
-                json.dump(doc, fh, indent=2)
-                fh.write("\n")
-            os.replace(tmp, out)
-        except BaseException:
-            Path(tmp).unlink(missing_ok=True)
-            raise
+        write_json_atomic(out, doc)
         print(f"written: {out}")
     return 0
