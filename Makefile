@@ -4,7 +4,7 @@ VENV   ?= .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
 
-.PHONY: run test lint format stability bench clean
+.PHONY: run test lint format stability bench fuzz clean
 
 $(STAMP): pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -25,6 +25,12 @@ format: $(STAMP)
 
 test: lint
 	QT_QPA_PLATFORM=offscreen $(BIN)/python -m pytest
+
+# the long fuzz profile (tests/fuzz): 10 000 generated and mutated input files through the CLI,
+# prints the tally; FUZZ_INPUTS=... to change the count
+FUZZ_INPUTS ?= 10000
+fuzz: $(STAMP)
+	RADARTUNE_FUZZ_INPUTS=$(FUZZ_INPUTS) QT_QPA_PLATFORM=offscreen $(BIN)/python -m pytest tests/fuzz -q
 
 stability: $(STAMP)
 	$(BIN)/radartune stability

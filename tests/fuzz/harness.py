@@ -92,6 +92,14 @@ def run_input(write: Callable[[Path], list[str]], *, label: str) -> list[str]:
         return problems
 
 
+def check(problems: list[str]) -> None:
+    """Fail the example at once in the short profile (Hypothesis then shrinks it); in the long
+    profile only count, so that every input of the budget runs and the tally is complete
+    (``conftest.py`` fails the session if the tally shows any bad outcome)."""
+    if inputs_budget() is None:
+        assert not problems, problems
+
+
 def peak_rss_mb() -> float:
     """Peak resident memory of this process so far, MB (Linux reports kB)."""
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0

@@ -18,7 +18,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from tests.fuzz.conftest import FUZZ_SETTINGS
-from tests.fuzz.harness import run_input
+from tests.fuzz.harness import check, run_input
 
 pytestmark = pytest.mark.fuzz
 
@@ -199,7 +199,7 @@ def simulate(name: str, data: bytes, label: str, extra: dict[str, bytes] | None 
         return ["simulate", "--scene", str(folder / name), "--out", str(out), "--fidelity", "fast"]
 
     problems = run_input(write, label=label)
-    assert not problems, problems
+    check(problems)
 
 
 trajectories = st.one_of(
@@ -298,7 +298,7 @@ def radar(data: bytes, label: str) -> None:
         return ["radar", "--cfg", str(folder / "radar.cfg"), "--json"]
 
     problems = run_input(write, label=label)
-    assert not problems, problems
+    check(problems)
 
 
 cfg_words = st.one_of(
@@ -376,7 +376,7 @@ def track(files: dict[str, Path], params: bytes | None, dataset: bytes | None, l
         return argv
 
     problems = run_input(write, label=label)
-    assert not problems, problems
+    check(problems)
 
 
 PARAM_KEYS = [
