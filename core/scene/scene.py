@@ -20,11 +20,13 @@ from core.limits import (
     MAX_FRAMES,
     MAX_PERSON_FRAMES,
     MAX_PERSONS,
+    MAX_SCATTERER_FRAMES,
     MAX_SIMULATED_SAMPLES,
     MAX_STATIC_REFLECTORS,
 )
 from core.scene.aoi import AOI
-from core.scene.clutter import check_clutter_radar
+from core.scene.body import N_BODY_SCATTERERS
+from core.scene.clutter import check_clutter_radar, expected_clutter_count
 from core.scene.trajectory import (
     TRAJECTORY_CLASSES,
     Trajectory,
@@ -473,6 +475,17 @@ def _parse_scene(data: Any, base_dir: Path) -> Scene:
         raise InputError(
             f"persons x frames = {len(persons)} x {n_frames} exceeds the limit "
             f"{MAX_PERSON_FRAMES} of one scene's work"
+        )
+    scatterers = (
+        sum(N_BODY_SCATTERERS if p.model == "extended" else 1 for p in persons)
+        + len(reflectors)
+        + expected_clutter_count(aoi, density)
+    )
+    if n_frames * scatterers > MAX_SCATTERER_FRAMES:
+        raise InputError(
+            f"frames x scatterers = {n_frames} x {scatterers:.0f} (persons' scatterers, static "
+            f"reflectors and expected clutter points) exceeds the limit {MAX_SCATTERER_FRAMES} "
+            "of one scene's work"
         )
     cube = radar.n_tx * radar.n_rx * radar.n_loops * radar.n_samples
     if n_frames * cube > MAX_SIMULATED_SAMPLES:

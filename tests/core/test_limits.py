@@ -165,3 +165,13 @@ def test_dataset_frames_and_persons() -> None:
 def test_table_lists_every_limit() -> None:
     names = {n for n in dir(limits) if n.isupper() and n != "LIMITS"}
     assert names == set(limits.LIMITS)
+
+
+def test_scatterer_frames() -> None:
+    """frames x (persons' scatterers + reflectors + expected clutter) bounds a scene's work."""
+    n_refl = 999
+    frames = limits.MAX_SCATTERER_FRAMES // (n_refl + 1)
+    refl = [{"x_m": 1.0, "y_m": 2.0}] * n_refl
+    assert scene(static_reflectors=refl, persons=[profile(frames)]).n_frames == frames
+    with pytest.raises(InputError, match=r"frames x scatterers = 101 x 1000"):
+        scene(static_reflectors=refl, persons=[profile(frames + 1)])
