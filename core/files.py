@@ -44,17 +44,44 @@ def atomic_open(path: str | os.PathLike, mode: str = "w") -> Iterator[IO[Any]]:
     if mode not in ("w", "wb"):
         raise ValueError(f"mode must be 'w' or 'wb', got {mode!r}")
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    except (OSError, ValueError) as exc:
+        raise InputError(f"cannot write ({_reason(exc)})", _printable(str(path))) from None
     try:
         with os.fdopen(fd, mode, **({"encoding": "utf-8"} if mode == "w" else {})) as fh:
             yield fh
             fh.flush()
             os.fsync(fh.fileno())
         os.replace(tmp, path)
-    except BaseException:
+    except BaseException as exc:
         Path(tmp).unlink(missing_ok=True)
+        if isinstance(exc, OSError):
+            raise InputError(f"cannot write ({_reason(exc)})", str(path)) from None
         raise
+
+
+def check_output_path(path: str | os.PathLike, *, what: str = "output file") -> Path:
+    """``path`` as a :class:`Path` if a file can be written there (checked before long work):
+    not a folder, its folder a folder (or creatable) and writable; else one line naming it."""
+    path = Path(path)
+    src = _printable(str(path))
+    try:
+        if path.is_dir():
+            raise InputError(f"{what} is a folder", src)
+        parent = path.parent
+        while not parent.exists() and parent != parent.parent:
+            parent = parent.parent
+        if not parent.is_dir():
+            raise InputError(f"cannot write {what}: {parent} is not a folder", src)
+        if not os.access(parent, os.W_OK | os.X_OK):
+            raise InputError(f"cannot write {what}: no permission in {parent}", src)
+    except (OSError, ValueError) as exc:
+        if isinstance(exc, InputError):
+            raise
+        raise InputError(f"cannot write {what} ({_reason(exc)})", src) from None
+    return path
 
 
 def write_text_atomic(path: str | os.PathLike, text: str) -> Path:

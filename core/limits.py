@@ -23,6 +23,10 @@ MAX_NPZ_MEMBERS = 64
 # ---- data sets -----------------------------------------------------------------------------------
 #: Most frames in one data set (the paper's has 35 trajectories of <= 250 frames).
 MAX_DATASET_FRAMES = 200_000
+#: Most trajectories ``radartune dataset`` simulates (the paper's set has 35).
+MAX_DATASET_TRAJECTORIES = 1_000
+#: Most worker processes of one command.
+MAX_JOBS = 256
 #: Frame periods a data set may record, s.
 FRAME_PERIOD_RANGE_S = (1e-4, 10.0)
 
@@ -68,6 +72,8 @@ LIMITS: dict[str, tuple[object, str]] = {
     "MAX_NPZ_ELEMENTS": (MAX_NPZ_ELEMENTS, "elements of all arrays of one .npz"),
     "MAX_NPZ_MEMBERS": (MAX_NPZ_MEMBERS, "arrays in one .npz"),
     "MAX_DATASET_FRAMES": (MAX_DATASET_FRAMES, "frames of one data set"),
+    "MAX_DATASET_TRAJECTORIES": (MAX_DATASET_TRAJECTORIES, "radartune dataset --trajectories"),
+    "MAX_JOBS": (MAX_JOBS, "--jobs of radartune dataset"),
     "FRAME_PERIOD_RANGE_S": (FRAME_PERIOD_RANGE_S, "frame period of a data set, s"),
     "MAX_PERSONS": (MAX_PERSONS, "persons in one scene or data set"),
     "MAX_FRAMES": (MAX_FRAMES, "frames of one trajectory"),

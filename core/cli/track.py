@@ -31,11 +31,13 @@ def run(args: argparse.Namespace) -> int:
     from core.dataset import Dataset
     from core.errors import InputError
     from core.evaluation import evaluate
-    from core.files import write_json_atomic
+    from core.files import check_output_path, write_json_atomic
     from core.tracking import TrackerParams, track_dataset
 
     if args.params and args.model:
         raise InputError("give either --params or --model, not both")
+    if args.out:
+        check_output_path(args.out)
     params = (
         TrackerParams.load(args.params)
         if args.params
@@ -50,6 +52,11 @@ def run(args: argparse.Namespace) -> int:
             raise InputError(
                 f"--trajectories must be comma-separated integers, got {args.trajectories!r}"
             ) from None
+        bad = [t for t in traj if not 0 <= t < ds.n_trajectories]
+        if bad:
+            raise InputError(
+                f"--trajectories must be indices in [0, {ds.n_trajectories}), got {bad}"
+            )
     t0 = time.perf_counter()
     est = track_dataset(ds, params, trajectories=traj, engine=args.engine)
     elapsed = time.perf_counter() - t0

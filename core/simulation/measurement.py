@@ -265,7 +265,7 @@ def chain_false_alarms(
     }
     try:
         write_npz_atomic(path, arrays, compressed=False)  # a reader never sees half a file
-    except OSError:
+    except (OSError, InputError):
         pass  # a read-only cache only costs the recomputation
     return fa
 

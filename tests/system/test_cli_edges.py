@@ -300,3 +300,39 @@ def test_keyboard_interrupt_and_broken_pipe_kept(capsys, monkeypatch) -> None:
     monkeypatch.setattr(radar, "run", interrupt)
     code, _, err = run_cli(capsys, "radar")
     assert code == 130 and err.strip() == "radartune radar: interrupted"
+
+
+# ---- arguments and outputs ---------------------------------------------------------------------
+
+
+def test_unwritable_output_refused_before_the_work(capsys, dataset, tmp_path) -> None:
+    """Before the fix: a FileNotFoundError/IsADirectoryError traceback after simulating."""
+    scene = tmp_path / "s.json"
+    scene.write_text(json.dumps(SCENE))
+    code, _, err = run_cli(capsys, "simulate", "--scene", str(scene), "--out", str(tmp_path))
+    assert_one_line(code, err, "is a folder")
+    (tmp_path / "file").write_text("x")
+    out = str(tmp_path / "file" / "o.json")
+    code, _, err = run_cli(capsys, "track", "--data", str(dataset), "--out", out)
+    assert_one_line(code, err, "is not a folder")
+
+
+@pytest.mark.parametrize(
+    ("argv", "needle"),
+    [
+        (["dataset", "--out", "x.npz", "--trajectories", "100000000"], "--trajectories must be in"),
+        (["dataset", "--out", "x.npz", "--jobs", "100000"], "--jobs must be in"),
+        (["stability", "--frames", "1000000000"], "--frames must be in"),
+    ],
+)
+def test_argument_limits(capsys, tmp_path, monkeypatch, argv, needle) -> None:
+    monkeypatch.chdir(tmp_path)
+    code, _, err = run_cli(capsys, *argv)
+    assert_one_line(code, err, needle)
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_track_trajectory_index_overflow(capsys, dataset) -> None:
+    """Before the fix: OverflowError converting the index to int64."""
+    code, _, err = run_cli(capsys, "track", "--data", str(dataset), "--trajectories", "9" * 25)
+    assert_one_line(code, err, "--trajectories must be indices in [0, 1)")
