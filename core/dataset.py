@@ -248,10 +248,9 @@ class Dataset:
             kw[k] = _typed(data[k], k, src)
         for k in ("scene_json", "radar_json", *(("fidelity",) if "fidelity" in data else ())):
             kw[k] = _text(data[k], k, src)
-        for k in ("scene_json", "radar_json"):
-            if kw[k]:
-                parse_json(kw[k], f"{src} ({k})")
-        radar = parse_json(kw["radar_json"], src) if kw["radar_json"] else {}
+        if kw["scene_json"]:
+            parse_json(kw["scene_json"], f"{src} (scene_json)")
+        radar = parse_json(kw["radar_json"], f"{src} (radar_json)") if kw["radar_json"] else {}
         if isinstance(radar, dict) and "frame_period_s" in radar:
             t = radar["frame_period_s"]
             lo, hi = FRAME_PERIOD_RANGE_S

@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import tempfile
 import zipfile
 import zlib
@@ -187,7 +188,7 @@ def parse_json(
         raise InputError(str(exc), source) from None
     except RecursionError:  # the depth scan makes this unreachable; kept as a last guard
         raise InputError(f"{what} is nested too deeply", source) from None
-    bad = _bad_string(data)
+    bad = _bad_string(data) if _may_hold_bad_string(text) else None
     if bad is not None:
         raise InputError(f"{what} {bad}", source)
     return data
@@ -197,30 +198,40 @@ class _JsonRefusal(ValueError):
     pass
 
 
+_JSON_STRING = re.compile(r'"(?:[^"\\]|\\.)*"', re.DOTALL)
+_NOT_BRACKET_OR_NEWLINE = re.compile(r"[^\[\]{}\n]+")
+
+
 def _check_depth(text: str, source: str, max_depth: int) -> None:
-    """Refuse brackets nested deeper than ``max_depth`` (outside strings), without recursion."""
-    depth = 0
-    in_string = False
-    escaped = False
-    line = 1
-    for ch in text:
-        if in_string:
-            if escaped:
-                escaped = False
-            elif ch == "\\":
-                escaped = True
-            elif ch == '"':
-                in_string = False
-        elif ch == '"':
-            in_string = True
-        elif ch in "[{":
-            depth += 1
-            if depth > max_depth:
-                raise InputError(f"JSON nested deeper than {max_depth} levels", f"{source}:{line}")
-        elif ch in "]}":
-            depth -= 1
-        if ch == "\n":
-            line += 1
+    """Refuse brackets nested deeper than ``max_depth`` outside strings, without recursion:
+    strings are blanked and everything but brackets and newlines dropped (regular expressions),
+    then the depth is a cumulative sum over the brackets."""
+    kept = _NOT_BRACKET_OR_NEWLINE.sub("", _JSON_STRING.sub('""', text)).encode("ascii")
+    chars = np.frombuffer(kept, dtype=np.uint8)
+    step = np.zeros(len(chars), dtype=np.int64)
+    step[(chars == ord("[")) | (chars == ord("{"))] = 1
+    step[(chars == ord("]")) | (chars == ord("}"))] = -1
+    depth = np.cumsum(step)
+    too_deep = np.flatnonzero(depth > max_depth)
+    if len(too_deep):
+        line = int(np.count_nonzero(chars[: too_deep[0]] == ord("\n"))) + 1
+        raise InputError(f"JSON nested deeper than {max_depth} levels", f"{source}:{line}")
+
+
+_NUL_OR_SURROGATE_ESCAPE = re.compile(r"\\u(?:0000|d[89a-f][0-9a-f]{2})", re.IGNORECASE)
+
+
+def _may_hold_bad_string(text: str) -> bool:
+    """False when no parsed string can hold a NUL or a lone surrogate: JSON allows neither raw
+    (control characters are invalid in strings; decoded UTF-8 has no surrogates), so only their
+    ``\\u`` escapes or surrogates already in ``text`` can bring them (walk the data then)."""
+    if _NUL_OR_SURROGATE_ESCAPE.search(text):
+        return True
+    try:
+        text.encode("utf-8")
+    except UnicodeEncodeError:
+        return True
+    return False
 
 
 def _bad_string(data: Any, where: str = "") -> str | None:
