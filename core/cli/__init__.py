@@ -14,6 +14,7 @@ import argparse
 import importlib
 import sys
 import traceback
+from typing import NoReturn
 
 from core.errors import InputError
 
@@ -35,8 +36,17 @@ COMMANDS = {
 EXIT_INPUT_ERROR = 2
 
 
+class OneLineParser(argparse.ArgumentParser):
+    """An argument parser whose usage errors are one line on stderr (exit 2), like every other
+    bad input; ``--help`` still prints the full usage."""
+
+    def error(self, message: str) -> NoReturn:
+        line = " ".join(f"{self.prog}: error: {message} (see {self.prog} --help)".split())
+        self.exit(EXIT_INPUT_ERROR, line + "\n")
+
+
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+    parser = OneLineParser(
         prog="radartune",
         description="FMCW radar simulation, IPDA people tracking and Optuna parameter tuning.",
     )

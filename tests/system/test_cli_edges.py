@@ -336,3 +336,14 @@ def test_track_trajectory_index_overflow(capsys, dataset) -> None:
     """Before the fix: OverflowError converting the index to int64."""
     code, _, err = run_cli(capsys, "track", "--data", str(dataset), "--trajectories", "9" * 25)
     assert_one_line(code, err, "--trajectories must be indices in [0, 1)")
+
+
+@pytest.mark.parametrize(
+    "argv", [["dashboard", "--port", "abc"], ["track"], ["bogus"], ["simulate", "--scene"]]
+)
+def test_usage_errors_are_one_line(capsys, argv) -> None:
+    """argparse printed the usage and then the error: two lines or more before the fix."""
+    with pytest.raises(SystemExit) as exc:
+        main(argv)
+    err = capsys.readouterr().err
+    assert exc.value.code == 2 and len(err.splitlines()) == 1 and "--help" in err, err
