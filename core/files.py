@@ -49,7 +49,7 @@ def atomic_open(path: str | os.PathLike, mode: str = "w") -> Iterator[IO[Any]]:
         path.parent.mkdir(parents=True, exist_ok=True)
         fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
     except (OSError, ValueError) as exc:
-        raise InputError(f"cannot write ({_reason(exc)})", _printable(str(path))) from None
+        raise InputError(f"cannot write ({_reason(exc)})", printable(str(path))) from None
     try:
         encoding = "utf-8" if mode == "w" else None
         with os.fdopen(fd, mode, encoding=encoding) as fh:
@@ -68,7 +68,7 @@ def check_output_path(path: str | os.PathLike, *, what: str = "output file") -> 
     """``path`` as a :class:`Path` if a file can be written there (checked before long work):
     not a folder, its folder a folder (or creatable) and writable; else one line naming it."""
     path = Path(path)
-    src = _printable(str(path))
+    src = printable(str(path))
     try:
         if path.is_dir():
             raise InputError(f"{what} is a folder", src)
@@ -134,7 +134,7 @@ def read_bytes(
     except IsADirectoryError:
         raise InputError(f"{what} is a directory", src) from None
     except (OSError, ValueError) as exc:  # ValueError: embedded NUL in the path
-        raise InputError(f"cannot read {what} ({_reason(exc)})", _printable(src)) from None
+        raise InputError(f"cannot read {what} ({_reason(exc)})", printable(src)) from None
     if len(data) > limit:
         raise InputError(f"{what} is more than the limit of {limit} bytes", src)
     return data
@@ -248,7 +248,8 @@ def _bad_string(data: Any, where: str = "") -> str | None:
                 why = _string_problem(k)
                 if why:
                     return f"{at or 'object'}: key {why}"
-                stack.append((v, f"{at}.{k}" if at else k))
+                key = printable(k)
+                stack.append((v, f"{at}.{key}" if at else key))
         elif isinstance(obj, list):
             stack.extend((v, f"{at}[{i}]") for i, v in enumerate(obj))
     return None
@@ -296,7 +297,7 @@ def read_npz(
     except FileNotFoundError:
         raise InputError("file not found", src) from None
     except (OSError, ValueError) as exc:
-        raise InputError(f"cannot read {what} ({_reason(exc)})", _printable(src)) from None
+        raise InputError(f"cannot read {what} ({_reason(exc)})", printable(src)) from None
     if size == 0:
         raise InputError(f"cannot read {what}: the file is empty (0 bytes)", src)
     if size > MAX_INPUT_BYTES:
@@ -366,12 +367,17 @@ def _npy_data(
 
 def _reason(exc: BaseException) -> str:
     text = getattr(exc, "strerror", None) or str(exc) or type(exc).__name__
-    return _printable(text.splitlines()[0] if text else type(exc).__name__)
+    return printable(text.splitlines()[0] if text else type(exc).__name__)
 
 
-def _printable(text: str) -> str:
-    """``text`` with NULs, control characters and lone surrogates escaped (safe to print)."""
+def printable(text: str) -> str:
+    """``text`` as one printable line: control characters, line separators and lone surrogates
+    escaped (``\\x0a``, ``\\u2028``, ``\\udc80``), so that an error naming it stays one line."""
     return text.encode("utf-8", "backslashreplace").decode("utf-8").translate(_CONTROL_ESCAPES)
 
 
-_CONTROL_ESCAPES = {c: f"\\x{c:02x}" for c in (*range(0x20), 0x7F)}
+_CONTROL_ESCAPES = {
+    **{c: f"\\x{c:02x}" for c in (*range(0x20), *range(0x7F, 0xA0))},
+    0x2028: "\\u2028",
+    0x2029: "\\u2029",
+}

@@ -108,8 +108,9 @@ def _input_files(args: argparse.Namespace) -> list[str]:
 
 def _error_line(args: argparse.Namespace, message: str) -> None:
     """Print ``message`` as exactly one line on stderr, safe for any terminal encoding."""
-    line = " ".join(f"radartune {args.command}: error: {message}".split("\n"))
-    line = line.replace("\r", " ").encode("utf-8", "backslashreplace").decode("utf-8")
+    from core.files import printable
+
+    line = printable(f"radartune {args.command}: error: {message}")
     try:
         print(line, file=sys.stderr)
     except UnicodeEncodeError:

@@ -207,3 +207,11 @@ def test_encrypted_flag_is_refused(tmp_path: Path) -> None:
     (tmp_path / "enc.npz").write_bytes(bytes(data))
     with pytest.raises(InputError, match=r"enc.npz: cannot read data set: corrupt .npz"):
         read_npz(tmp_path / "enc.npz")
+
+
+def test_key_with_line_breaks_stays_one_line() -> None:
+    """Found by the long fuzz run: a key with control characters and a NUL below it."""
+    with pytest.raises(InputError) as err:
+        parse_json('{"a\\n\\u2028b\\r": {"c": "\\u0000"}}', "x.json")
+    assert len(str(err.value).splitlines()) == 1
+    assert "a\\x0a\\u2028b\\x0d.c: string holds a NUL" in str(err.value)
