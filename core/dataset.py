@@ -112,6 +112,12 @@ class Dataset:
             a = getattr(self, name)
             if np.any(np.isinf(a)):  # NaN marks a person absent from a frame
                 raise ValueError(f"Dataset.{name} must be finite or NaN (absent), got infinity")
+        absent = np.isnan(self.truth_xy_m)
+        if np.any(absent != absent[..., :1]) or np.any(np.isnan(self.truth_v_mps) != absent):
+            raise ValueError(
+                "Dataset.truth_xy_m and truth_v_mps must be NaN together (a person absent from "
+                "a frame has neither position nor velocity)"
+            )
 
     # ---- derived -----------------------------------------------------------------------------
     @property

@@ -133,6 +133,7 @@ def test_dataset_flipped_bytes(capsys, dataset: Path, tmp_path: Path) -> None:
         ({"trajectory_class": np.array([1, 2])}, "trajectory_class"),
         ({"frame": np.array(["x"])}, "frame"),
         ({"truth_t_s": np.full(6, np.inf)}, "truth_t_s"),
+        ({"truth_xy_m": np.array([[[1.0, np.nan]]] * 6)}, "NaN together"),
         ({"scene_json": np.array("[" * 5000)}, "nested deeper"),
         ({"radar_json": np.array('{"frame_period_s": 1e300}')}, "frame_period_s"),
         ({"seed": np.array([1, 2])}, "seed"),
