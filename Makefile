@@ -4,7 +4,7 @@ VENV   ?= .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
 
-.PHONY: run test lint contracts typecheck format stability bench clean
+.PHONY: run test lint contracts typecheck format stability bench fuzz clean
 
 $(STAMP): pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -33,6 +33,12 @@ format: $(STAMP)
 
 test: lint contracts typecheck
 	QT_QPA_PLATFORM=offscreen $(BIN)/python -m pytest
+
+# the long fuzz profile (tests/fuzz): 10 000 generated and mutated input files through the CLI,
+# prints the tally; FUZZ_INPUTS=... to change the count
+FUZZ_INPUTS ?= 10000
+fuzz: $(STAMP)
+	RADARTUNE_FUZZ_INPUTS=$(FUZZ_INPUTS) QT_QPA_PLATFORM=offscreen $(BIN)/python -m pytest tests/fuzz -q
 
 stability: $(STAMP)
 	$(BIN)/radartune stability

@@ -17,6 +17,7 @@ from PySide6 import QtCore
 from app.data import FrameData, ParamSpec, TrackingResult
 from core.config import PAPER_RADAR, RadarConfig
 from core.errors import InputError
+from core.files import read_json, write_json_atomic
 
 
 class RadarModel(QtCore.QObject):
@@ -136,14 +137,7 @@ class SceneModel(QtCore.QObject):
     def load(self, path: str | Path) -> None:
         """Load a scene file; a malformed file raises :class:`InputError`, the scene stays."""
         path = Path(path)
-        try:
-            text = path.read_text()
-        except OSError as exc:
-            raise InputError(f"cannot read scene ({exc.strerror})", str(path)) from None
-        try:
-            doc = json.loads(text)
-        except json.JSONDecodeError as exc:
-            raise InputError(f"invalid JSON at line {exc.lineno}: {exc.msg}", str(path)) from None
+        doc = read_json(path, what="scene file")
         if not isinstance(doc, dict):
             raise InputError("a scene file must hold a JSON object", str(path))
         self.set_document(doc, base_dir=path.parent, source=str(path))
@@ -152,12 +146,9 @@ class SceneModel(QtCore.QObject):
     def save(self, path: str | Path) -> None:
         """Write the document atomically (temporary file, then rename)."""
         path = Path(path)
-        tmp = path.with_name(f".{path.name}.tmp")
         try:
-            tmp.write_text(json.dumps(self._doc, indent=2) + "\n")
-            tmp.replace(path)
+            write_json_atomic(path, self._doc)
         except OSError as exc:
-            tmp.unlink(missing_ok=True)
             raise InputError(f"cannot write scene ({exc.strerror})", str(path)) from None
         self._path = path
 

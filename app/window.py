@@ -286,7 +286,9 @@ class MainWindow(QtWidgets.QMainWindow):
 
     def load_params(self, path: str | Path) -> bool:
         try:
-            data = json.loads(Path(path).read_text())
+            from core.files import read_json
+
+            data = read_json(path, what="parameter file")
             from core.optimization import flat_params
 
             model = data.get("model", "cv") if isinstance(data, dict) else "cv"

@@ -9,6 +9,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from core.errors import InputError
+from core.files import read_text, write_text_atomic
+from core.limits import MAX_CUBE_SAMPLES
 
 SPEED_OF_LIGHT_MPS = 299_792_458.0
 BOLTZMANN_J_PER_K = 1.380649e-23
@@ -82,6 +84,12 @@ class RadarConfig:
                     f"{name} must have n_tx*n_rx={n_virtual} entries, "
                     f"got {len(getattr(self, name))}"
                 )
+        cube = n_virtual * self.n_loops * self.n_samples
+        if cube > MAX_CUBE_SAMPLES:
+            raise InputError(
+                f"n_tx*n_rx*n_loops*n_samples = {cube} samples a frame exceeds the limit "
+                f"{MAX_CUBE_SAMPLES}"
+            )
         if self.chirp_period_s * self.n_tx * self.n_loops > self.frame_period_s:
             raise InputError(
                 "frame_period_s is shorter than the chirps of one frame "
@@ -587,10 +595,7 @@ def read_ti_cfg(path: str | os.PathLike) -> RadarConfig:
         Naming the file, line number and field of a malformed known command.
     """
     p = Path(path)
-    try:
-        text = p.read_text()
-    except (OSError, UnicodeDecodeError) as exc:
-        raise InputError(f"cannot read TI configuration: {exc}", str(p)) from None
+    text = read_text(p, what="TI configuration")
     return radar_from_ti_commands(parse_ti_cfg(text, str(p)), str(p), name=p.stem)
 
 
@@ -646,10 +651,7 @@ def ti_cfg_text(radar: RadarConfig, comment: str = "") -> str:
 
 def write_ti_cfg(radar: RadarConfig, path: str | os.PathLike, comment: str = "") -> None:
     """Write ``radar`` as a TI ``.cfg`` file (atomically: temporary name, then rename)."""
-    p = Path(path)
-    tmp = p.with_name(p.name + ".tmp")
-    tmp.write_text(ti_cfg_text(radar, comment))
-    tmp.replace(p)
+    write_text_atomic(path, ti_cfg_text(radar, comment))
 
 
 #: The SPEC §3 processing defaults (module-level singleton for argument defaults).

@@ -8,14 +8,14 @@ from __future__ import annotations
 
 import json
 import os
-import tempfile
-import zipfile
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from core.errors import InputError
+from core.files import check_text_field, parse_json, read_npz, write_npz_atomic
+from core.limits import FRAME_PERIOD_RANGE_S, MAX_DATASET_FRAMES, MAX_PERSONS
 from core.pointcloud import POINT_FIELDS, PointCloud
 
 PER_POINT = ("frame", *POINT_FIELDS, "source")
@@ -57,17 +57,67 @@ class Dataset:
     seed: int = 0
 
     def __post_init__(self) -> None:
-        p = len(self.frame)
+        p = np.shape(self.frame)[0] if np.ndim(self.frame) == 1 else -1
         for name in PER_POINT:
             if np.shape(getattr(self, name)) != (p,):
-                raise ValueError(f"Dataset.{name} must have shape ({p},)")
+                raise ValueError(
+                    f"Dataset.{name} must have shape (P,) like frame, got "
+                    f"{np.shape(getattr(self, name))}"
+                )
+        if np.ndim(self.trajectory) != 1:
+            raise ValueError(
+                f"Dataset.trajectory must have shape (F,), got {np.shape(self.trajectory)}"
+            )
         f = len(self.trajectory)
-        if self.truth_xy_m.ndim != 3 or self.truth_xy_m.shape[0] != f:
-            raise ValueError("Dataset.truth_xy_m must have shape (F, n_persons, 2)")
+        if np.shape(self.truth_t_s) != (f,):
+            raise ValueError(
+                f"Dataset.truth_t_s must have shape ({f},), got {np.shape(self.truth_t_s)}"
+            )
+        for name in ("truth_xy_m", "truth_v_mps"):
+            shape = np.shape(getattr(self, name))
+            if len(shape) != 3 or shape[0] != f or shape[2] != 2:
+                raise ValueError(f"Dataset.{name} must have shape ({f}, n_persons, 2), got {shape}")
+        if np.shape(self.truth_v_mps) != np.shape(self.truth_xy_m):
+            raise ValueError("Dataset.truth_v_mps must have the shape of truth_xy_m")
+        if self.truth_xy_m.shape[1] > MAX_PERSONS:
+            raise ValueError(
+                f"Dataset has {self.truth_xy_m.shape[1]} persons, more than the limit {MAX_PERSONS}"
+            )
+        if f > MAX_DATASET_FRAMES:
+            raise ValueError(f"Dataset has {f} frames, more than the limit {MAX_DATASET_FRAMES}")
         if p and np.any(np.diff(self.frame) < 0):
             raise ValueError("Dataset.frame must be sorted")
+        if p and not (0 <= self.frame[0] and self.frame[-1] < f):
+            raise ValueError(
+                f"Dataset.frame must index the {f} frames, got {self.frame[0]}..{self.frame[-1]}"
+            )
         if f and np.any(np.diff(self.trajectory) < 0):
             raise ValueError("Dataset.trajectory must be non-decreasing")
+        k = len(self.trajectory_class)
+        if np.ndim(self.trajectory_class) != 1:
+            raise ValueError("Dataset.trajectory_class must have shape (K,)")
+        if f and not (self.trajectory[0] == 0 and self.trajectory[-1] == k - 1):
+            raise ValueError(
+                f"Dataset.trajectory must number the {k} trajectories of trajectory_class "
+                f"0..{k - 1}, got {self.trajectory[0]}..{self.trajectory[-1]}"
+            )
+        if f and np.any(np.diff(self.trajectory) > 1):
+            raise ValueError("Dataset.trajectory skips a trajectory (a step > 1)")
+        if not f and k:
+            raise ValueError(f"Dataset has no frames but {k} trajectory classes")
+        for name in (*POINT_FIELDS, "truth_t_s"):
+            if not np.all(np.isfinite(getattr(self, name))):
+                raise ValueError(f"Dataset.{name} must be finite")
+        for name in ("truth_xy_m", "truth_v_mps"):
+            a = getattr(self, name)
+            if np.any(np.isinf(a)):  # NaN marks a person absent from a frame
+                raise ValueError(f"Dataset.{name} must be finite or NaN (absent), got infinity")
+        absent = np.isnan(self.truth_xy_m)
+        if np.any(absent != absent[..., :1]) or np.any(np.isnan(self.truth_v_mps) != absent):
+            raise ValueError(
+                "Dataset.truth_xy_m and truth_v_mps must be NaN together (a person absent from "
+                "a frame has neither position nor velocity)"
+            )
 
     # ---- derived -----------------------------------------------------------------------------
     @property
@@ -188,41 +238,65 @@ class Dataset:
         arrays["radar_json"] = np.array(self.radar_json)
         arrays["fidelity"] = np.array(self.fidelity)
         arrays["seed"] = np.array(self.seed)
-        fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-        try:
-            with os.fdopen(fd, "wb") as fh:
-                np.savez_compressed(fh, **arrays)
-            os.replace(tmp, path)
-        except BaseException:
-            Path(tmp).unlink(missing_ok=True)
-            raise
+        write_npz_atomic(path, arrays)
         return path
 
     @classmethod
     def load(cls, path: str | os.PathLike) -> Dataset:
         """Read a data set; a missing or malformed file is an :class:`InputError` naming it."""
-        path = Path(path)
-        try:
-            with np.load(path, allow_pickle=False) as data:
-                missing = [k for k in REQUIRED if k not in data.files]
-                if missing:
-                    raise InputError(
-                        f"not a RadarTune data set: missing arrays {missing}", str(path)
-                    )
-                kw = {k: data[k] for k in (*PER_POINT, *PER_FRAME, "trajectory_class")}
-                kw["scene_json"] = str(data["scene_json"])
-                kw["radar_json"] = str(data["radar_json"])
-                if "fidelity" in data.files:
-                    kw["fidelity"] = str(data["fidelity"])
-                if "seed" in data.files:
-                    kw["seed"] = int(data["seed"])
-        except FileNotFoundError:
-            raise InputError("file not found", str(path)) from None
-        except (OSError, ValueError, zipfile.BadZipFile) as exc:
-            if isinstance(exc, InputError):
-                raise
-            raise InputError(f"cannot read data set ({exc})", str(path)) from None
+        src = str(path)
+        data = read_npz(path, what="data set")
+        missing = [k for k in REQUIRED if k not in data]
+        if missing:
+            raise InputError(f"not a RadarTune data set: missing arrays {missing}", src)
+        kw: dict = {}
+        for k in (*PER_POINT, *PER_FRAME, "trajectory_class"):
+            kw[k] = _typed(data[k], k, src)
+        for k in ("scene_json", "radar_json", *(("fidelity",) if "fidelity" in data else ())):
+            kw[k] = _text(data[k], k, src)
+        if kw["scene_json"]:
+            parse_json(kw["scene_json"], f"{src} (scene_json)")
+        radar = parse_json(kw["radar_json"], f"{src} (radar_json)") if kw["radar_json"] else {}
+        if isinstance(radar, dict) and "frame_period_s" in radar:
+            t = radar["frame_period_s"]
+            lo, hi = FRAME_PERIOD_RANGE_S
+            if isinstance(t, bool) or not isinstance(t, int | float) or not lo <= t <= hi:
+                raise InputError(
+                    f"radar_json frame_period_s must be in [{lo:g}, {hi:g}] s, got {t!r}", src
+                )
+        if "seed" in data:
+            seed = data["seed"]
+            if seed.shape != () or seed.dtype.kind not in "iu" or int(seed) < 0:
+                raise InputError(f"seed must be one integer >= 0, got {seed!r}", src)
+            kw["seed"] = int(seed)
         try:
             return cls(**kw)
         except ValueError as exc:
-            raise InputError(str(exc), str(path)) from None
+            raise InputError(str(exc), src) from None
+
+
+#: dtype kinds accepted per array: integers for indices, real numbers for values, text for class.
+_INTEGER_ARRAYS = ("frame", "source", "trajectory")
+
+
+def _typed(a: np.ndarray, name: str, src: str) -> np.ndarray:
+    """``a`` checked for the kind of values array ``name`` holds."""
+    if name == "trajectory_class":
+        if a.dtype.kind != "U" or a.ndim != 1:
+            raise InputError(
+                f"trajectory_class must be a 1-D text array, got {a.dtype} {a.shape}", src
+            )
+        return a
+    if name in _INTEGER_ARRAYS:
+        if a.dtype.kind not in "iu":
+            raise InputError(f"{name} must hold integers, got dtype {a.dtype}", src)
+        return a
+    if a.dtype.kind not in "iuf":
+        raise InputError(f"{name} must hold real numbers, got dtype {a.dtype}", src)
+    return a
+
+
+def _text(a: np.ndarray, name: str, src: str) -> str:
+    if a.shape != () or a.dtype.kind != "U":
+        raise InputError(f"{name} must be one text value, got {a.dtype} {a.shape}", src)
+    return check_text_field(str(a), name)

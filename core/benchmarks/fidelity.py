@@ -33,6 +33,8 @@ from typing import Any
 
 import numpy as np
 
+from core.files import write_text_atomic
+
 #: trajectories per class (a-e) in the full and the quick run (7: the paper's whole set of 35)
 PER_CLASS = 7
 PER_CLASS_QUICK = 1
@@ -715,9 +717,7 @@ def _write_table(result: dict, path: Path) -> None:
         + _loss_table(result)
         + "\n"
     )
-    tmp = path.with_suffix(path.suffix + ".tmp")
-    tmp.write_text(text)
-    tmp.replace(path)
+    write_text_atomic(path, text)
 
 
 def _plot(result: dict, path: Path) -> None:

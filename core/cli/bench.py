@@ -11,9 +11,10 @@ from __future__ import annotations
 import argparse
 import datetime as dt
 import importlib
-import json
 import platform
 from pathlib import Path
+
+from core.files import write_json_atomic
 
 BENCHMARKS = ("sim", "track", "tune", "fidelity", "dataset", "false_alarms", "cvca")
 #: not part of ``all``: hours of studies (16 x 1000 trials)
@@ -64,9 +65,7 @@ def run(args: argparse.Namespace) -> int:
         }
         # a quick run never overwrites the full run's figures
         path = out_dir / f"{name}{'-quick' if args.quick else ''}.json"
-        tmp = path.with_suffix(".json.tmp")
-        tmp.write_text(json.dumps(result, indent=2) + "\n")
-        tmp.replace(path)
+        write_json_atomic(path, result)
         print(module.summary(result))
         print(f"written: {path}")
     return 0

@@ -19,8 +19,14 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from core.errors import InputError
+    from core.limits import PORT_RANGE
     from core.optimization.dashboard import serve_dashboard
 
+    if not PORT_RANGE[0] <= args.port <= PORT_RANGE[1]:
+        raise InputError(
+            f"--port must be in [{PORT_RANGE[0]}, {PORT_RANGE[1]}] (0: any free port), "
+            f"got {args.port}"
+        )
     try:
         server = serve_dashboard(args.storage, port=args.port)
     except OSError as exc:

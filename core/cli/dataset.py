@@ -34,15 +34,20 @@ def run(args: argparse.Namespace) -> int:
 
     from core.cli.progress import ProgressBar
     from core.errors import InputError
+    from core.files import check_output_path
+    from core.limits import MAX_DATASET_TRAJECTORIES, MAX_JOBS
     from core.pipeline import paper_dataset
 
     t0 = time.perf_counter()
     if args.seed < 0:
         raise InputError(f"--seed must be >= 0, got {args.seed}")
-    if args.trajectories < 1:
-        raise InputError(f"--trajectories must be >= 1, got {args.trajectories}")
-    if args.jobs is not None and args.jobs < 1:
-        raise InputError(f"--jobs must be >= 1, got {args.jobs}")
+    if not 1 <= args.trajectories <= MAX_DATASET_TRAJECTORIES:
+        raise InputError(
+            f"--trajectories must be in [1, {MAX_DATASET_TRAJECTORIES}], got {args.trajectories}"
+        )
+    if args.jobs is not None and not 1 <= args.jobs <= MAX_JOBS:
+        raise InputError(f"--jobs must be in [1, {MAX_JOBS}], got {args.jobs}")
+    check_output_path(args.out, what="data set")
     from core.scene.scene import PERSON_MODELS
 
     if args.person_model not in PERSON_MODELS:

@@ -1,4 +1,5 @@
-"""Exit codes of ``radartune tune`` and ``radartune worker``: the one definition.
+"""Exit codes of ``radartune``: the one definition (every command uses 0, 2 and 130; ``tune``
+adds 3).
 
 The values follow the shell's conventions: 0 success, 2 bad input (argparse uses 2 for a bad
 command line too), 128 + 2 = 130 for an interrupt by Ctrl-C (SIGINT). Code 3 is ours: the study

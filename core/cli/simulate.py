@@ -30,6 +30,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     from core.cli.progress import ProgressBar
     from core.errors import InputError
+    from core.files import check_output_path
     from core.pipeline import plan, simulate_scene
     from core.scene import Scene
 
@@ -44,6 +45,7 @@ def run(args: argparse.Namespace) -> int:
         if args.explain:
             return 0
         raise InputError("--out FILE is required (or use --explain alone)")
+    check_output_path(args.out, what="data set")
     run_ = simulate_scene(
         scene, seed=args.seed, the_plan=the_plan, progress=ProgressBar("simulate")
     )

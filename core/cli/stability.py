@@ -26,10 +26,11 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from core.errors import InputError
+    from core.limits import MAX_FRAMES
     from core.tracking.stability import all_corners, stability_scene, sweep
 
-    if args.frames < 2 or args.ca_corners < 1:
-        raise InputError("--frames must be >= 2 and --ca-corners >= 1")
+    if not 2 <= args.frames <= MAX_FRAMES or args.ca_corners < 1:
+        raise InputError(f"--frames must be in [2, {MAX_FRAMES}] and --ca-corners >= 1")
     ds = stability_scene(args.frames, args.seed)
     plans = [
         ("cv", all_corners("cv", 256 if args.quick else None, args.seed)),

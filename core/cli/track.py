@@ -25,19 +25,19 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    import json
-    import os
-    import tempfile
     import time
     from pathlib import Path
 
     from core.dataset import Dataset
     from core.errors import InputError
     from core.evaluation import evaluate
+    from core.files import check_output_path, write_json_atomic
     from core.tracking import TrackerParams, track_dataset
 
     if args.params and args.model:
         raise InputError("give either --params or --model, not both")
+    if args.out:
+        check_output_path(args.out)
     params = (
         TrackerParams.load(args.params)
         if args.params
@@ -52,6 +52,11 @@ def run(args: argparse.Namespace) -> int:
             raise InputError(
                 f"--trajectories must be comma-separated integers, got {args.trajectories!r}"
             ) from None
+        bad = [t for t in traj if not 0 <= t < ds.n_trajectories]
+        if bad:
+            raise InputError(
+                f"--trajectories must be indices in [0, {ds.n_trajectories}), got {bad}"
+            )
     t0 = time.perf_counter()
     est = track_dataset(ds, params, trajectories=traj, engine=args.engine)
     elapsed = time.perf_counter() - t0
@@ -63,7 +68,6 @@ def run(args: argparse.Namespace) -> int:
     print(ev.format_table())
     if args.out:
         out = Path(args.out)
-        out.parent.mkdir(parents=True, exist_ok=True)
         doc = {
             "data": str(args.data),
             "params": params.to_dict(),
@@ -71,14 +75,6 @@ def run(args: argparse.Namespace) -> int:
             "elapsed_s": elapsed,
             **ev.to_dict(),
         }
-        fd, tmp = tempfile.mkstemp(dir=out.parent, prefix=f".{out.name}.", suffix=".tmp")
-        try:
-            with os.fdopen(fd, "w") as fh:
-                json.dump(doc, fh, indent=2)
-                fh.write("\n")
-            os.replace(tmp, out)
-        except BaseException:
-            Path(tmp).unlink(missing_ok=True)
-            raise
+        write_json_atomic(out, doc)
         print(f"written: {out}")
     return 0

@@ -30,6 +30,7 @@ from typing import Any
 import numpy as np
 
 from core.errors import InputError
+from core.files import write_json_atomic, write_text_atomic
 from core.optimization.storage import open_storage, redact
 from core.optimization.study import TrialSummary, study_progress
 
@@ -118,12 +119,6 @@ def main_study(studies: Sequence[StudyRecord], model: str) -> StudyRecord | None
     if not mine:
         return None
     return min(mine, key=lambda s: (s.best.value, s.name))
-
-
-def _write_text(path: Path, text: str) -> None:
-    tmp = path.with_name(f".{path.name}.tmp")
-    tmp.write_text(text)
-    os.replace(tmp, path)
 
 
 def _save_fig(fig: Any, path: Path) -> None:
@@ -319,7 +314,7 @@ def write_report(
         if other is not None:
             entry["generalisation"] = evaluate_params(other, params)[1].to_dict()
         result["models"][model] = entry
-        _write_text(out / f"best_{model}.json", json.dumps(params, indent=2) + "\n")
+        write_json_atomic(out / f"best_{model}.json", params)
     for s in sorted(studies, key=lambda s: (s.model, s.sampler, s.pruner, s.name)):
         states = [t.state for t in s.trials]
         b = s.best
@@ -353,8 +348,8 @@ def write_report(
             "cv_over_ca": cv / ca,
             "cv_not_worse_than_ca_by_more_than_5_percent": bool(cv <= (1 + CV_TOLERANCE) * ca),
         }
-    _write_text(out / "report.json", json.dumps(result, indent=2) + "\n")
-    _write_text(out / "report.md", render_markdown(result))
+    write_json_atomic(out / "report.json", result)
+    write_text_atomic(out / "report.md", render_markdown(result))
     return result
 
 

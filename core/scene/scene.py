@@ -6,7 +6,6 @@ import dataclasses
 import json
 import math
 import os
-import tempfile
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -16,14 +15,25 @@ import numpy as np
 
 from core.config import PAPER_RADAR, RadarConfig
 from core.errors import InputError
+from core.files import check_text_field, parse_json, read_json, write_text_atomic
+from core.limits import (
+    MAX_FRAMES,
+    MAX_PERSON_FRAMES,
+    MAX_PERSONS,
+    MAX_SCATTERER_FRAMES,
+    MAX_SIMULATED_SAMPLES,
+    MAX_STATIC_REFLECTORS,
+)
 from core.scene.aoi import AOI
-from core.scene.clutter import check_clutter_radar
+from core.scene.body import N_BODY_SCATTERERS
+from core.scene.clutter import check_clutter_radar, expected_clutter_count
 from core.scene.trajectory import (
     TRAJECTORY_CLASSES,
     Trajectory,
     generate_trajectory,
     profile_trajectory,
     validate_class_parameters,
+    waypoint_duration_s,
     waypoint_trajectory,
 )
 
@@ -43,8 +53,10 @@ PERSON_MODELS = ("point", "extended")
 REFLECTOR_KEYS = ("x_m", "y_m", "z_m", "rcs_dbsm")
 RCS_RANGE_DBSM = (-60.0, 60.0)
 WAYPOINT_SPEED_RANGE_MPS = (0.05, 3.0)
-MAX_PROFILE_FRAMES = 100_000
+MAX_PROFILE_FRAMES = MAX_FRAMES
 MIN_SCATTERER_RANGE_M = 0.1
+#: The longest a class trajectory without ``duration_s`` lasts (classes c-e draw 6-20 s).
+CLASS_MAX_DEFAULT_DURATION_S = 20.0
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -194,29 +206,12 @@ class Scene:
     def from_json(cls, path: str | os.PathLike) -> Scene:
         """Load a scene file; errors name the file and the line (syntax) or the field."""
         path = Path(path)
-        try:
-            text = path.read_text(encoding="utf-8")
-        except FileNotFoundError:
-            raise InputError("scene file not found", str(path)) from None
-        except (OSError, UnicodeDecodeError) as exc:
-            raise InputError(f"cannot read scene file ({exc})", str(path)) from None
-        try:
-            data = json.loads(text)
-        except json.JSONDecodeError as exc:
-            raise InputError(
-                f"invalid JSON: {exc.msg} (column {exc.colno})", f"{path}:{exc.lineno}"
-            ) from None
+        data = read_json(path, what="scene file")
         return cls.from_dict(data, source=str(path), base_dir=path.parent)
 
     @classmethod
     def from_json_text(cls, text: str, source: str = "<scene>") -> Scene:
-        try:
-            data = json.loads(text)
-        except json.JSONDecodeError as exc:
-            raise InputError(
-                f"invalid JSON: {exc.msg} (column {exc.colno})", f"{source}:{exc.lineno}"
-            ) from None
-        return cls.from_dict(data, source=source)
+        return cls.from_dict(parse_json(text, source, what="scene"), source=source)
 
     @classmethod
     def from_dict(
@@ -229,19 +224,6 @@ class Scene:
             if exc.source is None and source is not None:
                 raise InputError(exc.message, source) from None
             raise
-
-
-def write_text_atomic(path: Path, text: str) -> None:
-    """Write to a temporary file in the same folder, then rename."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as fh:
-            fh.write(text)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
 
 
 # ---- parsing -----------------------------------------------------------------------------------
@@ -290,8 +272,13 @@ def _parse_radar(spec: Any, base_dir: Path) -> RadarConfig:
     if spec == "paper":
         return PAPER_RADAR
     if isinstance(spec, str):
-        cfg = (base_dir / spec).resolve()
-        if not cfg.is_file():
+        check_text_field(spec, "radar")
+        try:
+            cfg = (base_dir / spec).resolve()
+            found = cfg.is_file()
+        except (OSError, ValueError) as exc:
+            raise InputError(f"radar: cannot use {spec!r} as a TI .cfg path ({exc})") from None
+        if not found:
             raise InputError(f"radar: TI .cfg file {spec!r} not found (looked for {str(cfg)!r})")
         try:
             from core.config import read_ti_cfg  # added by the radar chain (branch sim)
@@ -321,7 +308,8 @@ def _parse_trajectory(
                 f"{where}.class: unknown trajectory class {cls!r}; "
                 f"expected one of {list(TRAJECTORY_CLASSES)}"
             )
-        validate_class_parameters(cls, params, where)
+        checked = validate_class_parameters(cls, params, where)
+        _check_frames(checked.get("duration_s", CLASS_MAX_DEFAULT_DURATION_S) / dt, where)
         if "seed" in spec:
             seed = _integer(spec["seed"], f"{where}.seed")
         else:
@@ -337,6 +325,8 @@ def _parse_trajectory(
         w = spec["waypoints"]
         if not isinstance(w, list) or len(w) < 2:
             raise InputError(f"{where}.waypoints must list at least 2 [x_m, y_m, speed_mps]")
+        if len(w) > MAX_FRAMES:
+            raise InputError(f"{where}.waypoints lists {len(w)} points, more than {MAX_FRAMES}")
         rows = []
         for i, row in enumerate(w):
             f = f"{where}.waypoints[{i}]"
@@ -347,6 +337,7 @@ def _parse_trajectory(
             if not aoi.contains(np.array([x, y])):
                 raise InputError(f"{f}: point ({x}, {y}) lies outside the AOI")
             rows.append((x, y, s))
+        _check_frames(waypoint_duration_s(np.array(rows)) / dt, where)
         try:
             return waypoint_trajectory(np.array(rows), frame_period_s=dt)
         except InputError as exc:
@@ -360,6 +351,10 @@ def _parse_trajectory(
         p0 = _vector(spec["initial_position_m"], f"{where}.initial_position_m")
         v0 = _vector(spec["initial_velocity_mps"], f"{where}.initial_velocity_mps")
         acc = spec["acceleration_mps2"]
+        if isinstance(acc, list) and len(acc) > MAX_PROFILE_FRAMES:
+            raise InputError(
+                f"{where}.acceleration_mps2 lists {len(acc)} rows, more than {MAX_PROFILE_FRAMES}"
+            )
         if isinstance(acc, list) and acc and isinstance(acc[0], list):
             a = np.array(
                 [_vector(row, f"{where}.acceleration_mps2[{i}]") for i, row in enumerate(acc)]
@@ -383,6 +378,15 @@ def _parse_trajectory(
         f"{where} needs 'class' (a-e), 'waypoints' or 'initial_position_m' "
         f"(explicit profile), got keys {sorted(spec)}"
     )
+
+
+def _check_frames(n_frames: float, where: str) -> None:
+    """Refuse a trajectory that would last more than :data:`MAX_FRAMES` frames (before it is
+    built: its arrays have one row per frame)."""
+    if not n_frames <= MAX_FRAMES:
+        raise InputError(
+            f"{where} would last {n_frames:.0f} frames, more than the limit {MAX_FRAMES}"
+        )
 
 
 def person_seed(scene_seed: int, index: int) -> int:
@@ -412,6 +416,10 @@ def _parse_scene(data: Any, base_dir: Path) -> Scene:
     refl = data.get("static_reflectors", [])
     if not isinstance(refl, list):
         raise InputError("static_reflectors must be a list")
+    if len(refl) > MAX_STATIC_REFLECTORS:
+        raise InputError(
+            f"static_reflectors lists {len(refl)}, more than the limit {MAX_STATIC_REFLECTORS}"
+        )
     reflectors = []
     for i, r in enumerate(refl):
         where = f"static_reflectors[{i}]"
@@ -436,6 +444,8 @@ def _parse_scene(data: Any, base_dir: Path) -> Scene:
     persons_d = data.get("persons", [])
     if not isinstance(persons_d, list):
         raise InputError("persons must be a list")
+    if len(persons_d) > MAX_PERSONS:
+        raise InputError(f"persons lists {len(persons_d)}, more than the limit {MAX_PERSONS}")
     persons = []
     for i, p in enumerate(persons_d):
         where = f"persons[{i}]"
@@ -459,6 +469,29 @@ def _parse_scene(data: Any, base_dir: Path) -> Scene:
             raise InputError(f"{where}.model must be one of {list(PERSON_MODELS)}, got {model!r}")
         persons.append(
             Person(trajectory=traj, rcs_dbsm=rcs, model=model, spec=dict(p["trajectory"]))
+        )
+    n_frames = max((p.trajectory.n_frames for p in persons), default=1)
+    if len(persons) * n_frames > MAX_PERSON_FRAMES:
+        raise InputError(
+            f"persons x frames = {len(persons)} x {n_frames} exceeds the limit "
+            f"{MAX_PERSON_FRAMES} of one scene's work"
+        )
+    scatterers = (
+        sum(N_BODY_SCATTERERS if p.model == "extended" else 1 for p in persons)
+        + len(reflectors)
+        + expected_clutter_count(aoi, density)
+    )
+    if n_frames * scatterers > MAX_SCATTERER_FRAMES:
+        raise InputError(
+            f"frames x scatterers = {n_frames} x {scatterers:.0f} (persons' scatterers, static "
+            f"reflectors and expected clutter points) exceeds the limit {MAX_SCATTERER_FRAMES} "
+            "of one scene's work"
+        )
+    cube = radar.n_tx * radar.n_rx * radar.n_loops * radar.n_samples
+    if n_frames * cube > MAX_SIMULATED_SAMPLES:
+        raise InputError(
+            f"frames x radar cube = {n_frames} x {cube} samples exceeds the limit "
+            f"{MAX_SIMULATED_SAMPLES:.3g} of one scene's work"
         )
     return Scene(
         seed=seed,

@@ -189,6 +189,26 @@ def profile_trajectory(
     )
 
 
+def _waypoint_segments(
+    w: np.ndarray,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Segments ``(W-1, 2)``, lengths, speed gradients ``k`` and start times ``(W,)`` of a path."""
+    seg = np.diff(w[:, :2], axis=0)
+    length = np.hypot(seg[:, 0], seg[:, 1])
+    v0, v1 = w[:-1, 2], w[1:, 2]
+    k = np.where(length > 0, (v1 - v0) / np.where(length > 0, length, 1.0), 0.0)
+    # segment durations: T = ln(v1/v0)/k, or L/v0 when k = 0
+    with np.errstate(divide="ignore", invalid="ignore"):
+        dur = np.where(np.abs(k) > 1e-12, np.log(v1 / v0) / k, length / v0)
+    dur = np.where(length > 0, dur, 0.0)
+    return seg, length, k, np.concatenate(([0.0], np.cumsum(dur)))
+
+
+def waypoint_duration_s(waypoints: np.ndarray) -> float:
+    """How long walking the waypoints ``[x_m, y_m, speed_mps]`` (shape ``(W, 3)``) takes, s."""
+    return float(_waypoint_segments(np.asarray(waypoints, dtype=np.float64))[3][-1])
+
+
 def waypoint_trajectory(waypoints: np.ndarray, *, frame_period_s: float = 0.08) -> Trajectory:
     """A drawn path: waypoints ``[x_m, y_m, speed_mps]`` walked in order.
 
@@ -206,15 +226,8 @@ def waypoint_trajectory(waypoints: np.ndarray, *, frame_period_s: float = 0.08) 
     """
     w = np.asarray(waypoints, dtype=np.float64)
     dt = float(frame_period_s)
-    seg = np.diff(w[:, :2], axis=0)
-    length = np.hypot(seg[:, 0], seg[:, 1])
-    v0, v1 = w[:-1, 2], w[1:, 2]
-    k = np.where(length > 0, (v1 - v0) / np.where(length > 0, length, 1.0), 0.0)
-    # segment durations: T = ln(v1/v0)/k, or L/v0 when k = 0
-    with np.errstate(divide="ignore", invalid="ignore"):
-        dur = np.where(np.abs(k) > 1e-12, np.log(v1 / v0) / k, length / v0)
-    dur = np.where(length > 0, dur, 0.0)
-    t_start = np.concatenate(([0.0], np.cumsum(dur)))
+    seg, length, k, t_start = _waypoint_segments(w)
+    v0 = w[:-1, 2]
     n_frames = int(math.floor(t_start[-1] / dt + 1e-9)) + 1
     if n_frames < 2:
         raise InputError("waypoints describe a path shorter than one frame")

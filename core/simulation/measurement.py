@@ -76,6 +76,7 @@ import numpy as np
 
 from core.config import DEFAULT_PROCESSING, SPEED_OF_LIGHT_MPS, ProcessingSettings, RadarConfig
 from core.errors import InputError
+from core.files import read_npz, write_npz_atomic
 from core.pointcloud import SOURCE_OTHER, PointCloud
 from core.processing import estimate_angles, make_cfar
 from core.processing.angle import log_parabolic_offset
@@ -245,32 +246,29 @@ def chain_false_alarms(
     """
     path = _false_alarm_cache_path(radar, settings, n_frames)
     try:
-        with np.load(path) as z:
-            return FalseAlarms(
-                rate_per_frame=float(z["rate_per_frame"]),
-                doppler_index=z["doppler_index"].astype(np.int64),
-                snr_db=z["snr_db"].astype(np.float64),
-                azimuth_rad=z["azimuth_rad"].astype(np.float64),
-                range_frac=z["range_frac"].astype(np.float64),
-                n_frames=int(z["n_frames"]),
-            )
-    except (OSError, KeyError, ValueError):
+        z = read_npz(path, what="false-alarm cache")
+        return FalseAlarms(
+            rate_per_frame=float(z["rate_per_frame"]),
+            doppler_index=z["doppler_index"].astype(np.int64),
+            snr_db=z["snr_db"].astype(np.float64),
+            azimuth_rad=z["azimuth_rad"].astype(np.float64),
+            range_frac=z["range_frac"].astype(np.float64),
+            n_frames=int(z["n_frames"]),
+        )
+    except (KeyError, ValueError, TypeError):  # InputError is a ValueError
         pass
     fa = _measure_false_alarms(radar, settings, n_frames)
+    arrays = {
+        "rate_per_frame": np.asarray(fa.rate_per_frame),
+        "doppler_index": fa.doppler_index,
+        "snr_db": fa.snr_db,
+        "azimuth_rad": fa.azimuth_rad,
+        "range_frac": fa.range_frac,
+        "n_frames": np.asarray(fa.n_frames),
+    }
     try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        tmp = path.with_name(f"{path.stem}.{os.getpid()}.tmp.npz")
-        np.savez(
-            tmp,
-            rate_per_frame=fa.rate_per_frame,
-            doppler_index=fa.doppler_index,
-            snr_db=fa.snr_db,
-            azimuth_rad=fa.azimuth_rad,
-            range_frac=fa.range_frac,
-            n_frames=fa.n_frames,
-        )
-        tmp.replace(path)  # atomic: a reader never sees half a file
-    except OSError:
+        write_npz_atomic(path, arrays, compressed=False)  # a reader never sees half a file
+    except (OSError, InputError):
         pass  # a read-only cache only costs the recomputation
     return fa
 

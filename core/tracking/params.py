@@ -6,14 +6,14 @@ names them. Every field is validated in ``__post_init__`` with a message naming 
 
 from __future__ import annotations
 
-import json
 import math
 import os
-import tempfile
 from dataclasses import dataclass, fields
 from pathlib import Path
 
 from core.errors import InputError
+from core.files import read_json, write_json_atomic
+from core.limits import CLUTTER_DENSITY_RANGE, MAX_TRACKS, VARIANCE_RANGE
 from core.tracking.space import MODELS, P0_NAMES, STATE_DIM, defaults, p0_names, parameter
 
 NONPARAMETRIC = "nonparametric"
@@ -89,13 +89,18 @@ class TrackerParams:
             raise InputError(
                 f"p0 must have {n} entries for model {self.model!r}, got {len(p0)}: p0={p0}"
             )
+        lo, hi = VARIANCE_RANGE
         for i, v in enumerate(p0):
             if not (math.isfinite(v) and v > 0):
                 raise InputError(f"p0[{i}] must be a positive finite number, got {v}")
+            if not lo <= v <= hi:
+                raise InputError(f"p0[{i}] must be in [{lo:g}, {hi:g}], got {v}")
         for name in ("q_coeff", "r11", "r22", "r33"):
             v = getattr(self, name)
             if not _is_number(v) or not (math.isfinite(v) and v > 0):
                 raise InputError(f"{name} must be a positive finite number, got {name}={v!r}")
+            if not lo <= v <= hi:
+                raise InputError(f"{name} must be in [{lo:g}, {hi:g}], got {name}={v!r}")
         unit = ("p_d", "p_te", "p11", "p21", "p_g", "confirm_threshold", "delete_threshold")
         for name in unit:
             v = getattr(self, name)
@@ -124,10 +129,17 @@ class TrackerParams:
                 f"clutter_density must be a positive number or {NONPARAMETRIC!r}, "
                 f"got clutter_density={rho!r}"
             )
+        elif not CLUTTER_DENSITY_RANGE[0] <= rho <= CLUTTER_DENSITY_RANGE[1]:
+            raise InputError(
+                f"clutter_density must be in [{CLUTTER_DENSITY_RANGE[0]:g}, "
+                f"{CLUTTER_DENSITY_RANGE[1]:g}], got clutter_density={rho!r}"
+            )
         if isinstance(self.max_tracks, bool) or not isinstance(self.max_tracks, int):
             raise InputError(f"max_tracks must be an integer, got max_tracks={self.max_tracks!r}")
-        if self.max_tracks < 1:
-            raise InputError(f"max_tracks must be >= 1, got max_tracks={self.max_tracks}")
+        if not 1 <= self.max_tracks <= MAX_TRACKS:
+            raise InputError(
+                f"max_tracks must be in [1, {MAX_TRACKS}], got max_tracks={self.max_tracks}"
+            )
 
     # ---- derived -----------------------------------------------------------------------------
     @property
@@ -194,34 +206,13 @@ class TrackerParams:
 
     @classmethod
     def load(cls, path: str | os.PathLike) -> TrackerParams:
-        """Read a JSON parameter file; errors name the file."""
-        path = Path(path)
-        try:
-            text = path.read_text()
-        except FileNotFoundError:
-            raise InputError("file not found", str(path)) from None
-        except OSError as exc:
-            raise InputError(f"cannot read ({exc.strerror})", str(path)) from None
-        try:
-            data = json.loads(text)
-        except json.JSONDecodeError as exc:
-            raise InputError(f"invalid JSON at line {exc.lineno}: {exc.msg}", str(path)) from None
+        """Read a JSON parameter file; errors name the file (and line for syntax)."""
+        data = read_json(path, what="parameter file")
         return cls.from_dict(data, source=str(path))
 
     def save(self, path: str | os.PathLike) -> Path:
         """Write atomically (temporary file in the same folder, then rename)."""
-        path = Path(path)
-        path.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-        try:
-            with os.fdopen(fd, "w") as fh:
-                json.dump(self.to_dict(), fh, indent=2)
-                fh.write("\n")
-            os.replace(tmp, path)
-        except BaseException:
-            Path(tmp).unlink(missing_ok=True)
-            raise
-        return path
+        return write_json_atomic(path, self.to_dict())
 
 
 def _is_number(v: object) -> bool:
