@@ -272,11 +272,15 @@ def test_killed_worker_exits_3_resumable_and_the_same_command_completes(tmp_path
 
     url = f"sqlite:///{tmp_path}/k.db"
     # created before tune starts, so that polling never races tune's creation of the schema
+    # the objective's options are the study's (a worker reads them from the storage), so the
+    # study is created with the trial delay the command line repeats
     prepare_study(StudySettings(model="cv", n_trials=6, storage=url, study_name="k",
-                                objective="quadratic"))  # fmt: skip
-    # one worker, trials of 5 x 0.15 s: it is mid-trial for most of the time
+                                objective="quadratic",
+                                objective_options={"delay_s": 0.3}))  # fmt: skip
+    # one worker, trials of 5 x 0.3 s: it is mid-trial for most of the time, and a poll that
+    # takes a second on a loaded machine still finds a running trial after a complete one
     args = ["tune", "--model", "cv", "--trials", "6", "--jobs", "1", "--storage", url,
-            "--study", "k", *QUAD, "--objective-option", "delay_s=0.15"]  # fmt: skip
+            "--study", "k", *QUAD, "--objective-option", "delay_s=0.3"]  # fmt: skip
     parent = subprocess.Popen(
         [sys.executable, "-m", "core.cli", *args],
         cwd=ROOT,
@@ -322,12 +326,14 @@ def test_killed_worker_exits_3_resumable_and_the_same_command_completes(tmp_path
 def test_two_tune_runs_on_one_study_repeat_no_parameter_set(tmp_path: Path) -> None:
     url = f"sqlite:///{tmp_path}/r.db"
     common = ["tune", "--model", "cv", "--storage", url, "--study", "r", "--sampler", "random",
-              "--pruner", "none", *QUAD, "--objective-option", "delay_s=0.02"]  # fmt: skip
+              "--pruner", "none", *QUAD, "--objective-option", "delay_s=0.1"]  # fmt: skip
     from core.optimization import StudySettings, prepare_study
 
     prepare_study(StudySettings(model="cv", storage=url, study_name="r", sampler="random",
-                                pruner="none", objective="quadratic"))  # fmt: skip
-    # two runs on the study at once, each with 2 workers and the same --seed
+                                pruner="none", objective="quadratic",
+                                objective_options={"delay_s": 0.1}))  # fmt: skip
+    # two runs on the study at once, each with 2 workers and the same --seed; trials of 0.5 s,
+    # so neither run can finish the 16 before the other's workers (slow to start under load) join
     runs = [
         subprocess.Popen(
             [sys.executable, "-m", "core.cli", *common, "--trials", "16", "--jobs", "2"],
