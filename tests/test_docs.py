@@ -61,7 +61,13 @@ def subcommands() -> dict[str, set[str]]:
     sub = argparse.ArgumentParser(prog="radartune").add_subparsers()
     for module_name in COMMANDS.values():
         importlib.import_module(module_name).add_parser(sub)
-    return {name: set(OPTION.findall(p.format_help())) for name, p in sub.choices.items()}
+    found = {name: set(OPTION.findall(p.format_help())) for name, p in sub.choices.items()}
+    # `radartune gui` passes its arguments through to the app, which owns them (app/main.py
+    # imports no Qt at load)
+    from app.main import build_parser
+
+    found["gui"] = set(OPTION.findall(build_parser().format_help()))
+    return found
 
 
 @pytest.mark.parametrize("page", PAGES, ids=lambda p: str(p.relative_to(ROOT)))

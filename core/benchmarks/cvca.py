@@ -10,7 +10,7 @@
   bootstrap interval, wins, Wilcoxon);
 - the motion model isolated: CA's parameters with the CV model (the acceleration entries of
   p0 dropped) and q_coeff re-scanned (:data:`Q_GRID` and CA's own q), the best against CA's
-  own, paired (decision cvca2-01, item 4);
+  own, paired (decision evaluation-04, item 4);
 - per class, each model's loss split into transient, manoeuvre and steady frames
   (:func:`core.evaluation.loss_breakdown`), with N_c, the first confirmed frame and the
   mean along-track error;

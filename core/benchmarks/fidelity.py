@@ -52,7 +52,7 @@ N_BOOTSTRAP = 4000
 LOSS_TOLERANCE = 0.10
 #: a run (one trajectory, one noise seed) with a confirmed track is a "tail event" when its loss
 #: exceeds this multiple of the exact level's median loss of that trajectory: the estimate sat on
-#: a clutter point or track for a frame or more (docs/decisions/fidelity-09). Runs of one
+#: a clutter point or track for a frame or more (docs/decisions/evaluation-02). Runs of one
 #: trajectory mostly lie within 0.56-1.8x their median (82 % of exact's CV runs, 24 seeds); the
 #: few past 10x decide the mean
 TAIL_FACTOR = 10.0

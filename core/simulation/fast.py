@@ -42,7 +42,7 @@ channels, points and labels). The first is the second with one frame, so both gi
 frames for the same per-frame generators. The draws come from a compiled generator
 (:mod:`core.simulation.rng_kernels`) seeded per frame with four raw words of that frame's
 generator; the noise map's Gamma(12) is NumPy's float32 algorithm on those words
-(``docs/decisions/fidelity-07``).
+(``docs/decisions/simulation-11``).
 
 CFAR thresholds. Neighbouring cells of the exact chain's noise are correlated through the
 windows (|rho|^2 = 4/9 for Hann), here they are independent. The exact chain's thresholds on
@@ -52,7 +52,7 @@ less often a local maximum: 12 % of the exact chain's noise detections go, 3 % o
 cells'). :func:`core.simulation.fast_cfar.independent_cell_stages` scales both stages'
 ``pfa`` by one factor so that the expected noise detections per frame after both stages and
 peak grouping (:func:`core.processing.false_alarms.noise_detections_per_frame`) are the exact
-chain's (``docs/decisions/fidelity-08``). ``rect`` windows leave independent cells: the
+chain's (``docs/decisions/simulation-12``). ``rect`` windows leave independent cells: the
 thresholds are then the chain's own.
 
 Layout: the closed-form model and its compiled kernels (responses, noise map, patches) are in
@@ -62,7 +62,7 @@ module (about 700 lines) holds the two entry points with their compiled batch pa
 must equal draw for draw (:func:`fast_spectrum`, :func:`detected_channels`,
 :func:`points_from_channels`; tested bit for bit).
 
-Known approximations (measured in ``docs/fidelity.md``): the noise cells' correlation is
+Known approximations (measured in ``docs/fidelity-models.md``): the noise cells' correlation is
 modelled only through the thresholds (above); the beat tone's drift over the frame (<= 0.2
 range bins at 1.8 m/s) is reduced to its phase term.
 """

@@ -4,7 +4,7 @@ with thresholds for independent cells.
 Neighbouring cells of the exact chain's noise are correlated through the windows; the ``fast``
 level's noise map has independent cells. :func:`independent_cell_stages` scales both stages'
 ``pfa`` by one factor so that the expected noise detections per frame after both stages and
-peak grouping are the exact chain's (``docs/decisions/fidelity-08``); :func:`cfar_arguments`
+peak grouping are the exact chain's (``docs/decisions/simulation-12``); :func:`cfar_arguments`
 gives the compiled kernel's arguments (:class:`~core.processing.cfar.TwoStageCfarArgs`).
 """
 

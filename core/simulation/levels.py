@@ -1,4 +1,4 @@
-"""The fidelity levels: one registry, one small interface per level (docs/fidelity.md).
+"""The fidelity levels: one registry, one small interface per level (docs/fidelity-models.md).
 
 Every level simulates one frame (:class:`FrameSimulator`, the GUI's and the reference's entry
 point) and may simulate all frames of a trajectory in one call (:class:`FramesSimulator`, the

@@ -47,7 +47,7 @@ Speed: all four steps run in one compiled kernel over any number of frames
 (:func:`simulate_frames_measurement`, the data-set path; :func:`simulate_frame_measurement` is
 the same kernel with one frame). The kernel draws from its own xoshiro256** generator, seeded
 per frame with four raw draws of that frame's ``rng`` (:func:`frame_seed`), so both entry
-points give the same frames bit for bit (``docs/decisions/fidelity-04``).
+points give the same frames bit for bit (``docs/decisions/simulation-09``).
 
 Layout: about 950 lines, most of them the one compiled kernel (:func:`_measure_frames`, steps
 1-4 with its xoshiro256** generator) and the tables and false-alarm pool it reads, which are
@@ -56,8 +56,8 @@ by; its arguments are grouped (:class:`ModelConstants`, :class:`KernelTables`,
 :class:`ArrayLayout`, :class:`FalseAlarmPool`). The false-alarm measurement
 (:func:`chain_false_alarms`) could move out on its own.
 
-Not modelled (measured against ``exact`` in ``docs/fidelity.md``): the extra detections next to
-very strong or fast reflectors (window sidelobes, clutter-removal residuals), two reflectors
+Not modelled (measured against ``exact`` in ``docs/fidelity-models.md``): the extra detections
+next to very strong or fast reflectors (window sidelobes, clutter-removal residuals), two reflectors
 sharing a cell, the threshold effect of the estimators at very low SNR.
 """
 

@@ -104,7 +104,7 @@ def test_grouping_removes_more_with_correlated_cells() -> None:
     kept_indep = noise_detections_per_frame(
         RADAR, s, *f, independent_cells=True
     ) / noise_detections_per_frame(RADAR, off, *f, independent_cells=True)
-    # measured (docs/decisions/fidelity-08): 12 % removed in the exact chain, 3 % on
+    # measured (docs/decisions/simulation-12): 12 % removed in the exact chain, 3 % on
     # independent cells (mostly at zero Doppler, where the raw neighbours are larger)
     assert 0.84 < kept_exact < 0.90
     assert 0.95 < kept_indep < 0.99
