@@ -165,9 +165,11 @@ def test_breakdown_scores_only_frames_with_the_person_present() -> None:
     p, v = _walk(turn_at=30)  # no manoeuvre
     gone = p.copy()
     gone[20:25] = np.nan  # the person is absent for frames 20–24
+    v_gone = v.copy()
+    v_gone[20:25] = np.nan  # absent: neither position nor velocity (the data-set rule)
     has = np.ones(30, bool)
     est = p + [0.01, 0.0]
-    bd = loss_breakdown(_dataset(gone, v), _estimates(est, has), n_transient=5)
+    bd = loss_breakdown(_dataset(gone, v_gone), _estimates(est, has), n_transient=5)
     assert bd.n_c[0] == 25 and bd.sse[0] == pytest.approx(25e-4)
     assert bd.loss[0] == pytest.approx(25e-4 / 25**2)
     # the estimate "reappears" at frame 25: a second transient of 5 frames

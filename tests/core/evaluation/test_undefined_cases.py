@@ -59,6 +59,13 @@ def test_no_track_ever_confirmed(ds) -> None:
     assert "position RMSE        – (no track confirmed)" in ev.format_table()
 
 
+def _absent_too(v: np.ndarray, xy: np.ndarray) -> np.ndarray:
+    """The velocities with a person absent (NaN) wherever its position is: the data-set rule."""
+    v = np.array(v, dtype=float, copy=True)
+    v[np.isnan(xy)] = np.nan
+    return v
+
+
 def test_no_person(ds) -> None:
     f = ds.n_frames
     empty = replace(
@@ -88,7 +95,7 @@ def test_person_absent_for_some_frames(ds) -> None:
     f = ds.n_frames
     truth = ds.truth_xy_m.copy()
     truth[10:20, 0] = np.nan  # trajectory 0: the person leaves for frames 10–19
-    gone = replace(ds, truth_xy_m=truth)
+    gone = replace(ds, truth_xy_m=truth, truth_v_mps=_absent_too(ds.truth_v_mps, truth))
     has = np.ones(f, bool)
     xy = np.nan_to_num(truth[:, 0]) + [0.1, 0.0]  # 0.1 m off where present, anywhere when absent
     conf = np.full((f, 4, 2), np.nan)
@@ -116,7 +123,10 @@ def test_several_persons_ospa_over_the_persons_present(ds) -> None:
     two = replace(
         ds,
         truth_xy_m=np.concatenate((ds.truth_xy_m, second), axis=1),
-        truth_v_mps=np.concatenate((ds.truth_v_mps, ds.truth_v_mps[:, :1]), axis=1),
+        truth_v_mps=_absent_too(
+            np.concatenate((ds.truth_v_mps, ds.truth_v_mps[:, :1]), axis=1),
+            np.concatenate((ds.truth_xy_m, second), axis=1),
+        ),
     )
     has = np.ones(f, bool)
     conf = np.full((f, 4, 2), np.nan)
@@ -146,7 +156,10 @@ def test_track_cli_two_persons_prints_no_nan(ds, tmp_path, capsys) -> None:
     two = replace(
         ds,
         truth_xy_m=np.concatenate((truth, second), axis=1),
-        truth_v_mps=np.concatenate((ds.truth_v_mps, ds.truth_v_mps[:, :1]), axis=1),
+        truth_v_mps=_absent_too(
+            np.concatenate((ds.truth_v_mps, ds.truth_v_mps[:, :1]), axis=1),
+            np.concatenate((truth, second), axis=1),
+        ),
     )
     data = two.save(tmp_path / "two.npz")
     out = tmp_path / "r.json"
