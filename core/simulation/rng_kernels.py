@@ -18,7 +18,7 @@ still decide every frame.
   ``u < 1 - 0.0331 x^4`` (no logarithm for ~92 % of the Gamma(12) draws); ``d = k - 1/3``,
   ``c = 1/sqrt(9 d)`` are passed in so that a loop over cells computes them once.
 
-The laws are tested in ``tests/core/fidelity/test_rng_kernels.py`` (moments, Kolmogorov-Smirnov
+The laws are tested in ``tests/core/simulation/test_rng_kernels.py`` (moments, Kolmogorov-Smirnov
 against the exact distribution functions, tail probabilities).
 """
 

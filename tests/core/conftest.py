@@ -1,4 +1,4 @@
-"""The fidelity tests keep their on-disk caches (false-alarm pool) out of the user's cache."""
+"""Tests under core/ keep their on-disk caches (data sets, false-alarm pool) out of ~/.cache."""
 
 import pytest
 
