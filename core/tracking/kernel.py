@@ -17,6 +17,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 from numba import njit
 
+from core import jit_guard  # noqa: F401  (before any kernel compiles: see core/jit_guard.py)
 from core.tracking.gating import gate_threshold
 from core.tracking.initiation import initial_covariance
 from core.tracking.ipda import LOG_2PI
