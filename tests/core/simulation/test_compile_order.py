@@ -11,6 +11,7 @@ subtraction are fused (FMA), as ``fastmath`` lets LLVM do on a CPU with FMA.
 from __future__ import annotations
 
 import os
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -104,3 +105,45 @@ def test_fast_spectrum_does_not_depend_on_the_exact_level_compiled_first(tmp_pat
     alone = _run(_FAST_SPECTRUM, "alone", cache_dir=tmp_path / "alone")
     after = _run(_FAST_SPECTRUM, "exact-first", cache_dir=tmp_path / "exact_first")
     assert after == alone
+
+
+_CALLEE = """import numba
+
+from core import jit_guard  # noqa: F401
+
+
+@numba.njit(cache=True)
+def value():
+    return {value}
+"""
+
+_CALLER = """import numba
+
+from core import jit_guard  # noqa: F401
+from core.order_callee import value
+
+
+@numba.njit(cache=True)
+def value_plus_one():
+    return value() + 1.0
+"""
+
+
+def test_editing_a_called_kernel_module_recompiles_its_callers(tmp_path):
+    # numba's cache of value_plus_one holds value() compiled in; keyed on its own file only, it
+    # would return the old sum after order_callee.py changed (the salt: jit_guard's stamp)
+    shutil.copytree(ROOT / "core", tmp_path / "core", ignore=shutil.ignore_patterns("__pycache__"))
+    (tmp_path / "core" / "order_caller.py").write_text(_CALLER)
+    script = "from core.order_caller import value_plus_one; print(value_plus_one())"
+    env = dict(os.environ, PYTHONPATH=str(tmp_path))
+    env.pop("NUMBA_CACHE_DIR", None)  # the in-tree __pycache__ of the copy
+    sums = []
+    for value in ("1.0", "5.0"):
+        (tmp_path / "core" / "order_callee.py").write_text(_CALLEE.format(value=value))
+        out = subprocess.run(
+            [sys.executable, "-c", script], cwd=tmp_path, env=env, capture_output=True, text=True
+        )
+        assert out.returncode == 0, out.stderr
+        sums.append(float(out.stdout))
+    assert list((tmp_path / "core" / "__pycache__").glob("order_caller.*.nbi"))  # it was cached
+    assert sums == [2.0, 6.0]
