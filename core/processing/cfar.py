@@ -32,6 +32,7 @@ from scipy.integrate import quad
 from scipy.optimize import brentq
 from scipy.special import betaincc, betainccinv, gammainc, gammaincc, gammaln, logsumexp
 
+from core import jit_guard  # noqa: F401  (before any kernel compiles: see core/jit_guard.py)
 from core.config import DEFAULT_PROCESSING, CfarSettings, ProcessingSettings, RadarConfig
 from core.processing.spectrum import clutter_removal_noise_profile, effective_cells
 

@@ -7,6 +7,7 @@ import functools
 import numba
 import numpy as np
 
+from core import jit_guard  # noqa: F401  (before any kernel compiles: see core/jit_guard.py)
 from core.config import DEFAULT_PROCESSING, ProcessingSettings, RadarConfig
 from core.pointcloud import SOURCE_OTHER, PointCloud
 from core.processing import angle as _angle

@@ -17,6 +17,7 @@ import numba
 import numpy as np
 import scipy.fft
 
+from core import jit_guard  # noqa: F401  (before any kernel compiles: see core/jit_guard.py)
 from core.config import WINDOWS
 from core.errors import InputError
 

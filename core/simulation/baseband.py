@@ -22,6 +22,7 @@ from __future__ import annotations
 import numba
 import numpy as np
 
+from core import jit_guard  # noqa: F401  (before any kernel compiles: see core/jit_guard.py)
 from core.config import SPEED_OF_LIGHT_MPS, RadarConfig
 from core.simulation.antenna import AntennaGain
 from core.simulation.gaussian import complex_noise

@@ -76,6 +76,7 @@ from typing import NamedTuple
 import numba
 import numpy as np
 
+from core import jit_guard  # noqa: F401  (before any kernel compiles: see core/jit_guard.py)
 from core.config import (
     DEFAULT_PROCESSING,
     ProcessingSettings,

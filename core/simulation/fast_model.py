@@ -11,6 +11,7 @@ import numba
 import numpy as np
 import scipy.fft
 
+from core import jit_guard  # noqa: F401  (before any kernel compiles: see core/jit_guard.py)
 from core.config import SPEED_OF_LIGHT_MPS, ProcessingSettings, RadarConfig
 from core.processing import window
 from core.simulation.gaussian import FI, KI, WI

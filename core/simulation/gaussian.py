@@ -27,6 +27,8 @@ from __future__ import annotations
 import numba
 import numpy as np
 
+from core import jit_guard  # noqa: F401  (before any kernel compiles: see core/jit_guard.py)
+
 #: edge of the ziggurat's base strip (256 layers) and the area of every layer: the base strip's
 #: rectangle plus the tail, ``v = r f(r) + sqrt(pi / 2) erfc(r / sqrt 2)``, f(x) = exp(-x^2 / 2)
 ZIGGURAT_R = 3.6541528853610088

@@ -74,6 +74,7 @@ from typing import NamedTuple
 import numba
 import numpy as np
 
+from core import jit_guard  # noqa: F401  (before any kernel compiles: see core/jit_guard.py)
 from core.config import DEFAULT_PROCESSING, SPEED_OF_LIGHT_MPS, ProcessingSettings, RadarConfig
 from core.errors import InputError
 from core.files import read_npz, write_npz_atomic

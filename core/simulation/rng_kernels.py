@@ -27,6 +27,7 @@ from __future__ import annotations
 import numba
 import numpy as np
 
+from core import jit_guard  # noqa: F401  (before any kernel compiles: see core/jit_guard.py)
 from core.simulation import gaussian
 from core.simulation.gaussian import (  # noqa: F401  (state_from: re-exported for fast)
     FI,

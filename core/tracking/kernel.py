@@ -25,6 +25,7 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
+from core import jit_guard  # noqa: F401  (before any kernel compiles: see core/jit_guard.py)
 from core.tracking.ekf import MIN_RANGE_M
 from core.tracking.inputs import Frames, TrackerConstants, packed_frames
 from core.tracking.ipda import LOG_2PI
