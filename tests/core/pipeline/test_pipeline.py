@@ -27,7 +27,7 @@ from core.pipeline import reflectors as pipeline_reflectors
 from core.pointcloud import POINT_FIELDS
 from core.scene import Person, Scene, class_scene, profile_trajectory
 
-ROOT = Path(__file__).resolve().parents[2]
+ROOT = Path(__file__).resolve().parents[3]
 
 
 def short_scene(*, clutter: float = 0.0, frames: int = 8, rcs: float | None = None) -> Scene:
