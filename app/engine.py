@@ -340,7 +340,7 @@ def running_loss(
 
 # ---- radar files --------------------------------------------------------------------------------
 def read_ti_cfg(path: str | os.PathLike) -> RadarConfig:
-    from core.config import read_ti_cfg as _read
+    from core.formats.ti_cfg import read_ti_cfg as _read
 
     return _read(path)
 

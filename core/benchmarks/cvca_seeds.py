@@ -115,13 +115,8 @@ def run_study(
     model: str, seed: int, s: Settings, storage: str, dataset_path: str
 ) -> tuple[str, list[Any]]:
     """One TPE + ASHA study; returns its name and its trials (TrialSummary)."""
-    from core.optimization.study import (
-        StudySettings,
-        prepare_study,
-        run_worker,
-        start_study,
-        study_progress,
-    )
+    from core.optimization.progress import study_progress
+    from core.optimization.study import StudySettings, prepare_study, run_worker, start_study
 
     settings = StudySettings(
         model=model,

@@ -46,7 +46,8 @@ def _reference(dataset_path: str, n: int) -> dict[str, float]:
 
 
 def _study(dataset_path: str, storage: str, n_jobs: int, n_trials: int) -> dict[str, Any]:
-    from core.optimization.study import StudySettings, counted, start_study, study_progress
+    from core.optimization.progress import counted, study_progress
+    from core.optimization.study import StudySettings, start_study
 
     s = StudySettings(
         model="cv", n_trials=n_trials, n_jobs=n_jobs, storage=storage, dataset=dataset_path

@@ -25,7 +25,8 @@ def describe(radar: RadarConfig) -> dict[str, Any]:
 
 
 def run(args: argparse.Namespace) -> int:
-    from core.config import PAPER_RADAR, read_ti_cfg
+    from core.config import PAPER_RADAR
+    from core.formats.ti_cfg import read_ti_cfg
 
     radar = read_ti_cfg(args.cfg) if args.cfg else PAPER_RADAR
     info = describe(radar)

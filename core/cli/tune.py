@@ -80,7 +80,8 @@ def _options(items: list[str]) -> dict[str, float]:
 
 def run(args: argparse.Namespace) -> int:
     from core.optimization.data import resolve_dataset
-    from core.optimization.study import StudySettings, counted, start_study, study_progress
+    from core.optimization.progress import counted, study_progress
+    from core.optimization.study import StudySettings, start_study
 
     settings = StudySettings(
         model=args.model,

@@ -14,6 +14,14 @@ from core.optimization.objective import (
     make_losses,
     round_robin_order,
 )
+from core.optimization.progress import (
+    TrialSummary,
+    counted,
+    enqueue_params,
+    list_studies,
+    study_model,
+    study_progress,
+)
 from core.optimization.space import (
     MODELS,
     SEARCH_SPACE,
@@ -29,18 +37,12 @@ from core.optimization.study import (
     SAMPLERS,
     StudyHandle,
     StudySettings,
-    TrialSummary,
-    counted,
-    enqueue_params,
     fail_stale_trials,
-    list_studies,
     make_pruner,
     make_sampler,
     prepare_study,
     run_worker,
     start_study,
-    study_model,
-    study_progress,
 )
 
 __all__ = [

@@ -31,8 +31,8 @@ import numpy as np
 
 from core.errors import InputError
 from core.files import write_json_atomic, write_text_atomic
+from core.optimization.progress import TrialSummary, study_progress
 from core.optimization.storage import open_storage, redact
-from core.optimization.study import TrialSummary, study_progress
 
 #: The paper's Table I, ×10⁻³.
 PAPER_TABLE_I = {

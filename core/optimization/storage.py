@@ -147,6 +147,16 @@ def open_storage(url: str, *, create: bool = True) -> Any:
         raise InputError(f"storage {redact(url)!r}: cannot open: {first}") from None
 
 
+def load_existing_study(storage: Any, name: str) -> Any | None:
+    """The study ``name`` in an opened ``storage`` (see :func:`open_storage`), None if absent."""
+    import optuna
+
+    try:
+        return optuna.load_study(study_name=name, storage=storage)
+    except KeyError:
+        return None
+
+
 #: the lock file beside a journal or SQLite file: ``studies.log.flock``, ``studies.db.flock``
 LOCK_SUFFIX = ".flock"
 

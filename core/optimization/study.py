@@ -1,4 +1,6 @@
-"""Studies: create or resume, run workers, cap the total, survive crashes, read progress.
+"""Studies: create or resume, run workers, cap the total, survive crashes.
+
+Reading them (trials, progress, model, names): :mod:`core.optimization.progress`.
 
 One study per motion model. The study's settings live in its user attributes (``model``,
 ``objective``, ``dataset``, ``n_trials``, ``sampler``, ``pruner``, ``seed``), so that a worker
@@ -32,7 +34,7 @@ import socket
 import subprocess
 import sys
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
@@ -41,10 +43,11 @@ import numpy as np
 
 from core.errors import InputError
 from core.optimization.objective import evaluate, make_losses
-from core.optimization.space import check_model, flat_params, suggest_params, tracker_params_dict
+from core.optimization.space import check_model, suggest_params, tracker_params_dict
 from core.optimization.storage import (
     DEFAULT_STORAGE,
     absolute_url,
+    load_existing_study,
     normalize_url,
     open_storage,
     redact,
@@ -123,29 +126,6 @@ class StudySettings:
     def name(self) -> str:
         """The study name (default ``radartune-<model>``)."""
         return self.study_name or f"radartune-{self.model}"
-
-
-@dataclass(frozen=True, slots=True, kw_only=True)
-class TrialSummary:
-    """One trial as the GUI and the report see it (no Optuna types).
-
-    ``params`` are the flat Optuna parameters (``q_coeff``, ``p0_00``, …); ``value`` is L_t in m²
-    (the running mean at the pruning point for a PRUNED trial); ``duration_s`` is None while
-    RUNNING.
-    """
-
-    number: int
-    state: str
-    value: float | None
-    params: dict[str, float]
-    duration_s: float | None
-    datetime_start: dt.datetime | None
-    datetime_complete: dt.datetime | None
-    worker: str = ""
-
-    def tracker_params(self, model: str) -> dict[str, Any]:
-        """The trial's parameters as TrackerParams JSON."""
-        return tracker_params_dict(self.params, model)
 
 
 # ---- samplers and pruners ---------------------------------------------------------------------
@@ -305,15 +285,6 @@ def fail_stale_trials(study: Any, *, stale_after_s: float = STALE_AFTER_S) -> li
 
 
 # ---- creating, loading ------------------------------------------------------------------------
-def _load_existing(storage: Any, name: str) -> Any | None:
-    import optuna
-
-    try:
-        return optuna.load_study(study_name=name, storage=storage)
-    except KeyError:
-        return None
-
-
 def prepare_study(settings: StudySettings, *, dataset_path: str | None = None) -> Any:
     """Create the study (once, before any worker starts) or resume it; return the Optuna study.
 
@@ -335,7 +306,7 @@ def prepare_study(settings: StudySettings, *, dataset_path: str | None = None) -
         "objective_options": dict(settings.objective_options),
         "space": "paper-eq15",
     }
-    study = _load_existing(storage, settings.name)
+    study = load_existing_study(storage, settings.name)
     if study is not None:
         old = study.user_attrs
         for key in ("model", "objective", "sampler", "pruner"):
@@ -420,7 +391,7 @@ def run_worker(
 
     optuna.logging.set_verbosity(optuna.logging.WARNING)
     store = open_storage(storage, create=False)
-    probe = _load_existing(store, study_name)
+    probe = load_existing_study(store, study_name)
     if probe is None:
         raise InputError(f"no study {study_name!r} in {redact(storage)}")
     attrs = dict(probe.user_attrs)
@@ -582,75 +553,3 @@ def start_study(
         for _ in range(settings.n_jobs)
     ]
     return StudyHandle(settings, procs)
-
-
-# ---- reading ----------------------------------------------------------------------------------
-def _summary(t: Any) -> TrialSummary:
-    dur = None
-    if t.datetime_start is not None and t.datetime_complete is not None:
-        dur = (t.datetime_complete - t.datetime_start).total_seconds()
-    value = t.value if t.state.name == "COMPLETE" else None
-    if t.state.name == "PRUNED":
-        iv = t.intermediate_values
-        value = iv[max(iv)] if iv else None
-    return TrialSummary(
-        number=t.number,
-        state=t.state.name,
-        value=None if value is None else float(value),
-        params={k: float(v) for k, v in t.params.items()},
-        duration_s=dur,
-        datetime_start=t.datetime_start,
-        datetime_complete=t.datetime_complete,
-        worker=str(t.user_attrs.get("worker", "")),
-    )
-
-
-def study_progress(storage: str, name: str) -> tuple[list[TrialSummary], TrialSummary | None]:
-    """All trials of a study and the best COMPLETE one (None before the first completes)."""
-    store = open_storage(storage, create=False)
-    study = _load_existing(store, name)
-    if study is None:
-        raise InputError(f"no study {name!r} in {redact(storage)}")
-    trials = study.get_trials(deepcopy=False)
-    summaries = [_summary(t) for t in trials]
-    done = [s for s in summaries if s.state == "COMPLETE" and s.value is not None]
-    best = min(done, key=lambda s: (s.value, s.number)) if done else None
-    return summaries, best
-
-
-def study_model(storage: str, name: str) -> str:
-    """The motion model recorded in a study."""
-    store = open_storage(storage, create=False)
-    study = _load_existing(store, name)
-    if study is None:
-        raise InputError(f"no study {name!r} in {redact(storage)}")
-    return str(study.user_attrs.get("model", ""))
-
-
-def list_studies(storage: str) -> list[str]:
-    """Names of the studies in a storage."""
-    import optuna
-
-    return [s.study_name for s in optuna.get_all_study_summaries(open_storage(storage))]
-
-
-def enqueue_params(storage: str, name: str, params: dict[str, Any]) -> None:
-    """Queue TrackerParams JSON as the next trial of a study (``study.enqueue_trial``).
-
-    The parameters must match the study's model and lie inside the paper's bounds.
-    """
-    import optuna
-
-    store = open_storage(storage, create=False)
-    study = _load_existing(store, name)
-    if study is None:
-        raise InputError(f"no study {name!r} in {redact(storage)}")
-    model = study.user_attrs.get("model")
-    if params.get("model", "cv") != model:
-        raise InputError(f"parameters are for model {params.get('model')!r}, study is {model!r}")
-    optuna.load_study(study_name=name, storage=store).enqueue_trial(flat_params(params))
-
-
-def counted(summaries: Sequence[TrialSummary]) -> int:
-    """Trials that count toward the total: COMPLETE and PRUNED."""
-    return sum(1 for s in summaries if s.state in ("COMPLETE", "PRUNED"))

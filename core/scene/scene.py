@@ -16,6 +16,7 @@ import numpy as np
 from core.config import PAPER_RADAR, RadarConfig
 from core.errors import InputError
 from core.files import check_text_field, parse_json, read_json, write_text_atomic
+from core.formats.ti_cfg import read_ti_cfg
 from core.limits import (
     MAX_FRAMES,
     MAX_PERSON_FRAMES,
@@ -280,10 +281,6 @@ def _parse_radar(spec: Any, base_dir: Path) -> RadarConfig:
             raise InputError(f"radar: cannot use {spec!r} as a TI .cfg path ({exc})") from None
         if not found:
             raise InputError(f"radar: TI .cfg file {spec!r} not found (looked for {str(cfg)!r})")
-        try:
-            from core.config import read_ti_cfg  # added by the radar chain (branch sim)
-        except ImportError:
-            raise InputError("radar: TI .cfg import is not available in this build") from None
         return read_ti_cfg(cfg)
     if isinstance(spec, dict):
         try:

@@ -210,7 +210,7 @@ def test_truncated_map_gives_the_same_points() -> None:
 def test_variant_radars_run_through_the_chain(name: str) -> None:
     from pathlib import Path
 
-    from core.config import read_ti_cfg
+    from core.formats.ti_cfg import read_ti_cfg
 
     radar = read_ti_cfg(Path(__file__).resolve().parents[3] / "resources" / "radar" / f"{name}.cfg")
     antenna = AntennaGain.ideal(radar)

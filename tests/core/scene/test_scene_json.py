@@ -150,7 +150,7 @@ def test_waypoint_outside_the_aoi(tmp_path: Path) -> None:
 
 
 def test_radar_from_a_ti_cfg_relative_to_the_scene(tmp_path: Path) -> None:
-    from core.config import read_ti_cfg
+    from core.formats.ti_cfg import read_ti_cfg
 
     cfg = ROOT / "resources" / "radar" / "long_range.cfg"
     (tmp_path / "radar").mkdir()

@@ -1,0 +1,332 @@
+"""TI mmWave SDK CLI configuration (``.cfg``) files: reader and writer of :class:`RadarConfig`.
+
+A ``.cfg`` is the list of CLI commands the TI mmWave SDK demo sends to the device
+(``channelCfg``, ``profileCfg``, ``chirpCfg``, ``frameCfg``, ...). :func:`read_ti_cfg` builds a
+:class:`~core.config.RadarConfig` from it, naming file, line and field of a malformed command;
+:func:`write_ti_cfg` writes the inverse.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from dataclasses import dataclass
+from pathlib import Path
+
+from core.config import RadarConfig
+from core.errors import InputError
+from core.files import read_text, write_text_atomic
+
+#: IWR6843ISK antenna layout in units of lambda/2: TX -> (azimuth, elevation), RX -> azimuth.
+ISK_TX_POSITIONS = ((0, 0), (2, 1), (4, 0))
+ISK_RX_AZIMUTH = (0, 1, 2, 3)
+#: The device's maximum TX power; ``profileCfg`` carries a back-off from it in dB.
+TI_MAX_TX_POWER_DBM = 12.0
+
+#: Field names of the commands the reader needs (TI mmWave SDK user guide order).
+TI_COMMAND_FIELDS: dict[str, tuple[str, ...]] = {
+    "channelCfg": ("rxChannelEn", "txChannelEn", "cascading"),
+    "adcCfg": ("numADCBits", "adcOutputFmt"),
+    "profileCfg": (
+        "profileId",
+        "startFreq",
+        "idleTime",
+        "adcStartTime",
+        "rampEndTime",
+        "txOutPower",
+        "txPhaseShifter",
+        "freqSlopeConst",
+        "txStartTime",
+        "numAdcSamples",
+        "digOutSampleRate",
+        "hpfCornerFreq1",
+        "hpfCornerFreq2",
+        "rxGain",
+    ),
+    "chirpCfg": (
+        "chirpStartIdx",
+        "chirpEndIdx",
+        "profileId",
+        "startFreqVar",
+        "freqSlopeVar",
+        "idleTimeVar",
+        "adcStartTimeVar",
+        "txEnable",
+    ),
+    "frameCfg": (
+        "chirpStartIdx",
+        "chirpEndIdx",
+        "numLoops",
+        "numFrames",
+        "framePeriodicity",
+        "triggerSelect",
+        "frameTriggerDelay",
+    ),
+}
+#: Fields that must be integers (the rest are decimal numbers).
+_TI_INT_FIELDS = {
+    "rxChannelEn",
+    "txChannelEn",
+    "cascading",
+    "numADCBits",
+    "adcOutputFmt",
+    "profileId",
+    "txOutPower",
+    "txPhaseShifter",
+    "numAdcSamples",
+    "hpfCornerFreq1",
+    "hpfCornerFreq2",
+    "rxGain",
+    "chirpStartIdx",
+    "chirpEndIdx",
+    "txEnable",
+    "numLoops",
+    "numFrames",
+    "triggerSelect",
+}
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class TiCommand:
+    """One line of a TI ``.cfg`` file: command name, raw arguments and 1-based line number."""
+
+    name: str
+    args: tuple[str, ...]
+    line: int
+
+
+def parse_ti_cfg(text: str, source: str = "<cfg>") -> list[TiCommand]:
+    """Split a TI CLI configuration into commands; ``%`` starts a comment line.
+
+    Unknown commands are kept (and ignored by :func:`radar_from_ti_commands`).
+    """
+    commands = []
+    for number, raw in enumerate(text.splitlines(), start=1):
+        line = raw.strip()
+        if not line or line.startswith("%"):
+            continue
+        name, *args = line.split()
+        commands.append(TiCommand(name=name, args=tuple(args), line=number))
+    return commands
+
+
+def _ti_fields(cmd: TiCommand, source: str) -> dict[str, float | int]:
+    names = TI_COMMAND_FIELDS[cmd.name]
+    where = f"{source}:{cmd.line}"
+    if len(cmd.args) < len(names):
+        missing = names[len(cmd.args)]
+        raise InputError(
+            f"{cmd.name} needs {len(names)} fields, got {len(cmd.args)} "
+            f"(field {len(cmd.args) + 1} {missing!r} missing)",
+            where,
+        )
+    out: dict[str, float | int] = {}
+    for i, (name, text) in enumerate(zip(names, cmd.args), start=1):
+        try:
+            value = int(text, 0) if name in _TI_INT_FIELDS else float(text)
+        except ValueError:
+            kind = "an integer" if name in _TI_INT_FIELDS else "a number"
+            raise InputError(
+                f"{cmd.name} field {i} {name!r}: expected {kind}, got {text!r}", where
+            ) from None
+        if isinstance(value, float) and not math.isfinite(value):
+            raise InputError(f"{cmd.name} field {i} {name!r}: not finite, got {text!r}", where)
+        out[name] = value
+    return out
+
+
+def _ti_require(cond: bool, cmd: TiCommand, field_name: str, message: str, source: str) -> None:
+    if not cond:
+        index = TI_COMMAND_FIELDS[cmd.name].index(field_name) + 1
+        raise InputError(
+            f"{cmd.name} field {index} {field_name!r}: {message}", f"{source}:{cmd.line}"
+        )
+
+
+def radar_from_ti_commands(
+    commands: list[TiCommand], source: str = "<cfg>", name: str = "ti"
+) -> RadarConfig:
+    """Build a :class:`RadarConfig` from parsed TI commands (see :func:`read_ti_cfg`)."""
+    known = {c.name: c for c in commands if c.name in TI_COMMAND_FIELDS and c.name != "chirpCfg"}
+    for needed in ("channelCfg", "profileCfg", "chirpCfg", "frameCfg"):
+        if needed != "chirpCfg" and needed not in known:
+            raise InputError(f"missing command {needed!r}", source)
+    chirps = [c for c in commands if c.name == "chirpCfg"]
+    if not chirps:
+        raise InputError("missing command 'chirpCfg'", source)
+    ch_cmd, pr_cmd, fr_cmd = known["channelCfg"], known["profileCfg"], known["frameCfg"]
+    ch = _ti_fields(ch_cmd, source)
+    pr = _ti_fields(pr_cmd, source)
+    fr = _ti_fields(fr_cmd, source)
+    if "adcCfg" in known:
+        adc_cmd = known["adcCfg"]
+        adc = _ti_fields(adc_cmd, source)
+        _ti_require(
+            adc["adcOutputFmt"] in (1, 2),
+            adc_cmd,
+            "adcOutputFmt",
+            f"only complex sampling (1 or 2) is supported, got {adc['adcOutputFmt']}",
+            source,
+        )
+
+    rx_mask, tx_mask = int(ch["rxChannelEn"]), int(ch["txChannelEn"])
+    _ti_require(
+        0 < rx_mask < 16, ch_cmd, "rxChannelEn", f"mask 1..15 expected, got {rx_mask}", source
+    )
+    _ti_require(
+        0 < tx_mask < 8, ch_cmd, "txChannelEn", f"mask 1..7 expected, got {tx_mask}", source
+    )
+    rx_enabled = [r for r in range(4) if rx_mask >> r & 1]
+
+    for fname in ("startFreq", "rampEndTime", "freqSlopeConst", "digOutSampleRate"):
+        _ti_require(pr[fname] > 0, pr_cmd, fname, f"must be > 0, got {pr[fname]}", source)
+    for fname in ("idleTime", "txOutPower"):
+        _ti_require(pr[fname] >= 0, pr_cmd, fname, f"must be >= 0, got {pr[fname]}", source)
+    _ti_require(
+        pr["numAdcSamples"] > 0,
+        pr_cmd,
+        "numAdcSamples",
+        f"must be > 0, got {pr['numAdcSamples']}",
+        source,
+    )
+
+    # chirp index -> TX mask
+    tx_of_chirp: dict[int, int] = {}
+    for c in chirps:
+        cf = _ti_fields(c, source)
+        start, end, mask = int(cf["chirpStartIdx"]), int(cf["chirpEndIdx"]), int(cf["txEnable"])
+        _ti_require(
+            mask in (1, 2, 4),
+            c,
+            "txEnable",
+            f"one TX per chirp (mask 1, 2 or 4) expected, got {mask}",
+            source,
+        )
+        _ti_require(mask & tx_mask == mask, c, "txEnable", "TX not enabled in channelCfg", source)
+        _ti_require(end >= start >= 0, c, "chirpEndIdx", f"must be >= {start}, got {end}", source)
+        for idx in range(start, end + 1):
+            tx_of_chirp[idx] = mask.bit_length() - 1
+    first, last = int(fr["chirpStartIdx"]), int(fr["chirpEndIdx"])
+    _ti_require(
+        last >= first >= 0, fr_cmd, "chirpEndIdx", f"must be >= {first}, got {last}", source
+    )
+    for idx in range(first, last + 1):
+        _ti_require(
+            idx in tx_of_chirp, fr_cmd, "chirpEndIdx", f"chirp {idx} has no chirpCfg", source
+        )
+    tx_order = tuple(tx_of_chirp[idx] for idx in range(first, last + 1))
+    _ti_require(
+        fr["numLoops"] > 0, fr_cmd, "numLoops", f"must be > 0, got {fr['numLoops']}", source
+    )
+    _ti_require(
+        fr["framePeriodicity"] > 0,
+        fr_cmd,
+        "framePeriodicity",
+        f"must be > 0, got {fr['framePeriodicity']}",
+        source,
+    )
+
+    az = tuple(ISK_TX_POSITIONS[t][0] + ISK_RX_AZIMUTH[r] for t in tx_order for r in rx_enabled)
+    el = tuple(ISK_TX_POSITIONS[t][1] for t in tx_order for _ in rx_enabled)
+    ramp_s = pr["rampEndTime"] / 1e6
+    sample_rate_hz = pr["digOutSampleRate"] * 1000.0
+    # BW = S * Tc, rounded to 1 Hz (TI quantises the slope far more coarsely)
+    bandwidth_hz = float(round(pr["freqSlopeConst"] * 1e12 * ramp_s))
+    try:
+        return RadarConfig(
+            start_frequency_hz=pr["startFreq"] * 1e9,
+            ramp_time_s=ramp_s,
+            idle_time_s=pr["idleTime"] / 1e6,
+            bandwidth_hz=bandwidth_hz,
+            n_tx=len(tx_order),
+            n_rx=len(rx_enabled),
+            n_loops=int(fr["numLoops"]),
+            n_samples=int(pr["numAdcSamples"]),
+            sample_rate_hz=sample_rate_hz,
+            frame_period_s=fr["framePeriodicity"] / 1000.0,
+            tx_power_dbm=TI_MAX_TX_POWER_DBM - pr["txOutPower"],
+            receiver_gain_db=float(int(pr["rxGain"]) & 0x3F),
+            receiver_bandwidth_hz=sample_rate_hz,
+            tx_order=tx_order,
+            azimuth_positions=az,
+            elevation_positions=el,
+            name=name,
+        )
+    except InputError as exc:
+        raise InputError(exc.message, source) from None
+
+
+def read_ti_cfg(path: str | os.PathLike) -> RadarConfig:
+    """Read a :class:`RadarConfig` from a TI mmWave SDK CLI configuration (``.cfg``) file.
+
+    Uses ``channelCfg`` (RX/TX masks), ``profileCfg`` (start frequency, idle and ramp time, TX
+    back-off from 12 dBm, slope, sample count and rate, RX gain), ``chirpCfg`` (the TX of each
+    chirp slot), ``frameCfg`` (chirps per loop, loops, frame period) and ``adcCfg`` (complex
+    sampling). The bandwidth is slope x ramp end time; the receiver noise bandwidth is the
+    complex sampling rate; the virtual array is the IWR6843ISK layout for the enabled antennas.
+    Fields the format does not carry (antenna gain, noise figure, temperature, impedance) keep
+    their defaults. Unknown commands are ignored.
+
+    Raises
+    ------
+    InputError
+        Naming the file, line number and field of a malformed known command.
+    """
+    p = Path(path)
+    text = read_text(p, what="TI configuration")
+    return radar_from_ti_commands(parse_ti_cfg(text, str(p)), str(p), name=p.stem)
+
+
+def ti_cfg_text(radar: RadarConfig, comment: str = "") -> str:
+    """The TI CLI commands that configure ``radar`` (inverse of :func:`read_ti_cfg`).
+
+    Only IWR6843ISK-layout arrays with one TX per chirp slot can be written.
+    """
+    slope_mhz_per_us = radar.slope_hz_per_s / 1e12
+    rx_mask = (1 << radar.n_rx) - 1
+    tx_mask = 0
+    for t in radar.tx_order:
+        tx_mask |= 1 << t
+    lines = [f"% {line}" for line in comment.splitlines()] if comment else []
+    lines += [
+        "% RadarTune: TI mmWave SDK CLI configuration",
+        "sensorStop",
+        "flushCfg",
+        "dfeDataOutputMode 1",
+        f"channelCfg {rx_mask} {tx_mask} 0",
+        "adcCfg 2 1",
+        "adcbufCfg -1 0 1 1 1",
+        "profileCfg "
+        + " ".join(
+            [
+                "0",
+                f"{radar.start_frequency_hz / 1e9:.10g}",
+                f"{radar.idle_time_s * 1e6:.10g}",
+                "6",
+                f"{radar.ramp_time_s * 1e6:.10g}",
+                f"{max(0, round(TI_MAX_TX_POWER_DBM - radar.tx_power_dbm)):d}",
+                "0",
+                f"{slope_mhz_per_us:.12g}",
+                "0",
+                f"{radar.n_samples:d}",
+                f"{radar.sample_rate_hz / 1000.0:.10g}",
+                "0",
+                "0",
+                f"{round(radar.receiver_gain_db):d}",
+            ]
+        ),
+    ]
+    for slot, tx in enumerate(radar.tx_order):
+        lines.append(f"chirpCfg {slot} {slot} 0 0 0 0 0 {1 << tx}")
+    lines += [
+        f"frameCfg 0 {radar.n_tx - 1} {radar.n_loops} 0 {radar.frame_period_s * 1000:.10g} 1 0",
+        "lowPower 0 0",
+        "guiMonitor -1 1 1 0 0 0 1",
+        "sensorStart",
+    ]
+    return "\n".join(lines) + "\n"
+
+
+def write_ti_cfg(radar: RadarConfig, path: str | os.PathLike, comment: str = "") -> None:
+    """Write ``radar`` as a TI ``.cfg`` file (atomically: temporary name, then rename)."""
+    write_text_atomic(path, ti_cfg_text(radar, comment))

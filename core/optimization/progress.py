@@ -1,0 +1,111 @@
+"""Reading studies without touching them: trials as :class:`TrialSummary`, progress, model, names.
+
+Everything here is what the GUI, the CLI and the report read from a study while workers run it
+(:mod:`core.optimization.study`); no Optuna type leaves this module. :func:`enqueue_params`
+only queues a trial for the workers to run.
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+from core.errors import InputError
+from core.optimization.space import flat_params, tracker_params_dict
+from core.optimization.storage import load_existing_study, open_storage, redact
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class TrialSummary:
+    """One trial as the GUI and the report see it (no Optuna types).
+
+    ``params`` are the flat Optuna parameters (``q_coeff``, ``p0_00``, …); ``value`` is L_t in m²
+    (the running mean at the pruning point for a PRUNED trial); ``duration_s`` is None while
+    RUNNING.
+    """
+
+    number: int
+    state: str
+    value: float | None
+    params: dict[str, float]
+    duration_s: float | None
+    datetime_start: dt.datetime | None
+    datetime_complete: dt.datetime | None
+    worker: str = ""
+
+    def tracker_params(self, model: str) -> dict[str, Any]:
+        """The trial's parameters as TrackerParams JSON."""
+        return tracker_params_dict(self.params, model)
+
+
+def _summary(t: Any) -> TrialSummary:
+    dur = None
+    if t.datetime_start is not None and t.datetime_complete is not None:
+        dur = (t.datetime_complete - t.datetime_start).total_seconds()
+    value = t.value if t.state.name == "COMPLETE" else None
+    if t.state.name == "PRUNED":
+        iv = t.intermediate_values
+        value = iv[max(iv)] if iv else None
+    return TrialSummary(
+        number=t.number,
+        state=t.state.name,
+        value=None if value is None else float(value),
+        params={k: float(v) for k, v in t.params.items()},
+        duration_s=dur,
+        datetime_start=t.datetime_start,
+        datetime_complete=t.datetime_complete,
+        worker=str(t.user_attrs.get("worker", "")),
+    )
+
+
+def study_progress(storage: str, name: str) -> tuple[list[TrialSummary], TrialSummary | None]:
+    """All trials of a study and the best COMPLETE one (None before the first completes)."""
+    store = open_storage(storage, create=False)
+    study = load_existing_study(store, name)
+    if study is None:
+        raise InputError(f"no study {name!r} in {redact(storage)}")
+    trials = study.get_trials(deepcopy=False)
+    summaries = [_summary(t) for t in trials]
+    done = [s for s in summaries if s.state == "COMPLETE" and s.value is not None]
+    best = min(done, key=lambda s: (s.value, s.number)) if done else None
+    return summaries, best
+
+
+def study_model(storage: str, name: str) -> str:
+    """The motion model recorded in a study."""
+    store = open_storage(storage, create=False)
+    study = load_existing_study(store, name)
+    if study is None:
+        raise InputError(f"no study {name!r} in {redact(storage)}")
+    return str(study.user_attrs.get("model", ""))
+
+
+def list_studies(storage: str) -> list[str]:
+    """Names of the studies in a storage."""
+    import optuna
+
+    return [s.study_name for s in optuna.get_all_study_summaries(open_storage(storage))]
+
+
+def enqueue_params(storage: str, name: str, params: dict[str, Any]) -> None:
+    """Queue TrackerParams JSON as the next trial of a study (``study.enqueue_trial``).
+
+    The parameters must match the study's model and lie inside the paper's bounds.
+    """
+    import optuna
+
+    store = open_storage(storage, create=False)
+    study = load_existing_study(store, name)
+    if study is None:
+        raise InputError(f"no study {name!r} in {redact(storage)}")
+    model = study.user_attrs.get("model")
+    if params.get("model", "cv") != model:
+        raise InputError(f"parameters are for model {params.get('model')!r}, study is {model!r}")
+    optuna.load_study(study_name=name, storage=store).enqueue_trial(flat_params(params))
+
+
+def counted(summaries: Sequence[TrialSummary]) -> int:
+    """Trials that count toward the total: COMPLETE and PRUNED."""
+    return sum(1 for s in summaries if s.state in ("COMPLETE", "PRUNED"))
