@@ -103,6 +103,8 @@ def _repo_relative(path: Path) -> str:
 
 
 def _ks(a: np.ndarray, b: np.ndarray) -> float | None:
+    """Two-sample KS distance of two levels' point errors; None below 5 points (the table's
+    dash). Kept here: a statistic of the point errors this bench collects, not of the loss."""
     from scipy.stats import ks_2samp
 
     if len(a) < 5 or len(b) < 5:
