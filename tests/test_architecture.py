@@ -214,3 +214,25 @@ def private_imports() -> set[tuple[str, str, str]]:
 
 def test_no_private_name_imported_across_modules() -> None:
     assert sorted(private_imports()) == [], "private names imported from another module"
+
+
+def test_every_kernel_module_imports_the_jit_guard() -> None:
+    """A module that compiles numba kernels imports core.jit_guard first, or its compiled code
+    could depend on what else was compiled in the process (docs/decisions/simulation-13)."""
+    missing = []
+    for path in sorted((ROOT / "core").rglob("*.py")):
+        tree = ast.parse(path.read_text(), str(path))
+        uses_numba = any(
+            (isinstance(n, ast.Import) and any(a.name.split(".")[0] == "numba" for a in n.names))
+            or (isinstance(n, ast.ImportFrom) and (n.module or "").split(".")[0] == "numba")
+            for n in ast.walk(tree)
+        )
+        guarded = any(
+            isinstance(n, ast.ImportFrom)
+            and n.module == "core"
+            and any(a.name == "jit_guard" for a in n.names)
+            for n in tree.body
+        )
+        if uses_numba and not guarded and path.name != "jit_guard.py":
+            missing.append(path.relative_to(ROOT).as_posix())
+    assert missing == [], f"kernel modules without `from core import jit_guard`: {missing}"

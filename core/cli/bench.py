@@ -31,6 +31,11 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         "--out-dir", default="bench/results", help="folder for <name>.json (default: %(default)s)"
     )
     p.add_argument("--quick", action="store_true", help="short run (smoke test)")
+    p.add_argument(
+        "--render-only",
+        action="store_true",
+        help="fidelity: re-write its tables and plot from <out-dir>/fidelity.json, no run",
+    )
     for model in ("cv", "ca"):
         p.add_argument(
             f"--params-{model}",
@@ -42,6 +47,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    if args.render_only:
+        return _render_only(args)
     names = BENCHMARKS if args.name == "all" else (args.name,)
     out_dir = Path(args.out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
@@ -68,4 +75,31 @@ def run(args: argparse.Namespace) -> int:
         write_json_atomic(path, result)
         print(module.summary(result))
         print(f"written: {path}")
+    return 0
+
+
+def _render_only(args: argparse.Namespace) -> int:
+    """``--render-only``: the fidelity report re-rendered from a stored result."""
+    import json
+
+    from core.errors import InputError
+
+    if args.name != "fidelity":
+        raise InputError(f"--render-only is for fidelity only, not {args.name!r}")
+    from core.benchmarks.fidelity_report import render, summary
+
+    path = Path(args.out_dir) / f"fidelity{'-quick' if args.quick else ''}.json"
+    if not path.exists():
+        raise InputError("no such file (run `radartune bench fidelity` first)", str(path))
+    try:
+        result = json.loads(path.read_text())
+    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
+        raise InputError(f"not JSON: {exc}", str(path)) from None
+    try:
+        written = render(result, quick=args.quick)
+    except (KeyError, TypeError, ValueError, IndexError) as exc:
+        raise InputError(f"not a fidelity result: {exc!r}", str(path)) from None
+    print(summary(result))
+    for out in written:
+        print(f"written: {out}")
     return 0

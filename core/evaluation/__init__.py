@@ -7,6 +7,8 @@
 - :mod:`~core.evaluation.comparison` — two runs compared: loss breakdown by kind of frame,
   paired bootstrap ratio and Wilcoxon test
 - :mod:`~core.evaluation.spread` — spread of the person-labelled points around the truth
+- :mod:`~core.evaluation.intervals` — runs over noise seeds compared: ratio of mean losses with a
+  paired bootstrap interval and its verdict, rates of runs without a track and of tail events
 """
 
 from core.evaluation.comparison import (

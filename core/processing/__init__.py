@@ -11,13 +11,10 @@ from core.processing.cfar import (
     Detections,
     expected_false_alarms_per_frame,
     make_cfar,
-    pfa_ca,
-    pfa_cago,
-    pfa_caso,
-    threshold_factor,
     two_stage_cfar,
     two_stage_pfa,
 )
+from core.processing.cfar_thresholds import pfa_ca, pfa_cago, pfa_caso, threshold_factor
 from core.processing.points import build_point_cloud, label_sources, refine_bins
 from core.processing.spectrum import (
     doppler_fft,

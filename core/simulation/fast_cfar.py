@@ -22,11 +22,10 @@ from core.processing import Detections, make_cfar
 from core.processing.cfar import (
     TwoStageCfarArgs,
     effective_cells_or_none,
-    pfa_caso,
     stage_args,
-    threshold_factor,
     two_stage_kernel,
 )
+from core.processing.cfar_thresholds import pfa_caso, threshold_factor
 from core.processing.false_alarms import StageFactors, cells_correlated, noise_detections_per_frame
 from core.processing.spectrum import clutter_removal_noise_profile
 

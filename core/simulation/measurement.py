@@ -49,12 +49,12 @@ the same kernel with one frame). The kernel draws from its own xoshiro256** gene
 per frame with four raw draws of that frame's ``rng`` (:func:`frame_seed`), so both entry
 points give the same frames bit for bit (``docs/decisions/simulation-09``).
 
-Layout: about 950 lines, most of them the one compiled kernel (:func:`_measure_frames`, steps
-1-4 with its xoshiro256** generator) and the tables and false-alarm pool it reads, which are
-tabulated here with the same conventions (bin offsets, leakage sides) the kernel indexes them
-by; its arguments are grouped (:class:`ModelConstants`, :class:`KernelTables`,
-:class:`ArrayLayout`, :class:`FalseAlarmPool`). The false-alarm measurement
-(:func:`chain_false_alarms`) could move out on its own.
+Layout: this module tabulates the chain's responses (:func:`chain_tables`) with the same
+conventions (bin offsets, leakage sides) the kernel indexes them by, groups the kernel's
+arguments (:class:`ModelConstants`, :class:`KernelTables`, :class:`ArrayLayout`,
+:class:`FalseAlarmPool`) and holds the entry points; the compiled kernel with its generator is
+:func:`core.simulation.measurement_jit.measure_frames`, and the exact chain's false-alarm pool
+is measured by :func:`core.simulation.false_alarm_pool.chain_false_alarms`.
 
 Not modelled (measured against ``exact`` in ``docs/fidelity-models.md``): the extra detections
 next to very strong or fast reflectors (window sidelobes, clutter-removal residuals), two reflectors
@@ -64,40 +64,35 @@ sharing a cell, the threshold effect of the estimators at very low SNR.
 from __future__ import annotations
 
 import functools
-import hashlib
-import os
 from collections.abc import Sequence
 from dataclasses import dataclass
-from pathlib import Path
 from typing import NamedTuple
 
-import numba
 import numpy as np
 
 from core import jit_guard  # noqa: F401  (before any kernel compiles: see core/jit_guard.py)
 from core.config import DEFAULT_PROCESSING, SPEED_OF_LIGHT_MPS, ProcessingSettings, RadarConfig
 from core.errors import InputError
-from core.files import read_npz, write_npz_atomic
 from core.pointcloud import SOURCE_OTHER, PointCloud
 from core.processing import estimate_angles, make_cfar
 from core.processing.angle import log_parabolic_offset
 from core.processing.cfar import METHOD_CODE, effective_cells_or_none
-from core.processing.points import angle_twiddles, angles_of, array_rows
+from core.processing.points import angle_twiddles, array_rows
 from core.processing.spectrum import window
 from core.simulation.antenna import AntennaGain
+from core.simulation.false_alarm_pool import chain_false_alarms
 from core.simulation.fast import FramesOutput
 from core.simulation.fast_model import cell_noise_power_v2, range_responses
 from core.simulation.frame import FrameOutput, needs_elevation
 from core.simulation.gaussian import state_from
 from core.simulation.link import receiver_voltage_scale
+from core.simulation.measurement_jit import measure_frames
 from core.simulation.scatterers import Scatterers
 
 #: Tabulation steps: range and Doppler in fractions of a bin, azimuth in u = sin(az).
 RANGE_STEPS_PER_BIN = 64
 DOPPLER_STEPS_PER_BIN = 64
 AZIMUTH_STEPS = 4097
-#: Noise-only exact frames used to measure the chain's own false alarms.
-FALSE_ALARM_FRAMES = 300
 
 
 @dataclass(frozen=True, slots=True, kw_only=True, eq=False)
@@ -211,122 +206,6 @@ def chain_tables(radar: RadarConfig, settings: ProcessingSettings) -> ChainTable
     )
 
 
-@dataclass(frozen=True, slots=True, kw_only=True, eq=False)
-class FalseAlarms:
-    """The chain's own false alarms, measured on noise-only exact frames.
-
-    Attributes
-    ----------
-    rate_per_frame
-        Mean number of false-alarm points per frame.
-    doppler_index, snr_db, azimuth_rad, range_frac
-        ``(n_pool,)`` the measured points (Doppler index, reported SNR, azimuth, fractional
-        part of the range bin), resampled as a pool.
-    n_frames
-        Frames measured.
-    """
-
-    rate_per_frame: float
-    doppler_index: np.ndarray
-    snr_db: np.ndarray
-    azimuth_rad: np.ndarray
-    range_frac: np.ndarray
-    n_frames: int
-
-
-@functools.lru_cache(maxsize=16)
-def chain_false_alarms(
-    radar: RadarConfig, settings: ProcessingSettings, n_frames: int = FALSE_ALARM_FRAMES
-) -> FalseAlarms:
-    """Run ``n_frames`` noise-only frames through the exact chain (seeded) and pool the points.
-
-    The pool is cached on disk (``<cache>/false_alarms/<key>.npz`` in the data-set cache
-    folder; key: radar, settings, ``n_frames`` and the chain's source fingerprint), so a
-    worker process loads it instead of spending ~1 s of exact frames; a missing or unreadable
-    file is simply recomputed.
-    """
-    path = _false_alarm_cache_path(radar, settings, n_frames)
-    try:
-        z = read_npz(path, what="false-alarm cache")
-        return FalseAlarms(
-            rate_per_frame=float(z["rate_per_frame"]),
-            doppler_index=z["doppler_index"].astype(np.int64),
-            snr_db=z["snr_db"].astype(np.float64),
-            azimuth_rad=z["azimuth_rad"].astype(np.float64),
-            range_frac=z["range_frac"].astype(np.float64),
-            n_frames=int(z["n_frames"]),
-        )
-    except (KeyError, ValueError, TypeError):  # InputError is a ValueError
-        pass
-    fa = _measure_false_alarms(radar, settings, n_frames)
-    arrays = {
-        "rate_per_frame": np.asarray(fa.rate_per_frame),
-        "doppler_index": fa.doppler_index,
-        "snr_db": fa.snr_db,
-        "azimuth_rad": fa.azimuth_rad,
-        "range_frac": fa.range_frac,
-        "n_frames": np.asarray(fa.n_frames),
-    }
-    try:
-        write_npz_atomic(path, arrays, compressed=False)  # a reader never sees half a file
-    except (OSError, InputError):
-        pass  # a read-only cache only costs the recomputation
-    return fa
-
-
-@functools.cache
-def _chain_fingerprint() -> str:
-    """Hash of the sources the exact chain's false alarms depend on (config, simulation,
-    processing), so a changed chain never serves a stale pool."""
-    root = Path(__file__).resolve().parent.parent
-    files = [root / "config.py", root / "pointcloud.py"]
-    for pkg in ("simulation", "processing"):
-        files += sorted((root / pkg).rglob("*.py"))
-    h = hashlib.sha256()
-    for f in files:
-        if f.is_file():
-            h.update(f.relative_to(root).as_posix().encode() + b"\0" + f.read_bytes() + b"\0")
-    return h.hexdigest()[:16]
-
-
-def _false_alarm_cache_path(radar: RadarConfig, settings: ProcessingSettings, n_frames: int):
-    """``<cache>/false_alarms/<key>.npz``; ``<cache>``: ``$RADARTUNE_CACHE`` or
-    ``~/.cache/radartune`` (the data-set cache's folder, see ``core.pipeline``)."""
-    env = os.environ.get("RADARTUNE_CACHE")
-    root = Path(env) if env else Path.home() / ".cache" / "radartune"
-    key = hashlib.sha256(
-        f"{radar!r}\n{settings!r}\n{n_frames}\n{_chain_fingerprint()}".encode()
-    ).hexdigest()[:32]
-    return root / "false_alarms" / f"{key}.npz"
-
-
-def _measure_false_alarms(
-    radar: RadarConfig, settings: ProcessingSettings, n_frames: int
-) -> FalseAlarms:
-    """The pool itself: ``n_frames`` seeded noise-only frames of the exact chain."""
-    from core.simulation.frame import simulate_frame
-
-    rng = np.random.default_rng(20_261_121)
-    ant = AntennaGain.ideal(radar)
-    empty = Scatterers.empty()
-    clouds, dets = [], []
-    for _ in range(n_frames):
-        out = simulate_frame(radar, empty, rng, antenna=ant, settings=settings)
-        clouds.append(out.point_cloud)
-        dets.append(out.detections)
-    pc = PointCloud.concatenate(clouds)
-    det = np.concatenate(dets) if dets else np.zeros((0, 2), dtype=np.int64)
-    r_bin = pc.range_m / radar.range_resolution_m
-    return FalseAlarms(
-        rate_per_frame=len(pc) / n_frames,
-        doppler_index=det[:, 1].astype(np.int64),
-        snr_db=pc.snr_db,
-        azimuth_rad=pc.azimuth_rad,
-        range_frac=r_bin - np.round(r_bin),
-        n_frames=n_frames,
-    )
-
-
 #: No false alarms (noise-free frames).
 
 
@@ -384,7 +263,8 @@ class ArrayLayout(NamedTuple):
 
 
 class FalseAlarmPool(NamedTuple):
-    """:class:`FalseAlarms` as the compiled model resamples them."""
+    """:class:`~core.simulation.false_alarm_pool.FalseAlarms` as the compiled model resamples
+    them."""
 
     rate_per_frame: float
     doppler_index: np.ndarray
@@ -545,7 +425,7 @@ def _run(radar, settings, antenna, states, start, pos, vel, rcs, source, elev, n
     _, const = _setup(radar, settings)
     fa = _false_alarm_pool(radar, settings) if noise else _NO_FALSE_ALARM_POOL
     g_db = antenna.gain_db(np.arctan2(pos[:, 0], pos[:, 1])) if len(pos) else np.zeros(0)
-    counts, f64, i64 = _measure_frames(
+    counts, f64, i64 = measure_frames(
         states,
         start,
         np.ascontiguousarray(pos),
@@ -615,276 +495,6 @@ def simulate_frame_measurement(
     if keep_rd_map:
         rd_db = _model_map(radar, _setup(radar, settings)[0], out.detections, out.point_cloud)
     return FrameOutput(point_cloud=out.point_cloud, rd_map_db=rd_db, detections=out.detections)
-
-
-# ---- the compiled generator: xoshiro256** (Blackman & Vigna) and the draws the model needs ------
-
-
-@numba.njit(inline="always")
-def _rotl(x, k):  # pragma: no cover
-    return (x << np.uint64(k)) | (x >> np.uint64(64 - k))
-
-
-@numba.njit(cache=True, nogil=True)
-def _next_u64(s):  # pragma: no cover
-    """Next 64-bit output of xoshiro256** with state ``s`` (4,) uint64 (advanced in place)."""
-    result = _rotl(s[1] * np.uint64(5), 7) * np.uint64(9)
-    t = s[1] << np.uint64(17)
-    s[2] ^= s[0]
-    s[3] ^= s[1]
-    s[1] ^= s[2]
-    s[0] ^= s[3]
-    s[2] ^= t
-    s[3] = _rotl(s[3], 45)
-    return result
-
-
-@numba.njit(cache=True, nogil=True)
-def _uniform(s):  # pragma: no cover
-    """U[0, 1) with 53 random bits."""
-    return float(_next_u64(s) >> np.uint64(11)) * (1.0 / 9007199254740992.0)
-
-
-@numba.njit(cache=True, nogil=True)
-def _normal(s):  # pragma: no cover
-    """N(0, 1) by Box-Muller: sqrt(-2 ln u1) cos(2 pi u2), u1 in (0, 1]."""
-    u1 = 1.0 - _uniform(s)
-    return np.sqrt(-2.0 * np.log(u1)) * np.cos(2.0 * np.pi * _uniform(s))
-
-
-@numba.njit(cache=True, nogil=True)
-def _gamma(s, k):  # pragma: no cover
-    """Gamma(k, 1) by Marsaglia & Tsang (2000); k < 1 via Gamma(k + 1) U^(1/k)."""
-    if k < 1.0:
-        return _gamma(s, k + 1.0) * _uniform(s) ** (1.0 / k)
-    d = k - 1.0 / 3.0
-    c = 1.0 / np.sqrt(9.0 * d)
-    while True:
-        x = _normal(s)
-        v = 1.0 + c * x
-        if v <= 0.0:
-            continue
-        v = v * v * v
-        u = 1.0 - _uniform(s)
-        # accept when ln u < x^2/2 + d - d v + d ln v
-        if np.log(u) < 0.5 * x * x + d - d * v + d * np.log(v):
-            return d * v
-
-
-@numba.njit(cache=True, nogil=True)
-def _poisson(s, lam):  # pragma: no cover
-    """Poisson(lam) by multiplying uniforms (Knuth; the rates here are well below 1)."""
-    limit = np.exp(-lam)
-    k = 0
-    p = 1.0 - _uniform(s)
-    while p > limit:
-        k += 1
-        p *= 1.0 - _uniform(s)
-    return k
-
-
-@numba.njit(cache=True, nogil=True)
-def _randint(s, n):  # pragma: no cover
-    """Uniform integer in ``0 .. n-1`` (n >= 1; the bias of the modulo is below 2^-50)."""
-    return np.int64(_next_u64(s) % np.uint64(n))
-
-
-@numba.njit(cache=True, nogil=True)
-def _lerp(table, x, x0, step):  # pragma: no cover
-    """Linear interpolation in a table on the uniform grid ``x0 + i step`` (clamped)."""
-    t = (x - x0) / step
-    i = int(np.floor(t))
-    i = min(max(i, 0), table.shape[0] - 2)
-    w = min(max(t - i, 0.0), 1.0)
-    return table[i] * (1.0 - w) + table[i + 1] * w
-
-
-@numba.njit(cache=True, nogil=True)
-def _training_sum(s, method, n_train, n_eff, L, leak_l, leak_r):  # pragma: no cover
-    """CFAR noise estimate: each side ``(n / n_eff) Gamma(n_eff L)`` plus the own leakage."""
-    z1 = _gamma(s, n_eff * L) * (n_train / n_eff) + leak_l
-    z2 = _gamma(s, n_eff * L) * (n_train / n_eff) + leak_r
-    if method == 0:
-        # CA: (Z1 + Z2) / 2n
-        return (z1 + z2) / (2 * n_train)
-    if method == 1:
-        # CASO: min(Z1, Z2) / n
-        return min(z1, z2) / n_train
-    # CAGO: max(Z1, Z2) / n
-    return max(z1, z2) / n_train
-
-
-@numba.njit(cache=True, nogil=True)
-def _grow(f64, i64, need):  # pragma: no cover
-    """The output buffers with room for at least ``need`` rows (doubling)."""
-    if need <= f64.shape[0]:
-        return f64, i64
-    cap = max(need, 2 * f64.shape[0])
-    f2 = np.empty((cap, f64.shape[1]))
-    i2 = np.empty((cap, i64.shape[1]), dtype=np.int64)
-    f2[: f64.shape[0]] = f64
-    i2[: i64.shape[0]] = i64
-    return f2, i2
-
-
-@numba.njit(cache=True, nogil=True)
-def _measure_frames(
-    states, start, pos, vel, gain_db, rcs, elev, noise, const, tables, array, fa
-):  # pragma: no cover
-    """Steps 1-4 of the module docstring for every frame ``f`` (reflectors
-    ``start[f]:start[f+1]``), frame ``f`` drawing from the generator state ``states[f]``.
-
-    Returns ``counts`` ``(F,)``, ``f64`` ``(n, 8)`` (range, azimuth, elevation, radial velocity,
-    SNR, x, y, z) and ``i64`` ``(n, 3)`` (reflector index or -1 for a false alarm, range bin,
-    Doppler index). ``const``: :class:`ModelConstants`; ``tables``: :class:`KernelTables`;
-    ``array``: :class:`ArrayLayout`; ``fa``: :class:`FalseAlarmPool`.
-    """
-    t_mid, range_res, vel_res, n_loops = const.t_mid, const.range_res, const.vel_res, const.n_loops
-    doppler_scale, c_amp2, L = const.doppler_scale, const.c_amp2, const.L
-    rmeth, rn, rne, ralpha = const.range_stage
-    dmeth, dn, dne, dalpha = const.doppler_stage
-    bin_lo, bin_hi = const.bin_lo, const.bin_hi  # (const.m_az: not read here)
-    range_gain, range_est, range_leak = tables.range_gain, tables.range_est, tables.range_leak
-    doppler_gain, doppler_index = tables.doppler_gain, tables.doppler_index
-    doppler_est, doppler_leak, cell_noise = (
-        tables.doppler_est,
-        tables.doppler_leak,
-        tables.cell_noise,
-    )
-    az_pos, el_pos, n_tx, n_rx = array.az_pos, array.el_pos, array.n_tx, array.n_rx
-    row_ch, row_pos, upper, lower, tw_a = (
-        array.row_ch, array.row_pos, array.upper, array.lower, array.tw_a
-    )  # fmt: skip
-    fa_rate, fa_doppler, fa_snr, fa_az, fa_frac = fa
-    n_frames = states.shape[0]
-    counts = np.zeros(n_frames, dtype=np.int64)
-    cap = start[n_frames] + 4 * n_frames + 16
-    f64 = np.empty((cap, 8))
-    i64 = np.empty((cap, 3), dtype=np.int64)
-    n_out = 0
-    f_step = 1.0 / (range_gain.shape[0] - 1)
-    half = n_loops / 2
-    nu_step = n_loops / (doppler_gain.shape[0] - 1)
-    n_v = az_pos.shape[0]
-    xv = np.empty(n_v, dtype=np.complex128)
-    spec = np.empty(tw_a.shape[0])
-    s = np.empty(4, dtype=np.uint64)
-    for fr in range(n_frames):
-        s[:] = states[fr]
-        first = n_out
-        for i in range(start[fr], start[fr + 1]):
-            px = pos[i, 0] + vel[i, 0] * t_mid
-            py = pos[i, 1] + vel[i, 1] * t_mid
-            pz = pos[i, 2] + vel[i, 2] * t_mid
-            r = np.sqrt(px * px + py * py + pz * pz)
-            vr = (px * vel[i, 0] + py * vel[i, 1] + pz * vel[i, 2]) / r
-            r0 = np.sqrt(pos[i, 0] ** 2 + pos[i, 1] ** 2 + pos[i, 2] ** 2)
-            # A^2 = Pt Gt Gr lambda^2 sigma / ((4 pi)^3 R^4) * R 10^(Ge/20)   (eqs. 2-4)
-            amp2 = c_amp2 * 10.0 ** ((2.0 * gain_db[i] + rcs[i]) / 10.0) / r0**4
-            rb = r / range_res
-            k_int = np.floor(rb)
-            f = rb - k_int
-            nu_true = doppler_scale * vr / vel_res
-            nu = (nu_true + half) % n_loops - half
-            gr = _lerp(range_gain, f, 0.0, f_step)
-            r_est = k_int + _lerp(range_est, f, 0.0, f_step)
-            jd = int(np.rint((nu + half) / nu_step))
-            jr = int(np.rint(f / f_step))
-            dc = doppler_index[jd]
-            d_est = _lerp(doppler_est, nu, -half, nu_step)
-            # rho = A^2 |R|^2 |D|^2 / s2[d]  (per channel, peak cell)
-            rho = max(amp2 * gr * doppler_gain[jd] / cell_noise[dc], 1e-30)
-            # the array phase of the exact chain is that of the first chirp's direction
-            u0 = pos[i, 0] / r0
-            s0 = pos[i, 2] / r0
-            if noise:
-                # X = |sqrt(L rho) + n|^2 + Gamma(L - 1),  n ~ CN(0, 1)
-                a = np.sqrt(L * rho) + _normal(s) / np.sqrt(2.0)
-                b = _normal(s) / np.sqrt(2.0)
-                x = a * a + b * b + _gamma(s, L - 1.0)
-                # training cells: noise plus the reflector's own leakage (units of s2)
-                leak = L * amp2 / cell_noise[dc]
-                lr = leak * doppler_gain[jd]
-                ld = leak * gr
-                mu_r = _training_sum(
-                    s, rmeth, rn, rne, L, lr * range_leak[jr, 0], lr * range_leak[jr, 1]
-                )
-                mu_d = _training_sum(
-                    s, dmeth, dn, dne, L, ld * doppler_leak[jd, 0], ld * doppler_leak[jd, 1]
-                )
-                det = x > ralpha * mu_r and x > dalpha * mu_d
-                snr = 10.0 * np.log10(x / mu_r)
-                # Cramer-Rao: var(bin) = 6 / (4 pi^2 L rho)
-                sd_bin = np.sqrt(6.0 / (4.0 * np.pi**2 * L * rho))
-                r_est += sd_bin * _normal(s)
-                d_est += sd_bin * _normal(s)
-            else:
-                det = True
-                snr = 10.0 * np.log10(L * rho)
-            # angles: the chain's estimator on the peak cell's channel values, units of noise:
-            # x_v = rho^(1/2) exp(j pi (p_v u + e_v sin el)) exp(j 2 pi nu k(v) / (Nc Ntx)) + n_v
-            amp = np.sqrt(rho)
-            for v in range(n_v):
-                ph = np.pi * (az_pos[v] * u0 + el_pos[v] * s0)
-                ph += 2.0 * np.pi * nu_true * (v // n_rx) / (n_loops * n_tx)
-                xv[v] = amp * (np.cos(ph) + 1j * np.sin(ph))
-                if noise:
-                    xv[v] += (_normal(s) + 1j * _normal(s)) / np.sqrt(2.0)
-            a_i, e_i = angles_of(
-                xv,
-                d_est,
-                n_tx,
-                n_rx,
-                n_loops,
-                row_ch,
-                row_pos,
-                upper,
-                lower,
-                tw_a,
-                elev[fr],
-                spec,
-            )
-            if not (det and bin_lo - 0.5 <= r_est <= bin_hi + 0.5):
-                continue
-            u_est = np.sin(a_i) * np.cos(e_i)
-            az = np.arcsin(min(max(u_est / np.cos(e_i), -1.0), 1.0))
-            f64, i64 = _grow(f64, i64, n_out + 1)
-            rng_m = r_est * range_res
-            f64[n_out, 0] = rng_m
-            f64[n_out, 1] = az
-            f64[n_out, 2] = e_i
-            f64[n_out, 3] = ((d_est + half) % n_loops - half) * vel_res
-            f64[n_out, 4] = snr
-            i64[n_out, 0] = i
-            i64[n_out, 1] = int(np.rint(r_est))
-            i64[n_out, 2] = dc
-            n_out += 1
-        if noise and fa_rate > 0.0 and fa_snr.shape[0] > 0:
-            # the chain's own false alarms: Poisson count, resampled from the measured pool,
-            # range uniform over the detectable bins, Doppler refinement uniform in the cell
-            k = _poisson(s, fa_rate)
-            f64, i64 = _grow(f64, i64, n_out + k)
-            for _ in range(k):
-                pick = _randint(s, fa_snr.shape[0])
-                rb = bin_lo + _randint(s, bin_hi - bin_lo + 1) + fa_frac[pick]
-                db = fa_doppler[pick] - n_loops // 2 + (_uniform(s) - 0.5)
-                f64[n_out, 0] = rb * range_res
-                f64[n_out, 1] = fa_az[pick]
-                f64[n_out, 2] = 0.0
-                f64[n_out, 3] = db * vel_res
-                f64[n_out, 4] = fa_snr[pick]
-                i64[n_out, 0] = -1
-                i64[n_out, 1] = int(np.rint(rb))
-                i64[n_out, 2] = fa_doppler[pick]
-                n_out += 1
-        for j in range(first, n_out):
-            # x = r cos(el) sin(az), y = r cos(el) cos(az), z = r sin(el)
-            horiz = f64[j, 0] * np.cos(f64[j, 2])
-            f64[j, 5] = horiz * np.sin(f64[j, 1])
-            f64[j, 6] = horiz * np.cos(f64[j, 1])
-            f64[j, 7] = f64[j, 0] * np.sin(f64[j, 2])
-        counts[fr] = n_out - first
-    return counts, f64[:n_out], i64[:n_out]
 
 
 def _model_map(radar: RadarConfig, tab: ChainTables, cells: np.ndarray, pc: PointCloud):

@@ -13,7 +13,8 @@
 - :mod:`~core.tracking.results` — :class:`TrackerResult`, :class:`FrameTracks`, the kernel's
   :class:`~core.tracking.results.TrackRecord`
 - :mod:`~core.tracking.tracker` — :func:`run_tracker` (readable reference, every track)
-- :mod:`~core.tracking.kernel` — the same algorithm compiled with numba (hot path)
+- :mod:`~core.tracking.kernel` — the same algorithm compiled with numba (hot path); the
+  ``@njit`` code itself in :mod:`~core.tracking.kernel_jit`
 - :mod:`~core.tracking.batch` — :func:`track_dataset` over a :class:`core.dataset.Dataset`
 - :mod:`~core.tracking.synthetic` — synthetic measurements for tests and the stability sweep
 """

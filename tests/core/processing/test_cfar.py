@@ -24,7 +24,7 @@ from core.processing import (
     two_stage_cfar,
     two_stage_pfa,
 )
-from core.processing.cfar import _pfa_so_numeric
+from core.processing.cfar_thresholds import _pfa_so_numeric
 from core.processing.spectrum import (
     cell_power_correlation,
     clutter_removal_noise_profile,

@@ -16,20 +16,15 @@ from core.simulation import (
     post_processing_snr_db,
     simulate_frame,
 )
+from core.simulation.false_alarm_pool import _measure_false_alarms, chain_false_alarms
 from core.simulation.measurement import (
     _constants,
-    _gamma,
-    _measure_false_alarms,
-    _normal,
-    _poisson,
-    _randint,
-    _uniform,
-    chain_false_alarms,
     chain_tables,
     frame_seed,
     simulate_frame_measurement,
     simulate_frames_measurement,
 )
+from core.simulation.measurement_jit import _gamma, _normal, _poisson, _randint, _uniform
 
 RADAR = PAPER_RADAR
 ANT = AntennaGain.ideal(RADAR)

@@ -1,11 +1,12 @@
-"""The fidelity bench's loss comparison: paired bootstrap ratio and its verdict."""
+"""Statistics of tracking losses (core.evaluation.intervals): paired bootstrap ratio and its
+verdict, rates and rate ratios, the bulk and the tail events."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from core.benchmarks.fidelity import loss_ratio_interval, verdict
+from core.evaluation.intervals import loss_ratio_interval, verdict
 
 
 def test_identical_losses_are_within() -> None:
@@ -48,27 +49,8 @@ def test_verdict_bands() -> None:
     assert verdict(0.5, 0.89) == "outside"
 
 
-def test_bench_tracks_with_the_tuned_parameters_unless_told(tmp_path) -> None:
-    from core.benchmarks.fidelity import TUNED_PARAMS, tracker_parameters
-    from core.errors import InputError
-    from core.tracking import TrackerParams
-
-    params, said = tracker_parameters()
-    for model in ("cv", "ca"):
-        assert TUNED_PARAMS[model].exists()
-        assert params[model] == TrackerParams.load(TUNED_PARAMS[model])
-        assert params[model] != TrackerParams.default(model)
-    assert "docs/report/best_cv.json" in said and "docs/report/best_ca.json" in said
-    own = TrackerParams.default("cv")
-    path = own.save(tmp_path / "cv.json")
-    params, said = tracker_parameters(params_cv=path)
-    assert params["cv"] == own and str(path) in said
-    with pytest.raises(InputError, match="model must be 'ca'"):
-        tracker_parameters(params_ca=path)
-
-
 def test_regular_loss_leaves_out_runs_without_a_confirmed_track() -> None:
-    from core.benchmarks.fidelity import rate_interval, regular_loss
+    from core.evaluation.intervals import rate_interval, regular_loss
 
     loss = np.array([[1.0, 2.0, 1000.0], [3.0, 1000.0, 1000.0]])
     seen = np.array([[True, True, False], [True, False, False]])
@@ -82,7 +64,7 @@ def test_regular_loss_leaves_out_runs_without_a_confirmed_track() -> None:
 
 
 def test_split_tail_separates_rare_large_runs_by_the_exact_median() -> None:
-    from core.benchmarks.fidelity import exact_median_loss, split_tail
+    from core.evaluation.intervals import exact_median_loss, split_tail
 
     # 3 seeds x 3 trajectories; trajectory 2 never confirmed in seed 0
     ex = np.array([[1.0, 2.0, 9.0], [2.0, 4.0, 5.0], [3.0, 6.0, 7.0]])
@@ -106,7 +88,7 @@ def test_split_tail_separates_rare_large_runs_by_the_exact_median() -> None:
 
 
 def test_rate_ratio_interval_is_exact_and_covers_equal_rates() -> None:
-    from core.benchmarks.fidelity import rate_ratio_interval
+    from core.evaluation.intervals import rate_ratio_interval
 
     ratio, lo, hi = rate_ratio_interval(20, 1000, 10, 1000)
     assert ratio == pytest.approx(2.0) and lo < 2.0 < hi
