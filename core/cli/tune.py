@@ -81,7 +81,7 @@ def _options(items: list[str]) -> dict[str, float]:
 def run(args: argparse.Namespace) -> int:
     from core.optimization.data import resolve_dataset
     from core.optimization.progress import counted, study_progress
-    from core.optimization.study import StudySettings, start_study
+    from core.optimization.study import StudySettings, start_study, worker_alive
 
     settings = StudySettings(
         model=args.model,
@@ -112,6 +112,7 @@ def run(args: argparse.Namespace) -> int:
         bar = tqdm(total=settings.n_trials, desc=settings.name, unit="trial", file=sys.stderr)
     interrupted = False
     best = None
+    quiet_polls = 0
     while True:
         try:
             running = handle.is_running()
@@ -122,7 +123,15 @@ def run(args: argparse.Namespace) -> int:
                     bar.set_postfix_str(f"best L_t={best.value:.4g} (#{best.number})")
                 bar.refresh()
             if not running:
-                break
+                # another run's (or a joined worker's) live trial may hold the last slots: the
+                # study is not lost, it finishes when that trial does. Two polls without one
+                # (0.5 s apart) end the wait: a worker between two trials shows none briefly
+                others = [
+                    t for t in summaries if t.state == "RUNNING" and worker_alive(t.worker) is True
+                ]
+                quiet_polls = 0 if others else quiet_polls + 1
+                if interrupted or counted(summaries) >= settings.n_trials or quiet_polls >= 2:
+                    break
             time.sleep(0.5)
         except KeyboardInterrupt:
             if interrupted:

@@ -207,7 +207,7 @@ def worker_id() -> str:
     return f"{socket.gethostname()}:{pid}:{_start_ticks(pid) or 0}"
 
 
-def _worker_alive(wid: str) -> bool | None:
+def worker_alive(wid: str) -> bool | None:
     """True/False for a worker on this host, None if it runs on another host."""
     try:
         host, pid, ticks = wid.rsplit(":", 2)
@@ -272,7 +272,7 @@ def fail_stale_trials(study: Any, *, stale_after_s: float = STALE_AFTER_S) -> li
     failed = []
     now = dt.datetime.now()
     for t in study.get_trials(deepcopy=False, states=(TrialState.RUNNING,)):
-        alive = _worker_alive(str(t.user_attrs.get("worker", "")))
+        alive = worker_alive(str(t.user_attrs.get("worker", "")))
         age = (now - t.datetime_start).total_seconds() if t.datetime_start else math.inf
         if alive is False or (alive is None and age > stale_after_s):
             try:
