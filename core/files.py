@@ -16,13 +16,14 @@ CRCs. The limits live in :mod:`core.limits`.
 
 from __future__ import annotations
 
+import hashlib
 import json
 import os
 import re
 import tempfile
 import zipfile
 import zlib
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
 from typing import IO, Any
@@ -116,6 +117,16 @@ def write_npz_atomic(
 
 
 # ---- reading -------------------------------------------------------------------------------------
+
+
+def sources_hash(files: Iterable[Path], root: Path) -> str:
+    """A cache-key part that changes with the code: 16 hex digits of sha256 over each existing
+    file's path (relative to ``root``) and content, in the order given."""
+    h = hashlib.sha256()
+    for f in files:
+        if f.is_file():
+            h.update(f.relative_to(root).as_posix().encode() + b"\0" + f.read_bytes() + b"\0")
+    return h.hexdigest()[:16]
 
 
 def read_bytes(

@@ -17,6 +17,7 @@ import numpy as np
 from core.config import RadarConfig
 from core.dataset import Dataset
 from core.errors import InputError
+from core.files import sources_hash
 from core.pipeline.frames import ProgressCallback, simulate_scene
 from core.pointcloud import PointCloud
 from core.scene import Scene, paper_scenes
@@ -47,11 +48,7 @@ def code_fingerprint() -> str:
     files = [root / name for name in _SIMULATION_SOURCES]
     for pkg in _SIMULATION_PACKAGES:
         files += sorted((root / pkg).rglob("*.py"))
-    h = hashlib.sha256()
-    for f in files:
-        if f.is_file():
-            h.update(f.relative_to(root).as_posix().encode() + b"\0" + f.read_bytes() + b"\0")
-    return h.hexdigest()[:16]
+    return sources_hash(files, root)
 
 
 def dataset_key(

@@ -19,7 +19,7 @@ import numpy as np
 
 from core.config import ProcessingSettings, RadarConfig
 from core.errors import InputError
-from core.files import read_npz, write_npz_atomic
+from core.files import read_npz, sources_hash, write_npz_atomic
 from core.pointcloud import PointCloud
 from core.simulation.antenna import AntennaGain
 from core.simulation.scatterers import Scatterers
@@ -101,11 +101,7 @@ def _chain_fingerprint() -> str:
     files = [root / "config.py", root / "pointcloud.py"]
     for pkg in ("simulation", "processing"):
         files += sorted((root / pkg).rglob("*.py"))
-    h = hashlib.sha256()
-    for f in files:
-        if f.is_file():
-            h.update(f.relative_to(root).as_posix().encode() + b"\0" + f.read_bytes() + b"\0")
-    return h.hexdigest()[:16]
+    return sources_hash(files, root)
 
 
 def _false_alarm_cache_path(radar: RadarConfig, settings: ProcessingSettings, n_frames: int):

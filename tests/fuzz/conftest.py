@@ -14,6 +14,7 @@ from hypothesis import HealthCheck, settings
 
 from core.cli import main
 from tests.fuzz.harness import BAD_KINDS, TALLY, format_tally, inputs_budget
+from tests.scenes import small_scene
 
 #: Fuzz tests in tests/fuzz/test_fuzz_inputs.py (the long profile shares its budget among them).
 N_FUZZ_TESTS = 8
@@ -35,22 +36,7 @@ settings.register_profile(
 )
 FUZZ_SETTINGS = settings.get_profile("fuzz-long" if _budget else "fuzz-short")
 
-SCENE = {
-    "schema_version": 1,
-    "radar": "paper",
-    "seed": 2,
-    "clutter_density_per_m2": 0.0,
-    "persons": [
-        {
-            "trajectory": {
-                "initial_position_m": [1.0, 5.0],
-                "initial_velocity_mps": [0.4, -1.0],
-                "acceleration_mps2": [0.0, 0.0],
-                "frames": 12,
-            }
-        }
-    ],
-}
+SCENE = small_scene(velocity_mps=(0.4, -1.0), frames=12)
 
 
 @pytest.fixture(scope="session")

@@ -19,23 +19,9 @@ from core.limits import (
     MAX_TRACKS,
     VARIANCE_RANGE,
 )
+from tests.scenes import small_scene
 
-SCENE = {
-    "schema_version": 1,
-    "radar": "paper",
-    "seed": 2,
-    "clutter_density_per_m2": 0.0,
-    "persons": [
-        {
-            "trajectory": {
-                "initial_position_m": [1.0, 5.0],
-                "initial_velocity_mps": [0.0, -1.2],
-                "acceleration_mps2": [0.0, 0.0],
-                "frames": 6,
-            }
-        }
-    ],
-}
+SCENE = small_scene()
 
 
 def run_cli(capsys, *argv: str) -> tuple[int, str, str]:

@@ -13,25 +13,11 @@ import pytest
 
 from core.cli import main
 from core.dataset import Dataset
+from tests.scenes import small_scene
 
 ROOT = Path(__file__).resolve().parents[2]
 
-SCENE = {
-    "schema_version": 1,
-    "radar": "paper",
-    "seed": 2,
-    "clutter_density_per_m2": 0.0,
-    "persons": [
-        {
-            "trajectory": {
-                "initial_position_m": [1.0, 5.0],
-                "initial_velocity_mps": [0.0, -1.2],
-                "acceleration_mps2": [0.0, 0.0],
-                "frames": 6,
-            }
-        }
-    ],
-}
+SCENE = small_scene()
 
 
 def write(tmp_path: Path, data, name: str = "scene.json") -> Path:
