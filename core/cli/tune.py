@@ -12,6 +12,7 @@ import json
 import signal
 import sys
 import time
+from typing import TYPE_CHECKING
 
 from core.cli.exit_codes import (
     EXIT_INPUT_ERROR,
@@ -21,6 +22,10 @@ from core.cli.exit_codes import (
     epilog,
 )
 from core.errors import InputError
+
+if TYPE_CHECKING:
+    from core.optimization.progress import TrialSummary
+    from core.optimization.study import StudySettings
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
@@ -61,6 +66,31 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         metavar="KEY=VALUE",
         help="quadratic objective options: n_trajectories, delay_s",
     )
+    p.add_argument(
+        "--loss",
+        default="paper",
+        help="what trials minimise: paper (L_t, eq. 14), capped, median or trimmed "
+        "(docs/tuning.md; the paper's L_t is always recorded; default: %(default)s)",
+    )
+    p.add_argument(
+        "--validation",
+        default=None,
+        help="validation data set: the best trials by training loss are tracked on it and the "
+        "best there is chosen (default for paper data sets: paper:1000; for a file: none)",
+    )
+    p.add_argument(
+        "--repeats",
+        type=int,
+        default=1,
+        help="K studies <study>-r0 … with sampler seeds seed … seed+K-1 and, on paper data "
+        "sets, training sets of seeds SEED … SEED+K-1; chosen by validation",
+    )
+    p.add_argument(
+        "--top-k",
+        type=int,
+        default=None,
+        help="trials of each study tracked on the validation set (default: 10)",
+    )
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     p.set_defaults(func=run)
 
@@ -78,12 +108,44 @@ def _options(items: list[str]) -> dict[str, float]:
     return out
 
 
-def run(args: argparse.Namespace) -> int:
-    from core.optimization.data import resolve_dataset
-    from core.optimization.progress import counted, study_progress
-    from core.optimization.study import StudySettings, start_study, worker_alive
+def _paper_seed(dataset: str | None) -> int | None:
+    """The seed of a ``paper`` / ``paper:SEED[:MODEL]`` data-set argument; None for a file."""
+    if dataset in (None, "", "paper"):
+        return 0
+    parts = str(dataset).split(":")
+    if parts[0] != "paper":
+        return None
+    try:
+        return int(parts[1])
+    except (IndexError, ValueError):
+        raise InputError(f"data set {dataset!r}: expected paper:SEED or paper:SEED:MODEL") from None
 
-    settings = StudySettings(
+
+def _training_sets(args: argparse.Namespace) -> list[str | None]:
+    """The training data-set argument of each repeat."""
+    from core.optimization.validation import check_training_seed
+
+    seed = _paper_seed(args.dataset)
+    if seed is None:
+        return [args.dataset] * args.repeats  # a file: repeats differ by sampler seed only
+    check_training_seed(seed, args.repeats)
+    model = str(args.dataset).split(":")[2:] if args.dataset else []
+    return [":".join(["paper", str(seed + i), *model]) for i in range(args.repeats)]
+
+
+def run(args: argparse.Namespace) -> int:
+    from core.evaluation.robust import check_objective
+    from core.optimization.data import resolve_dataset
+    from core.optimization.study import StudySettings
+    from core.optimization.validation import TOP_K, VALIDATION_SEED, check_same_radar
+
+    if args.repeats < 1:
+        raise InputError(f"--repeats must be >= 1, got {args.repeats}")
+    top_k = TOP_K if args.top_k is None else args.top_k
+    if top_k < 1:
+        raise InputError(f"--top-k must be >= 1, got {top_k}")
+    check_objective(args.loss)
+    base = StudySettings(
         model=args.model,
         n_trials=args.trials,
         n_jobs=args.jobs,
@@ -95,18 +157,95 @@ def run(args: argparse.Namespace) -> int:
         dataset=args.dataset,
         objective=args.objective,
         objective_options=_options(args.objective_option),
+        loss=args.loss,
     )
-    path = None
-    if settings.objective == "tracker":
-        if args.dataset in (None, "", "paper") or str(args.dataset).startswith("paper:"):
+    # every data set is resolved and checked before any study is touched
+    plans: list[tuple[StudySettings, str | None]] = []
+    validation: str | None = None
+    if base.objective == "tracker":
+        if any(_paper_seed(d) is not None for d in [args.dataset, args.validation] if d):
             print(
-                "data set: the paper's (simulated once and cached; minutes the first time)",
+                "data sets: the paper's (simulated once and cached; minutes the first time)",
                 file=sys.stderr,
             )
-        path = resolve_dataset(args.dataset, person_model=args.person_model)
+        sets = _training_sets(args)
+        paths = [resolve_dataset(d, person_model=args.person_model) for d in sets]
+        val_arg = args.validation
+        if val_arg is None and _paper_seed(args.dataset) is not None:
+            model = str(args.dataset).split(":")[2:] if args.dataset else []
+            val_arg = ":".join(["paper", str(VALIDATION_SEED), *model])
+        if val_arg is not None:
+            val_seed = _paper_seed(val_arg)
+            if val_seed is not None and val_seed < VALIDATION_SEED:
+                raise InputError(
+                    f"--validation {val_arg!r}: paper seeds below {VALIDATION_SEED} are "
+                    "training sets; use paper:SEED with SEED >= 1000"
+                )
+            validation = resolve_dataset(val_arg, person_model=args.person_model)
+            if validation in paths:
+                raise InputError(f"--validation {val_arg!r} is a training set of this run")
+            check_same_radar(paths[0], validation, "validation")
+        for i, train_path in enumerate(paths):
+            check_same_radar(paths[0], train_path, "training")
+            plans.append((_repeat(base, i, args.repeats, dataset=sets[i]), train_path))
+    else:
+        plans = [(_repeat(base, i, args.repeats, dataset=None), None) for i in range(args.repeats)]
+    chosen = []
+    for settings, path in plans:
+        code, best = run_study(settings, path, progress=not args.no_progress)
+        if code != EXIT_OK:
+            return code
+        record: dict = {"study": settings.name}
+        if best is not None:
+            record.update(best_trial=best.number, best_loss=best.value)
+            record["params"] = best.tracker_params(settings.model)
+        if validation is not None and best is not None:
+            from core.optimization.validation import validate_study
+
+            validated = validate_study(settings.storage, settings.name, validation, top_k=top_k)
+            top = validated[0]
+            record.update(top.to_dict())
+            print(
+                f"study {settings.name}: chosen trial {top.number} by validation: "
+                f"{args.loss} {top.validation_value:.4g} (training {top.train_value:.4g})",
+                file=sys.stderr,
+            )
+        chosen.append(record)
+    out: dict = {"loss": args.loss, "validation": validation, "studies": chosen}
+    if chosen and all("params" in r for r in chosen):
+        key = "validation_value" if validation is not None else "best_loss"
+        win = min(chosen, key=lambda r: (r[key], r["study"]))
+        out.update(
+            chosen_study=win["study"],
+            best_trial=win.get("trial", win["best_trial"]),
+            best_loss=win.get("train_value", win["best_loss"]),
+            params=win["params"],
+        )
+        if validation is not None:
+            out["validation_value"] = win["validation_value"]
+    print(json.dumps(out))
+    return EXIT_OK
+
+
+def _repeat(base: StudySettings, i: int, n: int, *, dataset: str | None) -> StudySettings:
+    """The settings of repeat ``i`` of ``n`` (the base settings themselves when n = 1)."""
+    from dataclasses import replace
+
+    if n == 1:
+        return base
+    return replace(base, study_name=f"{base.name}-r{i}", seed=base.seed + i, dataset=dataset)
+
+
+def run_study(
+    settings: StudySettings, path: str | None, *, progress: bool = True
+) -> tuple[int, TrialSummary | None]:
+    """Create or resume one study, run its workers to the total; (exit code, best trial)."""
+    from core.optimization.progress import counted, study_progress
+    from core.optimization.study import start_study, worker_alive
+
     handle = start_study(settings, dataset_path=path)
     bar = None
-    if not args.no_progress:
+    if progress:
         from tqdm import tqdm
 
         bar = tqdm(total=settings.n_trials, desc=settings.name, unit="trial", file=sys.stderr)
@@ -120,7 +259,7 @@ def run(args: argparse.Namespace) -> int:
             if bar is not None:
                 bar.n = min(counted(summaries), settings.n_trials)
                 if best is not None:
-                    bar.set_postfix_str(f"best L_t={best.value:.4g} (#{best.number})")
+                    bar.set_postfix_str(f"best={best.value:.4g} (#{best.number})")
                 bar.refresh()
             if not running:
                 # another run's (or a joined worker's) live trial may hold the last slots: the
@@ -146,18 +285,9 @@ def run(args: argparse.Namespace) -> int:
     codes = handle.returncodes()
     n = counted(summaries)
     print(f"study {settings.name}: {n} of {settings.n_trials} trials counted", file=sys.stderr)
-    if best is not None:
-        print(
-            json.dumps(
-                {
-                    "best_trial": best.number,
-                    "best_loss": best.value,
-                    "params": best.tracker_params(settings.model),
-                }
-            )
-        )
     pids = [p.pid for p in handle.procs]
-    return exit_code(codes, pids, n, settings.n_trials, settings.name, interrupted=interrupted)
+    code = exit_code(codes, pids, n, settings.n_trials, settings.name, interrupted=interrupted)
+    return code, best
 
 
 def _ending(code: int) -> str:

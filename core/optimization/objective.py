@@ -22,15 +22,24 @@ import math
 import time
 from collections.abc import Collection, Sequence
 from dataclasses import dataclass, field
-from typing import Any, Protocol
+from typing import Any, NamedTuple, Protocol
 
 import numpy as np
 
 from core.errors import InputError
+from core.evaluation.loss import NO_CONFIRMATION_LOSS
+from core.evaluation.robust import OBJECTIVES, aggregate, check_objective
 from core.optimization.space import P0_NAMES, check_model, search_space, tracker_params_dict
 
-#: score of a trajectory without any confirmed frame (SPEC §5), m²
-NO_CONFIRMATION_LOSS = 1.0
+
+class TrajectoryScore(NamedTuple):
+    """One trajectory's scores: the paper's ``L(k)`` (m², eq. 13), ``MSE(k)`` (m², NaN when
+    ``N_c = 0``), ``N_c(k)`` and the capped loss ``C(k)`` (m², :mod:`core.evaluation.robust`)."""
+
+    loss: float
+    mse: float
+    n_c: int
+    capped: float
 
 
 class TrajectoryLosses(Protocol):
@@ -41,7 +50,7 @@ class TrajectoryLosses(Protocol):
         """Class label of each trajectory, length K."""
         ...
 
-    def losses(self, params: dict[str, Any], ks: Sequence[int]) -> list[tuple[float, float, int]]:
+    def losses(self, params: dict[str, Any], ks: Sequence[int]) -> list[TrajectoryScore]:
         """``(L(k), MSE(k), N_c(k))`` of each trajectory ``k`` in ``ks`` for TrackerParams JSON."""
         ...
 
@@ -84,10 +93,10 @@ class QuadraticLosses:
             return self.classes
         return tuple("abcde"[k % 5] for k in range(self.n_trajectories))
 
-    def losses(self, params: dict[str, Any], ks: Sequence[int]) -> list[tuple[float, float, int]]:
+    def losses(self, params: dict[str, Any], ks: Sequence[int]) -> list[TrajectoryScore]:
         return [self._loss(params, k) for k in ks]
 
-    def _loss(self, params: dict[str, Any], k: int) -> tuple[float, float, int]:
+    def _loss(self, params: dict[str, Any], k: int) -> TrajectoryScore:
         if self.delay_s:
             time.sleep(self.delay_s)
         p = dict(params)
@@ -104,7 +113,7 @@ class QuadraticLosses:
         # L(k) = L_min (1 + w_k |u - c|^2)
         value = self.loss_min * (1.0 + w * d2)
         n_c = 100
-        return value, value * n_c, n_c
+        return TrajectoryScore(value, value * n_c, n_c, value)
 
 
 class TrackerLosses:
@@ -132,8 +141,9 @@ class TrackerLosses:
         flat = {b.name: b.high for b in search_space(model)}
         self.losses(tracker_params_dict(flat, model), [0])
 
-    def losses(self, params: dict[str, Any], ks: Sequence[int]) -> list[tuple[float, float, int]]:
+    def losses(self, params: dict[str, Any], ks: Sequence[int]) -> list[TrajectoryScore]:
         from core.evaluation import tracked_person_xy, trajectory_loss
+        from core.evaluation.robust import capped_loss
         from core.tracking import TrackerParams, track_dataset
 
         if not len(ks):
@@ -146,16 +156,24 @@ class TrackerLosses:
         for i in range(len(ks)):
             s = slice(int(est.offsets[i]), int(est.offsets[i + 1]))
             value, mse, n_c = trajectory_loss(est.estimate_xy[s], est.has_estimate[s], truth[s])
-            out.append((float(value), float(mse), int(n_c)))
+            capped = capped_loss(est.estimate_xy[s], est.has_estimate[s], truth[s])
+            out.append(TrajectoryScore(float(value), float(mse), int(n_c), capped))
         return out
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
 class TrialResult:
-    """Outcome of evaluating one parameter set on all (or a pruned prefix of) trajectories."""
+    """Outcome of evaluating one parameter set on all (or a pruned prefix of) trajectories.
+
+    ``value`` is the study's objective (:data:`core.evaluation.robust.OBJECTIVES`);
+    ``paper_value`` the paper's ``L_t`` (eq. 14) of the same trajectories, always computed;
+    ``losses`` the paper's ``L(k)`` and ``capped`` the capped ``C(k)`` per trajectory.
+    """
 
     value: float
+    paper_value: float
     losses: tuple[float, ...]
+    capped: tuple[float, ...]
     mse: tuple[float, ...]
     n_c: tuple[int, ...]
     order: tuple[int, ...]
@@ -174,8 +192,10 @@ def evaluate(
     trial: Reports | None = None,
     pruner: str = "asha",
     prune_steps: Collection[int] | None = None,
+    loss: str = "paper",
 ) -> TrialResult:
-    """L_t of ``params`` (eq. 14), reporting to ``trial`` after every trajectory.
+    """The objective ``loss`` of ``params`` (default L_t, eq. 14), reported after every
+    trajectory.
 
     Parameters
     ----------
@@ -192,13 +212,19 @@ def evaluate(
         Steps after which ``should_prune`` is asked (None: every step). Successive halving only
         acts at its rungs, so asking there alone gives the same decisions with fewer storage
         reads.
+    loss
+        The objective (:data:`core.evaluation.robust.OBJECTIVES`): ``"paper"`` (L_t),
+        ``"capped"``, ``"median"`` or ``"trimmed"``. ASHA is told the objective of the
+        trajectories done so far; Wilcoxon the per-trajectory loss the objective uses.
 
     Returns
     -------
     TrialResult
-        ``value`` is L_t in m² (the running mean at the pruning point if pruned). A NaN or
-        infinite trajectory loss is an error (the tracker must never produce one).
+        ``value`` is the objective in m² (of the trajectories done at the pruning point if
+        pruned). A NaN or infinite trajectory loss is an error (the tracker must never produce
+        one).
     """
+    per_trajectory, how = OBJECTIVES[check_objective(loss)]
     order = round_robin_order(losses.trajectory_classes)
     if not order:
         raise InputError("the data set has no trajectories")
@@ -213,41 +239,44 @@ def evaluate(
     else:
         ends = sorted({i for i in prune_steps if 0 < i < n} | {n})
     ls: list[float] = []
+    cs: list[float] = []
     ms: list[float] = []
     ns: list[int] = []
+    used = cs if per_trajectory == "capped" else ls  # the per-trajectory loss the objective uses
+
+    def result(pruned: bool) -> TrialResult:
+        return TrialResult(
+            value=aggregate(used, how),
+            paper_value=float(np.mean(ls)),
+            losses=tuple(ls),
+            capped=tuple(cs),
+            mse=tuple(ms),
+            n_c=tuple(ns),
+            order=tuple(order[: len(ls)]),
+            pruned=pruned,
+        )
+
     start = 0
     for end in ends:
-        for value, mse, n_c in losses.losses(params, order[start:end]):
+        for score in losses.losses(params, order[start:end]):
             k = order[len(ls)]
-            if not math.isfinite(value):
-                raise FloatingPointError(f"trajectory {k}: loss is {value}")
-            ls.append(value)
-            ms.append(mse)
-            ns.append(n_c)
+            for name, value in (("loss", score.loss), ("capped loss", score.capped)):
+                if not math.isfinite(value):
+                    raise FloatingPointError(f"trajectory {k}: {name} is {value}")
+            ls.append(score.loss)
+            cs.append(score.capped)
+            ms.append(score.mse)
+            ns.append(score.n_c)
             if trial is not None and pruner != "none":
                 if pruner == "wilcoxon":
-                    trial.report(value, k)
+                    trial.report(used[-1], k)
                 else:
-                    # running mean after i trajectories: L̄_i = (1/i) Σ_j L(k_j)
-                    trial.report(float(np.mean(ls)), len(ls))
+                    # the objective of the first i trajectories (for L_t: L̄_i = (1/i) Σ_j L(k_j))
+                    trial.report(aggregate(used, how), len(ls))
         start = end
         if trial is not None and pruner != "none" and end < n and trial.should_prune():
-            return TrialResult(
-                value=float(np.mean(ls)),
-                losses=tuple(ls),
-                mse=tuple(ms),
-                n_c=tuple(ns),
-                order=tuple(order[:end]),
-                pruned=True,
-            )
-    return TrialResult(
-        value=float(np.mean(ls)),
-        losses=tuple(ls),
-        mse=tuple(ms),
-        n_c=tuple(ns),
-        order=tuple(order),
-        pruned=False,
-    )
+            return result(pruned=True)
+    return result(pruned=False)
 
 
 def make_losses(objective: str, model: str, dataset: Any = None, **kwargs: Any) -> TrajectoryLosses:
@@ -271,6 +300,7 @@ __all__ = [
     "QuadraticLosses",
     "TrackerLosses",
     "TrajectoryLosses",
+    "TrajectoryScore",
     "TrialResult",
     "evaluate",
     "make_losses",

@@ -42,6 +42,7 @@ from typing import Any
 import numpy as np
 
 from core.errors import InputError
+from core.evaluation.robust import check_objective
 from core.optimization.objective import evaluate, make_losses
 from core.optimization.space import check_model, suggest_params, tracker_params_dict
 from core.optimization.storage import (
@@ -90,6 +91,10 @@ class StudySettings:
         Path of a data set ``.npz``; None: the paper's data set (seed 0, 35 trajectories, cached).
     objective
         ``"tracker"`` (the IPDA tracker on the data set) or ``"quadratic"`` (test objective).
+    loss
+        What a trial minimises (:data:`core.evaluation.robust.OBJECTIVES`): ``"paper"`` (the
+        paper's L_t, eq. 14), ``"capped"``, ``"median"`` or ``"trimmed"``. The paper's L_t is
+        recorded beside it on every trial (user attribute ``paper_loss``).
     objective_options
         Options of the quadratic objective (``n_trajectories``, ``delay_s``).
     """
@@ -105,6 +110,7 @@ class StudySettings:
     dataset: str | None = None
     objective: str = "tracker"
     objective_options: dict[str, float] = field(default_factory=dict)
+    loss: str = "paper"
 
     def __post_init__(self) -> None:
         check_model(self.model)
@@ -120,6 +126,7 @@ class StudySettings:
             raise InputError(
                 f"objective must be one of {', '.join(OBJECTIVES)}, got {self.objective!r}"
             )
+        check_objective(self.loss)
         normalize_url(self.storage)
 
     @property
@@ -304,13 +311,15 @@ def prepare_study(settings: StudySettings, *, dataset_path: str | None = None) -
         "pruner": settings.pruner,
         "seed": int(settings.seed),
         "objective_options": dict(settings.objective_options),
+        "loss": settings.loss,
         "space": "paper-eq15",
     }
     study = load_existing_study(storage, settings.name)
     if study is not None:
         old = study.user_attrs
-        for key in ("model", "objective", "sampler", "pruner"):
-            if old.get(key) != attrs[key]:
+        for key in ("model", "objective", "sampler", "pruner", "loss"):
+            # a study made before robust objectives existed minimised the paper's loss
+            if old.get(key, "paper" if key == "loss" else None) != attrs[key]:
                 raise InputError(
                     f"study {settings.name!r} in {redact(settings.storage)} has {key}="
                     f"{old.get(key)!r}, asked {attrs[key]!r}; use another --study name"
@@ -437,7 +446,12 @@ def run_worker(
                 break
             params = tracker_params_dict(suggest_params(trial, model), model)
             result = evaluate(
-                losses, params, trial=trial, pruner=attrs["pruner"], prune_steps=prune_steps
+                losses,
+                params,
+                trial=trial,
+                pruner=attrs["pruner"],
+                prune_steps=prune_steps,
+                loss=str(attrs.get("loss", "paper")),
             )
         except KeyboardInterrupt:
             study.tell(trial, state=TrialState.FAIL)
@@ -456,6 +470,8 @@ def run_worker(
                 ) from None
             continue
         failures = 0
+        if attrs.get("loss", "paper") != "paper":  # else the trial's value is L_t itself
+            trial.set_user_attr("paper_loss", result.paper_value)
         if result.pruned:
             study.tell(trial, state=TrialState.PRUNED)
         else:

@@ -1,0 +1,120 @@
+"""Robust objectives: losses that rare events cannot swamp, beside the paper's L_t.
+
+The paper's loss of a trajectory, ``L(k) = MSE(k) / N_c(k)`` (eq. 13), is 1 m² for a trajectory
+never confirmed and grows with the square of the error of a track seduced by clutter: one such
+trajectory can make most of ``L_t = mean_k L(k)`` (eq. 14). Two ways to bound the influence of one
+trajectory, used by the study objectives (:data:`OBJECTIVES`):
+
+- **capped** per-frame error, as GOSPA (α = 2, p = 2) scores one person: in every frame in which
+  the person is present,
+
+  ``d_f = min(|x̂_f − x_f|, c)²``  if a confirmed estimate exists (an error beyond ``c`` counts as
+  ``c²``: a track on clutter costs no more than being lost), and
+  ``d_f = c² / 2``  if none (GOSPA's cost of a missed target with α = 2),
+
+  and ``C(k) = mean_f d_f``. A frame cannot cost more than ``c²``, so a trajectory cannot cost
+  more than ``c²`` either; a trajectory never confirmed costs ``c² / 2``.
+- **aggregation** over trajectories other than the mean: the median of ``L(k)``, or the mean of
+  ``L(k)`` without its largest ``TRIM_FRACTION`` (a one-sided trimmed mean: only the tail that
+  dominates is cut).
+
+The paper's ``L_t`` is always computed beside whichever objective a study minimises.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+
+import numpy as np
+
+from core.errors import InputError
+
+#: Cut-off of the capped loss (m): an error beyond it is as bad as a lost track.
+CAPPED_CUTOFF_M = 0.5
+#: Fraction of the largest trajectory losses left out by the trimmed mean.
+TRIM_FRACTION = 0.1
+#: Study objectives: name → (per-trajectory loss, aggregation over trajectories).
+OBJECTIVES: dict[str, tuple[str, str]] = {
+    "paper": ("paper", "mean"),
+    "capped": ("capped", "mean"),
+    "median": ("paper", "median"),
+    "trimmed": ("paper", "trimmed"),
+}
+
+
+def check_objective(name: str) -> str:
+    """``name`` if it is one of :data:`OBJECTIVES`, else one :class:`InputError` line."""
+    if name not in OBJECTIVES:
+        raise InputError(f"loss must be one of {', '.join(OBJECTIVES)}, got {name!r}")
+    return name
+
+
+def capped_loss(
+    estimate_xy: np.ndarray,
+    has_estimate: np.ndarray,
+    truth_xy: np.ndarray,
+    cutoff_m: float = CAPPED_CUTOFF_M,
+) -> float:
+    """``C(k)``: the mean capped squared error of one trajectory (m²).
+
+    Parameters
+    ----------
+    estimate_xy
+        Estimated position (N, 2) in m (ignored where ``has_estimate`` is False).
+    has_estimate
+        (N,) bool, a confirmed track exists in the frame.
+    truth_xy
+        Ground truth (N, 2) in m, NaN where the person is absent (those frames are not scored).
+    cutoff_m
+        ``c`` in m, > 0.
+
+    Returns
+    -------
+    float
+        ``mean_f d_f`` over the frames with the person present; 0 when there is none.
+    """
+    if not cutoff_m > 0:
+        raise InputError(f"cutoff_m must be > 0, got {cutoff_m}")
+    truth = np.asarray(truth_xy, dtype=np.float64)
+    present = np.all(np.isfinite(truth), axis=1)
+    n = int(present.sum())
+    if n == 0:
+        return 0.0
+    has = np.asarray(has_estimate, dtype=bool)[present]
+    e = np.asarray(estimate_xy, dtype=np.float64)[present] - truth[present]
+    c2 = cutoff_m * cutoff_m
+    # d_f = min(|x̂ − x|, c)² with an estimate, c²/2 without
+    d = np.where(has, np.minimum(np.sum(e * e, axis=1), c2), 0.5 * c2)
+    return float(np.sum(d) / n)
+
+
+def trimmed_mean(values: Sequence[float], fraction: float = TRIM_FRACTION) -> float:
+    """Mean of ``values`` without their largest ``floor(fraction · n)`` (at least one stays)."""
+    v = np.sort(np.asarray(values, dtype=np.float64))
+    if v.size == 0:
+        return math.nan
+    keep = v.size - min(int(math.floor(fraction * v.size)), v.size - 1)
+    return float(np.mean(v[:keep]))
+
+
+def aggregate(values: Sequence[float], how: str) -> float:
+    """Trajectory losses → one objective value: ``"mean"``, ``"median"`` or ``"trimmed"``."""
+    if how == "mean":
+        return float(np.mean(values))
+    if how == "median":
+        return float(np.median(values))
+    if how == "trimmed":
+        return trimmed_mean(values)
+    raise InputError(f"aggregation must be mean, median or trimmed, got {how!r}")
+
+
+__all__ = [
+    "CAPPED_CUTOFF_M",
+    "OBJECTIVES",
+    "TRIM_FRACTION",
+    "aggregate",
+    "capped_loss",
+    "check_objective",
+    "trimmed_mean",
+]
