@@ -138,8 +138,13 @@ class TrackerLosses:
 
     def warm_up(self, model: str) -> None:
         """Load the compiled tracker (numba) before the first trial, so trial times are honest."""
+        from core.tracking import TrackerParams
+        from core.tracking.warm import load_compiled
+
         flat = {b.name: b.high for b in search_space(model)}
-        self.losses(tracker_params_dict(flat, model), [0])
+        load_compiled(
+            TrackerParams.from_dict({**self.base_params, **tracker_params_dict(flat, model)})
+        )
 
     def losses(self, params: dict[str, Any], ks: Sequence[int]) -> list[TrajectoryScore]:
         from core.evaluation import tracked_person_xy, trajectory_loss
