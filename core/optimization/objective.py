@@ -211,7 +211,8 @@ def evaluate(
     trial
         Optuna trial (or anything with ``report``/``should_prune``); None: no reporting.
     pruner
-        ``"asha"`` reports the running mean at step i (1-based count of trajectories done);
+        ``"asha"`` reports the running mean at step i (1-based count of trajectories done)
+        after every trajectory, or only at ``prune_steps`` and the last step when given;
         ``"wilcoxon"`` reports L(k) at step k; ``"none"`` reports nothing.
     prune_steps
         Steps after which ``should_prune`` is asked (None: every step). Successive halving only
@@ -275,8 +276,10 @@ def evaluate(
             if trial is not None and pruner != "none":
                 if pruner == "wilcoxon":
                     trial.report(used[-1], k)
-                else:
-                    # the objective of the first i trajectories (for L_t: L̄_i = (1/i) Σ_j L(k_j))
+                elif prune_steps is None or len(ls) == end:
+                    # the objective of the first i trajectories (for L_t: L̄_i = (1/i) Σ_j L(k_j)),
+                    # reported where the pruner decides (and at the end): every report is a
+                    # storage write, and successive halving reads only the values at its rungs
                     trial.report(aggregate(used, how), len(ls))
         start = end
         if trial is not None and pruner != "none" and end < n and trial.should_prune():

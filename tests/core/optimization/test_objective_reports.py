@@ -62,6 +62,15 @@ def test_running_mean_is_reported_after_every_trajectory() -> None:
     assert rec.asked == list(range(1, 10))
 
 
+def test_with_rungs_the_running_mean_is_reported_at_the_rungs_and_the_end() -> None:
+    q = QuadraticLosses(model="cv", n_trajectories=35)
+    rec = Recorder()
+    res = evaluate(q, dict(centre("cv"), r11=0.5), trial=rec, pruner="asha", prune_steps={5, 15})
+    assert [s for s, _ in rec.reports] == [5, 15, 35] and rec.asked == [5, 15]
+    running = np.cumsum(res.losses) / np.arange(1, 36)
+    np.testing.assert_allclose([v for _, v in rec.reports], running[[4, 14, 34]], rtol=1e-12)
+
+
 def test_pruning_stops_early_with_the_running_mean() -> None:
     q = QuadraticLosses(model="cv", n_trajectories=10)
     rec = Recorder(prune_at=5)
