@@ -179,3 +179,28 @@ def test_wrong_sample_format_names_line_and_field(lines: str, field: str) -> Non
     with pytest.raises(InputError, match=field) as err:
         adc_format(parse_ti_cfg(text, "x.cfg"), "x.cfg")
     assert f"x.cfg:{len(text.splitlines())}" in str(err.value)
+
+
+@pytest.mark.slow
+def test_one_gigabyte_capture_streams_in_bounded_memory(tmp_path: Path) -> None:
+    """A 1 GiB capture (sparse: zeros) is read frame by frame; Python allocations stay within a
+    few frames whatever the file's size."""
+    import tracemalloc
+
+    lay = CaptureLayout(n_loops=32, n_tx=3, n_rx=4, n_samples=256)
+    path = tmp_path / "big.bin"
+    n_frames = (1 << 30) // lay.frame_bytes
+    with path.open("wb") as fh:
+        fh.truncate(n_frames * lay.frame_bytes)
+    cap = open_capture(path, lay)
+    assert cap.n_frames == n_frames == 2730
+    from core.formats.dca1000 import iter_raw_frames
+
+    tracemalloc.start()
+    try:
+        seen = sum(1 for words in iter_raw_frames(cap) if words.shape == (lay.frame_words,))
+        _, peak = tracemalloc.get_traced_memory()
+    finally:
+        tracemalloc.stop()
+    assert seen == n_frames
+    assert peak < 4 * lay.frame_bytes
