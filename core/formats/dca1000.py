@@ -228,11 +228,11 @@ def open_capture(
     src = printable(str(p))
     cfg = printable(str(cfg_path))
     try:
-        size = p.stat().st_size
-        if not p.is_file():
-            raise InputError("not a file", src)
+        is_file, size = p.is_file(), p.stat().st_size
     except (OSError, ValueError) as exc:
         raise InputError(f"cannot read capture ({type(exc).__name__})", src) from None
+    if not is_file:
+        raise InputError("capture is not a file", src)
     lay = layout
     if size == 0:
         raise InputError("empty capture (0 bytes)", src)

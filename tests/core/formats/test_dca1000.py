@@ -136,6 +136,8 @@ def test_size_mismatch_is_one_line_naming_both_files(
 def test_missing_capture_is_input_error(tmp_path: Path) -> None:
     with pytest.raises(InputError, match="cannot read capture"):
         open_capture(tmp_path / "absent.bin", SMALL)
+    with pytest.raises(InputError, match="capture is not a file"):
+        open_capture(tmp_path, SMALL)
 
 
 CFG_HEAD = """channelCfg 15 5 0
