@@ -45,6 +45,10 @@ from core.scene import Scene
 #: 16-bit range then holds a sample 20 log10(32767 / (8 sqrt 2)) = 69 dB above the noise, and the
 #: rounding adds 1/12 count² to 64: 0.006 dB.
 ADC_NOISE_RMS_COUNTS = 8.0
+#: ``adcbufCfg`` of the SDK configurations ``ti_cfg_text`` writes (sampleSwap 1: Q before I) and
+#: of written captures (sampleSwap 0: I before Q, TI's documented DCA1000 order).
+SDK_ADCBUF_CFG = "adcbufCfg -1 0 1 1 1"
+CAPTURE_ADCBUF_CFG = "adcbufCfg -1 0 0 1 1"
 #: The trajectory class of a recorded data set.
 RECORDED_CLASS = "real"
 #: The ``fidelity`` a data set read from a capture records.
@@ -268,7 +272,13 @@ def write_capture(
     if cfg_path == bin_path:
         raise InputError("the capture needs a suffix other than .cfg", printable(str(bin_path)))
     radar = scene.radar
-    text = ti_cfg_text(radar, comment=f"DCA1000 capture {bin_path.name} written by RadarTune")
+    text = ti_cfg_text(
+        radar,
+        comment=f"DCA1000 capture {bin_path.name} written by RadarTune; I before Q as TI "
+        "documents the DCA1000 layout (adcbufCfg sampleSwap 0)",
+    )
+    # I first: what TI's, mmWave Studio's and OpenRadar-style readers assume
+    text = text.replace(f"\n{SDK_ADCBUF_CFG}\n", f"\n{CAPTURE_ADCBUF_CFG}\n")
     layout = CaptureLayout.from_radar(radar, adc_format(parse_ti_cfg(text)))
     clipped = [0]
 

@@ -98,6 +98,16 @@ def test_written_samples_are_the_exact_chains(scene: Scene) -> None:
     assert abs(ours.snr_db[0] - exact.snr_db[0]) < 0.1
 
 
+def test_written_capture_is_i_first_as_ti_documents(scene: Scene, tmp_path: Path) -> None:
+    """The first chirp's first words are I(0) I(1) Q(0) Q(1) of virtual channel 0, and the .cfg
+    says so (sampleSwap 0)."""
+    bin_path, cfg_path = write_capture(scene, tmp_path / "s.bin")
+    assert read_ti_capture_cfg(cfg_path)[1] == AdcFormat(iq_swap=False)
+    i, q, _ = next(iter_adc_frames(scene))
+    words = np.fromfile(bin_path, dtype="<i2", count=4)
+    assert words.tolist() == [i[0, 0, 0], i[0, 0, 1], q[0, 0, 0], q[0, 0, 1]]
+
+
 def test_quantise_rounds_and_saturates() -> None:
     cube = np.array([0.4 + 1.6j, -2.5 - 1e9j, 1e9 + 0j])
     i, q, n = quantise(cube, 1.0)
