@@ -53,6 +53,7 @@ TI_COMMAND_FIELDS: dict[str, tuple[str, ...]] = {
         "adcStartTimeVar",
         "txEnable",
     ),
+    "adcbufCfg": ("subFrameIdx", "adcOutputFmt", "sampleSwap", "chanInterleave", "chirpThreshold"),
     "frameCfg": (
         "chirpStartIdx",
         "chirpEndIdx",
@@ -83,6 +84,10 @@ _TI_INT_FIELDS = {
     "numLoops",
     "numFrames",
     "triggerSelect",
+    "subFrameIdx",
+    "sampleSwap",
+    "chanInterleave",
+    "chirpThreshold",
 }
 
 
@@ -144,9 +149,13 @@ def _ti_require(cond: bool, cmd: TiCommand, field_name: str, message: str, sourc
 
 
 def radar_from_ti_commands(
-    commands: list[TiCommand], source: str = "<cfg>", name: str = "ti"
+    commands: list[TiCommand], source: str = "<cfg>", name: str = "ti", *, real_ok: bool = False
 ) -> RadarConfig:
-    """Build a :class:`RadarConfig` from parsed TI commands (see :func:`read_ti_cfg`)."""
+    """Build a :class:`RadarConfig` from parsed TI commands (see :func:`read_ti_cfg`).
+
+    ``real_ok``: accept real-only sampling (``adcCfg`` format 0; raw ADC captures) instead of
+    refusing it; the configuration is then the complex one's (see :func:`adc_format`).
+    """
     known = {c.name: c for c in commands if c.name in TI_COMMAND_FIELDS and c.name != "chirpCfg"}
     for needed in ("channelCfg", "profileCfg", "chirpCfg", "frameCfg"):
         if needed != "chirpCfg" and needed not in known:
@@ -162,7 +171,7 @@ def radar_from_ti_commands(
         adc_cmd = known["adcCfg"]
         adc = _ti_fields(adc_cmd, source)
         _ti_require(
-            adc["adcOutputFmt"] in (1, 2),
+            adc["adcOutputFmt"] in ((0, 1, 2) if real_ok else (1, 2)),
             adc_cmd,
             "adcOutputFmt",
             f"only complex sampling (1 or 2) is supported, got {adc['adcOutputFmt']}",
@@ -275,6 +284,87 @@ def read_ti_cfg(path: str | os.PathLike) -> RadarConfig:
     p = Path(path)
     text = read_text(p, what="TI configuration")
     return radar_from_ti_commands(parse_ti_cfg(text, str(p)), str(p), name=p.stem)
+
+
+#: ``adcCfg`` numADCBits code -> bits per sample (TI mmWave SDK user guide).
+ADC_BITS = {0: 12, 1: 14, 2: 16}
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class AdcFormat:
+    """How the ADC samples of a raw capture are coded (``adcCfg`` and ``adcbufCfg``).
+
+    Parameters
+    ----------
+    complex_samples
+        Complex (I and Q) samples; False: real-only (``adcCfg`` format 0, ``adcbufCfg`` 1).
+    iq_swap
+        ``adcbufCfg`` sampleSwap 1 ("Q in LSB, I in MSB"): Q is stored before I.
+    n_bits
+        Significant bits per 16-bit word (12, 14 or 16; ``adcCfg`` numADCBits 0, 1, 2).
+    """
+
+    complex_samples: bool = True
+    iq_swap: bool = False
+    n_bits: int = 16
+
+
+def adc_format(commands: list[TiCommand], source: str = "<cfg>") -> AdcFormat:
+    """The :class:`AdcFormat` of parsed TI commands.
+
+    Without ``adcCfg``: 16-bit complex; without ``adcbufCfg``: I before Q (TI's documented
+    DCA1000 layout). ``adcbufCfg`` is read with (SDK 2 and later) or without (SDK 1) its
+    subFrameIdx field. Interleaved channels (chanInterleave 0, xWR14xx) are refused: that layout
+    is not the one the DCA1000 records for xWR16xx/18xx/68xx.
+    """
+    known = {c.name: c for c in commands}
+    n_bits, complex_samples = 16, True
+    if "adcCfg" in known:
+        cmd = known["adcCfg"]
+        adc = _ti_fields(cmd, source)
+        code = int(adc["numADCBits"])
+        _ti_require(code in ADC_BITS, cmd, "numADCBits", f"0, 1 or 2 expected, got {code}", source)
+        fmt = int(adc["adcOutputFmt"])
+        _ti_require(fmt in (0, 1, 2), cmd, "adcOutputFmt", f"0, 1 or 2 expected, got {fmt}", source)
+        n_bits, complex_samples = ADC_BITS[code], fmt != 0
+    iq_swap = False
+    if "adcbufCfg" in known:
+        cmd = known["adcbufCfg"]
+        if len(cmd.args) == 4:  # SDK 1.x: no subFrameIdx
+            cmd = TiCommand(name=cmd.name, args=("-1", *cmd.args), line=cmd.line)
+        buf = _ti_fields(cmd, source)
+        fmt, swap = int(buf["adcOutputFmt"]), int(buf["sampleSwap"])
+        _ti_require(fmt in (0, 1), cmd, "adcOutputFmt", f"0 or 1 expected, got {fmt}", source)
+        _ti_require(
+            (fmt == 0) == complex_samples,
+            cmd,
+            "adcOutputFmt",
+            f"{'real' if fmt else 'complex'} disagrees with adcCfg's "
+            f"{'complex' if complex_samples else 'real'} samples",
+            source,
+        )
+        _ti_require(swap in (0, 1), cmd, "sampleSwap", f"0 or 1 expected, got {swap}", source)
+        _ti_require(
+            int(buf["chanInterleave"]) == 1,
+            cmd,
+            "chanInterleave",
+            f"only non-interleaved channels (1) are supported, got {buf['chanInterleave']}",
+            source,
+        )
+        iq_swap = swap == 1
+    return AdcFormat(complex_samples=complex_samples, iq_swap=iq_swap, n_bits=n_bits)
+
+
+def read_ti_capture_cfg(path: str | os.PathLike) -> tuple[RadarConfig, AdcFormat]:
+    """The radar and the ADC sample format of the ``.cfg`` that made a raw ADC capture.
+
+    As :func:`read_ti_cfg`, but real-only sampling is accepted (its format says so).
+    """
+    p = Path(path)
+    text = read_text(p, what="TI configuration")
+    commands = parse_ti_cfg(text, str(p))
+    radar = radar_from_ti_commands(commands, str(p), name=p.stem, real_ok=True)
+    return radar, adc_format(commands, str(p))
 
 
 def ti_cfg_text(radar: RadarConfig, comment: str = "") -> str:

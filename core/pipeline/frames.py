@@ -6,6 +6,7 @@ import json
 import time
 from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -98,8 +99,6 @@ def iter_frames(
         Frame indices to simulate (default all); every frame has its own random streams, so a
         frame simulated alone equals the same frame of a full run.
     """
-    from core import simulation as sim  # heavy import, and the radar chain is another branch
-
     p = the_plan or plan(scene, keep_rd_maps=keep_rd_maps, fidelity=fidelity)
     if p.consumer == "study":
         raise InputError("a study trial never simulates: load the cached data set instead")
@@ -107,30 +106,65 @@ def iter_frames(
     radar = scene.radar
     settings = processing_settings(scene)
     simulate = simulator(p.fidelity)
-    antenna = sim.AntennaGain.draw(radar, stage_rng(seed, "antenna"))
+    for fi in frame_inputs(scene, p, seed, frames):
+        out = simulate(
+            radar,
+            fi.scatterers,
+            fi.rng,
+            antenna=fi.antenna,
+            settings=settings,
+            keep_rd_map=p.keep_rd_maps,
+            elevation=p.elevation,
+        )
+        yield FrameResult(
+            index=fi.index,
+            t_s=fi.t_s,
+            truth_xy_m=fi.truth_xy_m,
+            truth_v_mps=fi.truth_v_mps,
+            point_cloud=out.point_cloud,
+            rd_map_db=out.rd_map_db if p.keep_rd_maps else None,
+            detections=out.detections,
+            n_clutter=fi.n_clutter,
+        )
+
+
+@dataclass(frozen=True, slots=True, kw_only=True, eq=False)
+class FrameInput:
+    """What a frame simulator is given for one frame: reflectors, antenna, noise generator."""
+
+    index: int
+    t_s: float
+    truth_xy_m: np.ndarray  # (n_persons, 2)
+    truth_v_mps: np.ndarray  # (n_persons, 2)
+    scatterers: Any  # core.simulation.Scatterers
+    antenna: Any  # core.simulation.AntennaGain
+    rng: np.random.Generator
+    n_clutter: int
+
+
+def frame_inputs(
+    scene: Scene, p: Plan, seed: int, frames: Sequence[int] | None = None
+) -> Iterator[FrameInput]:
+    """Each asked frame's simulator inputs, as :func:`iter_frames` simulates them (one definition:
+    the DCA1000 writer synthesises the same frames' ADC samples from these)."""
+    from core import simulation as sim  # heavy import, and the radar chain is another branch
+
+    settings = processing_settings(scene)
+    antenna = sim.AntennaGain.draw(scene.radar, stage_rng(seed, "antenna"))
     reflectors = Reflectors.build(scene, p, seed, antenna, settings)
     t_s, xy, v = reflectors.truth_t_s, reflectors.truth_xy_m, reflectors.truth_v_mps
     idx = np.asarray(frames if frames is not None else range(scene.n_frames), dtype=np.int64)
     # every asked frame's reflectors at once (each frame on its own streams, the same bits)
     every, clutter_counts = reflectors.frames_at(idx)
     for f, scatterers, n_clutter in zip(idx.tolist(), every, clutter_counts.tolist()):
-        out = simulate(
-            radar,
-            scatterers,
-            stage_rng(seed, "noise", f),
-            antenna=antenna,
-            settings=settings,
-            keep_rd_map=p.keep_rd_maps,
-            elevation=p.elevation,
-        )
-        yield FrameResult(
+        yield FrameInput(
             index=f,
             t_s=float(t_s[f]),
             truth_xy_m=xy[f],
             truth_v_mps=v[f],
-            point_cloud=out.point_cloud,
-            rd_map_db=out.rd_map_db if p.keep_rd_maps else None,
-            detections=out.detections,
+            scatterers=scatterers,
+            antenna=antenna,
+            rng=stage_rng(seed, "noise", f),
             n_clutter=n_clutter,
         )
 

@@ -90,16 +90,77 @@ def simulate_frame(
         add_complex_noise(cube, noise_power_v2(radar), rng, window=w)
     elif settings.range_window != "rect":
         cube *= w
+    if elevation is None:
+        elevation = needs_elevation(radar, scatterers)
+    return process_windowed_cube(
+        cube, radar, scatterers, settings=settings, keep_rd_map=keep_rd_map, elevation=elevation
+    )
+
+
+def process_windowed_cube(
+    cube: np.ndarray,
+    radar: RadarConfig,
+    scatterers: Scatterers,
+    *,
+    settings: ProcessingSettings = DEFAULT_PROCESSING,
+    keep_rd_map: bool = False,
+    elevation: bool = False,
+) -> FrameOutput:
+    """The processing half of the exact chain on a cube the range window was applied to.
+
+    Range FFT (in place: ``cube`` is overwritten), static clutter removal and Doppler FFT, the
+    range-Doppler map, then :func:`frame_from_spectrum`.
+
+    Parameters
+    ----------
+    cube
+        ``[virtual channel, loop, ADC sample]`` complex64, C-contiguous, windowed along samples.
+    scatterers
+        The frame's reflectors for the ``source`` labels (``Scatterers.empty()``: none known).
+    """
     rc = scipy.fft.fft(cube, axis=-1, overwrite_x=True)
     if not keep_rd_map:
         # only the range bins the CFAR looks at (limits plus its training window)
         rc = rc[:, :, : processed_range_bins(radar, settings)]
     dc = doppler_fft(rc, settings.doppler_window, remove_static=settings.static_clutter_removal)
     rd = range_doppler_map(dc)
-    if elevation is None:
-        elevation = needs_elevation(radar, scatterers)
     return frame_from_spectrum(
         dc, rd, radar, scatterers, settings=settings, keep_rd_map=keep_rd_map, elevation=elevation
+    )
+
+
+def process_cube(
+    cube: np.ndarray,
+    radar: RadarConfig,
+    *,
+    settings: ProcessingSettings = DEFAULT_PROCESSING,
+    keep_rd_map: bool = False,
+    elevation: bool = False,
+    scatterers: Scatterers | None = None,
+) -> FrameOutput:
+    """The processing half of the exact chain on a received (e.g. recorded) baseband cube.
+
+    The range window, then :func:`process_windowed_cube`: what :func:`simulate_frame` does after
+    synthesising the cube, one definition for both.
+
+    Parameters
+    ----------
+    cube
+        ``[virtual channel, loop, ADC sample]`` complex (volts or ADC counts: the chain is
+        scale-free), not modified.
+    scatterers
+        Reflectors for the ``source`` labels; None: every point ``SOURCE_OTHER``.
+    """
+    # x_w[v, m, n] = x[v, m, n] w[n]
+    w = window(settings.range_window, radar.n_samples)
+    windowed = np.multiply(cube, w, dtype=np.complex64)
+    return process_windowed_cube(
+        windowed,
+        radar,
+        Scatterers.empty() if scatterers is None else scatterers,
+        settings=settings,
+        keep_rd_map=keep_rd_map,
+        elevation=elevation,
     )
 
 
