@@ -104,6 +104,7 @@ def run(args: argparse.Namespace) -> int:
                 file=sys.stderr,
             )
         path = resolve_dataset(args.dataset, person_model=args.person_model)
+        require_truth(path)
     handle = start_study(settings, dataset_path=path)
     bar = None
     if not args.no_progress:
@@ -213,3 +214,18 @@ def exit_code(
             file=sys.stderr,
         )
     return EXIT_WORKER_LOST
+
+
+def require_truth(path) -> None:
+    """A study scores tracks against ground truth: refuse a data set without any (an imported
+    recording without ``--truth``) with one line."""
+    from core.dataset import Dataset
+    from core.errors import InputError
+    from core.formats.recording import has_truth
+
+    if not has_truth(Dataset.load(path)):
+        raise InputError(
+            "the data set has no ground truth (imported without --truth?): a study needs "
+            "truth to score; import it again with --truth CSV",
+            str(path),
+        )
