@@ -485,6 +485,9 @@ def _tlv_walk(packet: bytes, start: int, n_tlvs: int) -> list[tuple[int, int, in
 def _parse_packet(
     packet: bytes, offset: int, radar: RadarConfig | None, rep: UartReport, src: str
 ) -> UartFrame | None:
+    """The packet under the header layout that tiles it with the fewest unknown TLV types
+    (the platform's usual layout first, accepted at once when every TLV type is known)."""
+    best: tuple[int, UartFrame, Counter] | None = None
     for hdr in _header_candidates(packet):
         if len(packet) < hdr.size:
             continue
@@ -503,9 +506,7 @@ def _parse_packet(
                 "recorded with (--cfg) to scale them to m/s",
                 f"{src}:{offset}",
             ) from None
-        if unknown:
-            rep.unknown_tlvs.update(unknown)
-        return UartFrame(
+        frame = UartFrame(
             offset=offset,
             version=version,
             platform=platform,
@@ -517,7 +518,16 @@ def _parse_packet(
             points=points,
             extras=extras,
         )
-    return None
+        n_unknown = sum(unknown.values())
+        if best is None or n_unknown < best[0]:
+            best = (n_unknown, frame, unknown)
+        if n_unknown == 0:
+            break
+    if best is None:
+        return None
+    if best[2]:
+        rep.unknown_tlvs.update(best[2])
+    return best[1]
 
 
 class _Undecodable(Exception):
