@@ -7,7 +7,7 @@ import argparse
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
-    from core.formats.recording import FORMATS
+    from core.formats.table import FORMATS
 
     p = sub.add_parser(
         "import",
@@ -29,7 +29,8 @@ def run(args: argparse.Namespace) -> int:
     import time
 
     from core.files import check_output_path
-    from core.formats.recording import read_recording, read_truth_csv, to_dataset
+    from core.formats.recording import read_truth_csv, to_dataset
+    from core.formats.table import read_recording
     from core.formats.ti_cfg import read_ti_cfg
 
     t0 = time.perf_counter()

@@ -5,9 +5,7 @@ configuration, what it dropped); :func:`to_dataset` adds the optional ground tru
 ``time_s, person, x_m, y_m``) and builds a :class:`~core.dataset.Dataset` that ``radartune
 track``, the report and (with truth) studies use like a simulated one.
 
-:data:`FORMATS` is the one table of formats ``radartune import`` / ``export`` know: a name, how
-to recognise a file (``sniff``), how to read it and, where supported, how to write a simulated
-scene in it. A new format is a new row (see ``docs/real-data.md``).
+The table of formats is :mod:`core.formats.table`.
 """
 
 from __future__ import annotations
@@ -17,9 +15,7 @@ import io
 import json
 import math
 import os
-from collections.abc import Callable
 from dataclasses import dataclass, field
-from pathlib import Path
 
 import numpy as np
 
@@ -259,93 +255,3 @@ def to_dataset(
 def has_truth(ds: Dataset) -> bool:
     """True when the data set has at least one person with a position somewhere."""
     return ds.n_persons > 0 and bool(np.isfinite(ds.truth_xy_m).any())
-
-
-# ---- the format table -------------------------------------------------------------------------
-@dataclass(frozen=True, slots=True, kw_only=True)
-class FileFormat:
-    """One row of :data:`FORMATS`.
-
-    ``sniff(head, path)``: True when a file whose first bytes are ``head`` is in this format.
-    ``read(path, radar)``: the :class:`Recording` (``radar`` from ``--cfg`` or None).
-    ``write(path, run, radar, variant)``: the files written for a simulated scene run (the
-    data file and its ``.cfg``), or None when the format cannot be written.
-    """
-
-    name: str
-    description: str
-    suffixes: tuple[str, ...]
-    sniff: Callable[[bytes, Path], bool]
-    read: Callable[[Path, RadarConfig | None], Recording]
-    write: Callable[[Path, object, RadarConfig, str | None], list[Path]] | None = None
-    variants: tuple[str, ...] = ()
-
-
-def _uart_row() -> FileFormat:
-    from core.formats import ti_uart_import
-
-    return FileFormat(
-        name="uart",
-        description="TI mmWave demo UART stream (Demo Visualizer .dat, serial dumps), every SDK",
-        suffixes=(".dat", ".bin", ".uart", ".log"),
-        sniff=ti_uart_import.sniff,
-        read=ti_uart_import.read,
-        write=ti_uart_import.write,
-        variants=ti_uart_import.VARIANTS,
-    )
-
-
-def _replay_row() -> FileFormat:
-    from core.formats import ti_replay
-
-    return FileFormat(
-        name="replay",
-        description="TI Industrial Visualizer replay (replay_N.json, or a folder of them)",
-        suffixes=(".json",),
-        sniff=ti_replay.sniff,
-        read=ti_replay.read,
-        write=ti_replay.write,
-    )
-
-
-#: name -> row, in the order auto-detection tries them. The DCA1000 reader adds its row here.
-FORMATS: dict[str, FileFormat] = {row.name: row for row in (_uart_row(), _replay_row())}
-
-#: Bytes read from the start of a file to recognise its format.
-SNIFF_BYTES = 1 << 16
-
-
-def detect_format(path: Path) -> FileFormat:
-    """The format of ``path`` (first by content, then by suffix); one line if none fits."""
-    if path.is_dir():
-        head = b""
-    else:
-        try:
-            with open(path, "rb") as fh:
-                head = fh.read(SNIFF_BYTES)
-        except OSError as exc:
-            raise InputError(f"cannot read ({exc.strerror or exc})", str(path)) from None
-        if not head:
-            raise InputError("empty file: no bytes to read", f"{path}:0")
-    for row in FORMATS.values():
-        if row.sniff(head, path):
-            return row
-    raise InputError(
-        f"format not recognised (none of {', '.join(FORMATS)} fits its first bytes); give --format",
-        str(path),
-    )
-
-
-def read_recording(
-    path: str | os.PathLike, *, fmt: str | None, radar: RadarConfig | None
-) -> Recording:
-    path = Path(path)
-    if not path.exists():
-        raise InputError("no such file", str(path))
-    if fmt is None:
-        row = detect_format(path)
-    elif fmt in FORMATS:
-        row = FORMATS[fmt]
-    else:
-        raise InputError(f"--format must be one of {list(FORMATS)}, got {fmt!r}")
-    return row.read(path, radar)

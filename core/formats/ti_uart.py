@@ -41,9 +41,10 @@ import math
 import os
 import struct
 from collections import Counter
-from collections.abc import Iterable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import NamedTuple, Protocol, TypeVar
 
 import numpy as np
 
@@ -352,20 +353,65 @@ def iter_uart_frames(
         An empty stream, no magic word anywhere, or Q-format points without ``radar``; one line
         naming the file and the byte offset.
     """
-    if isinstance(source, str | os.PathLike):
-        src = name or str(source)
-        chunks: Iterable[bytes] = _file_chunks(Path(source), chunk_bytes)
-    else:
-        src = name or "<stream>"
-        chunks = source
     rep = report if report is not None else UartReport()
+    src = name or (str(source) if isinstance(source, str | os.PathLike) else "<stream>")
+
+    def parse(packet: bytes, offset: int) -> UartFrame | None:
+        return _parse_packet(packet, offset, radar, rep, src)
+
+    return _iter_packets(source, parse, rep, src, chunk_bytes)
+
+
+def iter_raw_packets(
+    source: str | os.PathLike | Iterable[bytes],
+    *,
+    radar: RadarConfig | None = None,
+    report: UartReport | None = None,
+    chunk_bytes: int = CHUNK_BYTES,
+    name: str | None = None,
+) -> Iterator[RawPacket]:
+    """:func:`iter_uart_frames` for bulk import: the same packets, checks and counts, each as a
+    :class:`RawPacket` (float points left as bytes to decode all at once)."""
+    rep = report if report is not None else UartReport()
+    src = name or (str(source) if isinstance(source, str | os.PathLike) else "<stream>")
+
+    def parse(packet: bytes, offset: int) -> RawPacket | None:
+        return parse_packet_raw(packet, offset, radar, rep, src)
+
+    return _iter_packets(source, parse, rep, src, chunk_bytes)
+
+
+class _Packet(Protocol):
+    frame_number: int
+    header_bytes: int
+    point_format: str
+
+
+P = TypeVar("P", bound=_Packet)
+
+
+def _iter_packets(
+    source: str | os.PathLike | Iterable[bytes],
+    parse: Callable[[bytes, int], P | None],
+    rep: UartReport,
+    src: str,
+    chunk_bytes: int = CHUNK_BYTES,
+) -> Iterator[P]:
+    """Find, check and hand each packet to ``parse``; resynchronise and count as documented
+    in the module docstring. Memory: one chunk plus one packet."""
+    chunks: Iterable[bytes]
+    if isinstance(source, str | os.PathLike):
+        chunks = _file_chunks(Path(source), chunk_bytes)
+    else:
+        chunks = source
     rep.source = src
-    buf = bytearray()
+    buf = b""  # immutable: a packet is one slice (one copy); a refill joins the rest and a chunk
     pos = 0  # read position in buf
     base = 0  # stream offset of buf[0]
     last_frame: int | None = None
     eof = False
     it = iter(chunks)
+    generations: Counter = Counter()
 
     def more() -> bool:
         """Append the next chunk (dropping what was consumed first); False at the end."""
@@ -374,11 +420,9 @@ def iter_uart_frames(
             return False
         for chunk in it:
             if chunk:
-                if pos:
-                    del buf[:pos]
-                    base += pos
-                    pos = 0
-                buf += chunk
+                base += pos
+                buf = buf[pos:] + bytes(chunk)
+                pos = 0
                 rep.n_bytes += len(chunk)
                 return True
         eof = True
@@ -422,9 +466,12 @@ def iter_uart_frames(
             rep.bytes_skipped += nxt - pos
             pos = nxt
             continue
-        packet = bytes(buf[pos : pos + total])
-        frame = _parse_packet(packet, base + pos, radar, rep, src)
-        inner = packet.find(MAGIC, 1)
+        packet = buf[pos : pos + total]
+        frame = parse(packet, base + pos)
+        # a packet followed at once by the next magic word cannot have swallowed its start;
+        # otherwise look for a magic word inside it (bytes lost near its end)
+        following = buf[pos + total : pos + total + len(MAGIC)]
+        inner = -1 if following == MAGIC else packet.find(MAGIC, 1)
         if frame is None or inner > 0:
             # damaged (bytes lost inside it, or it swallowed the next packet): resync
             rep.n_damaged += 1
@@ -437,10 +484,10 @@ def iter_uart_frames(
             rep.n_dropped += frame.frame_number - last_frame - 1
         last_frame = frame.frame_number
         rep.n_frames += 1
-        rep.generations[
-            f"{frame.header_bytes}-byte header, {frame.point_format or 'no'} points"
-        ] += 1
+        generations[frame.header_bytes, frame.point_format] += 1
         yield frame
+    for (hb, fmt), n in generations.items():
+        rep.generations[f"{hb}-byte header, {fmt or 'no'} points"] += n
 
     if rep.n_bytes == 0:
         raise InputError("empty file: no bytes to read", f"{src}:0")
@@ -530,6 +577,87 @@ def _parse_packet(
     return best[1]
 
 
+class RawPacket(NamedTuple):
+    """A packet as the fast import path keeps it: float points (SDK >= 3 TLV 1) and their side
+    info (TLV 7) as raw bytes, joined and decoded once for the whole log; any other point format
+    decoded (``points``)."""
+
+    frame_number: int
+    header_bytes: int
+    point_format: str
+    float_points: bytes
+    side_info: bytes
+    points: UartPoints | None
+    extras: tuple[str, ...]
+
+
+#: TLV types whose payload the fast path checks by length only.
+_AUX_SIZES = {t: dt.itemsize for t, (_, dt) in AUX_TLVS.items()}
+_OTHER_POINT_TLVS = frozenset((EXT_DETECTED_POINTS, COMPRESSED_POINTS, SPHERICAL_POINTS))
+
+
+def parse_packet_raw(
+    packet: bytes, offset: int, radar: RadarConfig | None, rep: UartReport, src: str
+) -> RawPacket | None:
+    """:func:`_parse_packet` for the importer: the same header choice and checks, without
+    building arrays for the common SDK >= 3 float packet (see :class:`RawPacket`)."""
+    for hdr in _header_candidates(packet):
+        if len(packet) < hdr.size:
+            continue
+        fields = hdr.unpack_from(packet, 0)
+        version, n_detected, n_tlvs = fields[1], fields[6], fields[7]
+        tlvs = _tlv_walk(packet, hdr.size, n_tlvs)
+        if tlvs is None:
+            continue
+        float_points = side = b""
+        names: list[str] = []
+        simple = True
+        for t, off, n in tlvs:
+            if t == DETECTED_POINTS:
+                if n != POINT_FLOAT.itemsize * n_detected or _is_q(
+                    packet, off, n, n_detected, version
+                ):
+                    simple = False
+                    break
+                float_points = packet[off : off + n]
+            elif t == DETECTED_POINTS_SIDE_INFO:
+                if n != SIDE_INFO.itemsize * n_detected:
+                    simple = False
+                    break
+                side = packet[off : off + n]
+            elif t in _AUX_SIZES:
+                if n % _AUX_SIZES[t]:
+                    simple = False
+                    break
+                names.append(AUX_TLVS[t][0])
+            else:  # other point formats, unknown types: the full decoder
+                simple = False
+                break
+        if simple and (float_points or not side):
+            return RawPacket(
+                fields[4],
+                hdr.size,
+                "float" if float_points else "",
+                float_points,
+                side,
+                None,
+                tuple(names),
+            )
+        break
+    frame = _parse_packet(packet, offset, radar, rep, src)
+    if frame is None:
+        return None
+    return RawPacket(
+        frame.frame_number,
+        frame.header_bytes,
+        frame.point_format,
+        b"",
+        b"",
+        frame.points,
+        tuple(frame.extras),
+    )
+
+
 class _Undecodable(Exception):
     """A TLV's length does not fit its documented layout under this header interpretation."""
 
@@ -596,6 +724,16 @@ def _decode_tlvs(
     return points, fmt, extras, unknown
 
 
+def _is_q(packet: bytes, off: int, n: int, n_detected: int, version: int) -> bool:
+    """Whether TLV 1 at ``off`` is the SDK 1.x/2.x Q-format form (see :func:`_detected_points`)."""
+    if n < Q_DESCRIPTOR.itemsize:
+        return False
+    k, q = struct.unpack_from("<2H", packet, off)
+    if not (n == Q_DESCRIPTOR.itemsize + k * POINT_Q.itemsize and q <= 15 and k == n_detected):
+        return False
+    return not (n == POINT_FLOAT.itemsize * n_detected and (version >> 24) >= 3)
+
+
 def _detected_points(
     packet: bytes, off: int, n: int, n_detected: int, version: int, radar: RadarConfig | None
 ) -> tuple[UartPoints, str]:
@@ -605,13 +743,8 @@ def _detected_points(
     header's count agreeing) and its Q is at most 15; float when it is ``16·numDetectedObj``;
     where both fit (one 16-byte point), the SDK major decides (< 3: Q-format).
     """
-    is_q = False
-    if n >= Q_DESCRIPTOR.itemsize:
+    if _is_q(packet, off, n, n_detected, version):
         k, q = struct.unpack_from("<2H", packet, off)
-        is_q = n == Q_DESCRIPTOR.itemsize + k * POINT_Q.itemsize and q <= 15 and k == n_detected
-        if is_q and n == POINT_FLOAT.itemsize * n_detected and (version >> 24) >= 3:
-            is_q = False
-    if is_q:
         p = np.frombuffer(packet, POINT_Q, count=k, offset=off + Q_DESCRIPTOR.itemsize)
         if k and radar is None:
             raise _NeedsRadar

@@ -28,25 +28,31 @@ def read(path: Path, radar: RadarConfig | None, *, chunks=None) -> Recording:
     """Read a UART log (or, with ``chunks``, an iterable of byte chunks named ``path``)."""
     report = ti_uart.UartReport()
     cfg = radar if radar is not None else PAPER_RADAR
-    parts: dict[str, list[np.ndarray]] = {k: [] for k in ("x", "y", "z", "v", "snr")}
+    raw: list[bytes] = []  # float points (TLV 1, SDK >= 3) of the packets decoded in bulk
+    raw_side: list[bytes] = []
+    decoded: list[tuple[int, ti_uart.UartPoints]] = []  # (packet index, points) of the rest
     numbers: list[int] = []
     counts: list[int] = []
     extras: set[str] = set()
     source = chunks if chunks is not None else path
-    for fr in ti_uart.iter_uart_frames(source, radar=radar, report=report, name=str(path)):
-        p = fr.points
-        parts["x"].append(p.x_m)
-        parts["y"].append(p.y_m)
-        parts["z"].append(p.z_m)
-        parts["v"].append(p.velocity_mps)
-        parts["snr"].append(p.snr_db)
-        numbers.append(fr.frame_number)
-        counts.append(len(p))
-        if fr.extras:
-            extras.update(fr.extras)
-    cat = {k: np.concatenate(v) if v else np.zeros(0) for k, v in parts.items()}
-    cloud, keep = points_to_cloud(cat["x"], cat["y"], cat["z"], cat["v"], cat["snr"])
+    for k, pk in enumerate(
+        ti_uart.iter_raw_packets(source, radar=radar, report=report, name=str(path))
+    ):
+        numbers.append(pk.frame_number)
+        if pk.points is None:
+            n = len(pk.float_points) // ti_uart.POINT_FLOAT.itemsize
+            raw.append(pk.float_points)
+            # no side info: a marker per point that decodes to NaN (no SNR)
+            raw_side.append(pk.side_info or _NO_SIDE * n)
+        else:
+            n = len(pk.points)
+            decoded.append((k, pk.points))
+        counts.append(n)
+        if pk.extras:
+            extras.update(pk.extras)
     pkt_counts = np.asarray(counts, dtype=np.int64)
+    x, y, z, v, snr = _assemble(raw, raw_side, decoded, pkt_counts)
+    cloud, keep = points_to_cloud(x, y, z, v, snr)
     if not keep.all():
         # points with a non-finite coordinate or velocity are dropped (counted)
         packet_of_point = np.repeat(np.arange(len(pkt_counts)), pkt_counts)
@@ -81,6 +87,40 @@ def read(path: Path, radar: RadarConfig | None, *, chunks=None) -> Recording:
             "unknown_tlvs": {str(k): v for k, v in report.unknown_tlvs.items()},
         },
     )
+
+
+#: Side info of a packet without TLV 7: the most negative int16, read back as "no SNR".
+_NO_SIDE = np.array([(-32768, -32768)], ti_uart.SIDE_INFO).tobytes()
+
+
+def _assemble(
+    raw: list[bytes],
+    raw_side: list[bytes],
+    decoded: list[tuple[int, ti_uart.UartPoints]],
+    counts: np.ndarray,
+) -> tuple[np.ndarray, ...]:
+    """x, y, z, v, SNR of every point in packet order: the bulk-decoded float packets and the
+    individually decoded ones interleaved back by packet index."""
+    pts = np.frombuffer(b"".join(raw), ti_uart.POINT_FLOAT)
+    side = np.frombuffer(b"".join(raw_side), ti_uart.SIDE_INFO)
+    # snr in 0.1 dB steps; the "absent" marker as NaN
+    snr = np.where(side["snr"] == -32768, np.nan, side["snr"] * 0.1)
+    cols = [pts["x"], pts["y"], pts["z"], pts["v"], snr]
+    if not decoded:
+        return tuple(np.asarray(c, dtype=np.float64) for c in cols)
+    total = int(counts.sum())
+    out = [np.empty(total) for _ in range(5)]
+    starts = np.concatenate(([0], np.cumsum(counts)))
+    is_bulk = np.ones(len(counts), dtype=bool)
+    is_bulk[[k for k, _ in decoded]] = False
+    bulk_rows = np.repeat(is_bulk, counts)
+    for o, c in zip(out, cols):
+        o[bulk_rows] = c
+    for k, p in decoded:
+        s = slice(starts[k], starts[k + 1])
+        for o, c in zip(out, (p.x_m, p.y_m, p.z_m, p.velocity_mps, p.snr_db)):
+            o[s] = c
+    return tuple(out)
 
 
 def write(path: Path, run, radar: RadarConfig, variant: str | None) -> list[Path]:

@@ -12,7 +12,8 @@ import pytest
 from core.cli import main
 from core.dataset import Dataset
 from core.errors import InputError
-from core.formats.recording import FORMATS, read_truth_csv, truth_on_frames
+from core.formats.recording import read_truth_csv, truth_on_frames
+from core.formats.table import FORMATS
 from core.formats.ti_replay import read as read_replay
 from tests.scenes import small_scene
 
