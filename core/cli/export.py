@@ -53,7 +53,7 @@ def run(args: argparse.Namespace) -> int:
     the_plan = plan(scene, fidelity=args.fidelity)
     run_ = simulate_scene(scene, seed=args.seed, the_plan=the_plan, progress=ProgressBar("export"))
     assert row.write is not None
-    written = row.write(Path(out), run_, scene.radar, args.variant)
+    written = row.write(Path(out), list(run_.clouds), scene.radar, args.variant)
     n_points = sum(len(c) for c in run_.clouds)
     print(
         f"wrote {', '.join(str(p) for p in written)}: {args.format}"

@@ -216,7 +216,7 @@ def exit_code(
     return EXIT_WORKER_LOST
 
 
-def require_truth(path) -> None:
+def require_truth(path: str) -> None:
     """A study scores tracks against ground truth: refuse a data set without any (an imported
     recording without ``--truth``) with one line."""
     from core.dataset import Dataset

@@ -8,7 +8,7 @@ scene in it. A new format is a new row in :data:`FORMATS` (see ``docs/real-data.
 from __future__ import annotations
 
 import os
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -16,6 +16,7 @@ from core.config import RadarConfig
 from core.errors import InputError
 from core.formats import ti_replay, ti_uart_import
 from core.formats.recording import Recording
+from core.pointcloud import PointCloud
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -24,8 +25,9 @@ class FileFormat:
 
     ``sniff(head, path)``: True when a file whose first bytes are ``head`` is in this format.
     ``read(path, radar)``: the :class:`Recording` (``radar`` from ``--cfg`` or None).
-    ``write(path, run, radar, variant)``: the files written for a simulated scene run (the
-    data file and its ``.cfg``), or None when the format cannot be written.
+    ``write(path, clouds, radar, variant)``: the files written for a simulated scene's point
+    clouds, one per frame (the data file and its ``.cfg``), or None when the format cannot be
+    written; ``variants``: the values ``--variant`` accepts (first: the default).
     """
 
     name: str
@@ -33,7 +35,7 @@ class FileFormat:
     suffixes: tuple[str, ...]
     sniff: Callable[[bytes, Path], bool]
     read: Callable[[Path, RadarConfig | None], Recording]
-    write: Callable[[Path, object, RadarConfig, str | None], list[Path]] | None = None
+    write: Callable[[Path, Sequence[PointCloud], RadarConfig, str | None], list[Path]] | None = None
     variants: tuple[str, ...] = ()
 
 

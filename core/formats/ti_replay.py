@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import json
 import re
+from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
@@ -28,6 +29,7 @@ from core.config import PAPER_RADAR, RadarConfig
 from core.errors import InputError
 from core.files import read_json, write_text_atomic
 from core.formats.recording import Recording, frames_from_numbers, points_to_cloud
+from core.pointcloud import PointCloud
 
 #: File names the visualizer writes.
 REPLAY_NAME = re.compile(r"^replay_(\d+)\.json$")
@@ -173,12 +175,14 @@ def read(path: Path, radar: RadarConfig | None) -> Recording:
     )
 
 
-def replay_document(run, radar: RadarConfig, *, t0_ms: float = 0.0) -> dict:
-    """A simulated run as the visualizer's replay document (one file, all frames)."""
+def replay_document(
+    clouds: Sequence[PointCloud], radar: RadarConfig, *, t0_ms: float = 0.0
+) -> dict:
+    """Point clouds (one per frame) as the visualizer's replay document (one file, all frames)."""
     from core.formats.ti_cfg import ti_cfg_text
 
     frames = []
-    for k, c in enumerate(run.clouds):
+    for k, c in enumerate(clouds):
         rows = np.column_stack(
             (
                 c.x_m,
@@ -209,8 +213,10 @@ def replay_document(run, radar: RadarConfig, *, t0_ms: float = 0.0) -> dict:
     }
 
 
-def write(path: Path, run, radar: RadarConfig, variant: str | None) -> list[Path]:
-    """Write the run as one replay JSON file (values rounded to float32, as the device's)."""
-    doc = replay_document(run, radar)
+def write(
+    path: Path, clouds: Sequence[PointCloud], radar: RadarConfig, variant: str | None
+) -> list[Path]:
+    """Write the clouds as one replay JSON file (values rounded to float32, as the device's)."""
+    doc = replay_document(clouds, radar)
     write_text_atomic(path, json.dumps(doc, indent=1))
     return [path]

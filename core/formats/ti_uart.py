@@ -382,9 +382,12 @@ def iter_raw_packets(
 
 
 class _Packet(Protocol):
-    frame_number: int
-    header_bytes: int
-    point_format: str
+    @property
+    def frame_number(self) -> int: ...
+    @property
+    def header_bytes(self) -> int: ...
+    @property
+    def point_format(self) -> str: ...
 
 
 P = TypeVar("P", bound=_Packet)
@@ -804,7 +807,7 @@ def _compressed_points(packet: bytes, off: int, n: int) -> UartPoints:
     if n < COMPRESSED_UNIT.itemsize:
         raise _Undecodable
     u = np.frombuffer(packet, COMPRESSED_UNIT, count=1, offset=off)[0]
-    units = [float(u[k]) for k in COMPRESSED_UNIT.names]
+    units = [float(u[k]) for k in COMPRESSED_UNITS]
     if not all(math.isfinite(x) for x in units):
         raise _Undecodable
     el_u, az_u, dop_u, r_u, snr_u = units

@@ -7,6 +7,7 @@ data set's float64 arrays is done once for the whole log (``radartune bench impo
 
 from __future__ import annotations
 
+from collections.abc import Iterable, Sequence
 from pathlib import Path
 
 import numpy as np
@@ -14,6 +15,7 @@ import numpy as np
 from core.config import PAPER_RADAR, RadarConfig
 from core.formats import ti_uart
 from core.formats.recording import Recording, frames_from_numbers, points_to_cloud
+from core.pointcloud import PointCloud
 
 #: Point formats ``radartune export --format uart --variant`` writes (default first).
 VARIANTS = ti_uart.WRITE_FORMATS
@@ -24,7 +26,9 @@ def sniff(head: bytes, path: Path) -> bool:
     return ti_uart.MAGIC in head
 
 
-def read(path: Path, radar: RadarConfig | None, *, chunks=None) -> Recording:
+def read(
+    path: Path, radar: RadarConfig | None, *, chunks: Iterable[bytes] | None = None
+) -> Recording:
     """Read a UART log (or, with ``chunks``, an iterable of byte chunks named ``path``)."""
     report = ti_uart.UartReport()
     cfg = radar if radar is not None else PAPER_RADAR
@@ -123,12 +127,14 @@ def _assemble(
     return tuple(out)
 
 
-def write(path: Path, run, radar: RadarConfig, variant: str | None) -> list[Path]:
-    """Write a simulated run's point clouds as a UART log and its ``.cfg`` next to it."""
+def write(
+    path: Path, clouds: Sequence[PointCloud], radar: RadarConfig, variant: str | None
+) -> list[Path]:
+    """Write point clouds (one per frame) as a UART log and its ``.cfg`` next to it."""
     from core.formats.ti_cfg import write_ti_cfg
 
     fmt = variant or VARIANTS[0]
-    ti_uart.write_uart_log(path, run.clouds, fmt=fmt, radar=radar)
+    ti_uart.write_uart_log(path, clouds, fmt=fmt, radar=radar)
     cfg = path.with_suffix(".cfg")
     write_ti_cfg(radar, cfg, comment=f"written by radartune export with {path.name}")
     return [path, cfg]
