@@ -13,8 +13,10 @@ from pathlib import Path
 import numpy as np
 
 from core.config import PAPER_RADAR, RadarConfig
+from core.errors import InputError
 from core.formats import ti_uart
 from core.formats.recording import Recording, frames_from_numbers, points_to_cloud
+from core.limits import MAX_DATASET_FRAMES
 from core.pointcloud import PointCloud
 
 #: Point formats ``radartune export --format uart --variant`` writes (default first).
@@ -43,6 +45,13 @@ def read(
         ti_uart.iter_raw_packets(source, radar=radar, report=report, name=str(path))
     ):
         numbers.append(pk.frame_number)
+        if k >= MAX_DATASET_FRAMES:
+            # the data set could not hold it: stop here rather than fill memory first
+            raise InputError(
+                f"more than {MAX_DATASET_FRAMES} packets (the data-set limit of frames) within "
+                f"the first {report.n_bytes} bytes; split the log",
+                str(path),
+            )
         if pk.points is None:
             n = len(pk.float_points) // ti_uart.POINT_FLOAT.itemsize
             raw.append(pk.float_points)

@@ -343,3 +343,13 @@ def test_import_inserts_empty_frames_for_gaps_and_splits_runs(tmp_path) -> None:
     rec = read_log(tmp_path / "x.dat", None, chunks=[data])
     assert rec.counts.tolist() == [5, 5, 0, 5]
     assert "1 dropped" in rec.notes[0]
+
+
+def test_a_log_longer_than_the_data_set_limit_stops_early(tmp_path, monkeypatch) -> None:
+    """The importer refuses at the limit instead of reading (and holding) the whole log."""
+    import core.formats.ti_uart_import as imp
+
+    monkeypatch.setattr(imp, "MAX_DATASET_FRAMES", 3)
+    data = b"".join(log(n=6))
+    with pytest.raises(InputError, match=r"more than 3 packets .*split the log"):
+        read_log(tmp_path / "long.dat", None, chunks=[data])
