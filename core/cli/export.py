@@ -9,7 +9,9 @@ import argparse
 def add_parser(sub: argparse._SubParsersAction) -> None:
     from core.formats.table import FORMATS
 
-    writable = tuple(n for n, row in FORMATS.items() if row.write is not None)
+    writable = tuple(
+        n for n, row in FORMATS.items() if row.write is not None or row.write_scene is not None
+    )
     p = sub.add_parser(
         "export",
         help="simulate a scene and write it as a TI UART log or visualizer replay (+ .cfg)",
@@ -50,14 +52,22 @@ def run(args: argparse.Namespace) -> int:
         raise InputError(f"--seed must be >= 0, got {args.seed}")
     out = check_output_path(args.out)
     scene = Scene.from_json(args.scene)
-    the_plan = plan(scene, fidelity=args.fidelity)
-    run_ = simulate_scene(scene, seed=args.seed, the_plan=the_plan, progress=ProgressBar("export"))
-    assert row.write is not None
-    written = row.write(Path(out), list(run_.clouds), scene.radar, args.variant)
-    n_points = sum(len(c) for c in run_.clouds)
+    if row.write_scene is not None:  # e.g. ADC captures: the format simulates what it needs
+        written = row.write_scene(
+            Path(out), scene, seed=args.seed, fidelity=args.fidelity, variant=args.variant
+        )
+        what = f"{scene.n_frames} frames"
+    else:
+        the_plan = plan(scene, fidelity=args.fidelity)
+        run_ = simulate_scene(
+            scene, seed=args.seed, the_plan=the_plan, progress=ProgressBar("export")
+        )
+        assert row.write is not None
+        written = row.write(Path(out), list(run_.clouds), scene.radar, args.variant)
+        what = f"{len(run_.clouds)} frames, {sum(len(c) for c in run_.clouds)} points"
     print(
         f"wrote {', '.join(str(p) for p in written)}: {args.format}"
-        f"{' ' + args.variant if args.variant else ''}, {len(run_.clouds)} frames, "
-        f"{n_points} points; elapsed {time.perf_counter() - t0:.1f} s"
+        f"{' ' + args.variant if args.variant else ''}, {what}; "
+        f"elapsed {time.perf_counter() - t0:.1f} s"
     )
     return 0

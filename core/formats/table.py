@@ -28,6 +28,9 @@ class FileFormat:
     ``write(path, clouds, radar, variant)``: the files written for a simulated scene's point
     clouds, one per frame (the data file and its ``.cfg``), or None when the format cannot be
     written; ``variants``: the values ``--variant`` accepts (first: the default).
+    ``write_scene(path, scene, *, seed, fidelity, variant)``: for formats that need more than
+    point clouds (a DCA1000 capture needs the ADC samples): writes from the scene itself;
+    ``radartune export`` calls it instead of simulating and calling ``write``.
     """
 
     name: str
@@ -37,6 +40,7 @@ class FileFormat:
     read: Callable[[Path, RadarConfig | None], Recording]
     write: Callable[[Path, Sequence[PointCloud], RadarConfig, str | None], list[Path]] | None = None
     variants: tuple[str, ...] = ()
+    write_scene: Callable[..., list[Path]] | None = None
 
 
 def _uart_row() -> FileFormat:
