@@ -57,6 +57,19 @@ class ReplayEngine(Engine):
             radar=self.radar,
         )
 
+    def scene_dataset(self, frames, scene, path: Path) -> Path:
+        """A study "on the current scene" of a replay studies the recording itself, which
+        needs its ground truth (imported with ``--truth``)."""
+        from core.errors import InputError
+        from core.formats.recording import has_truth
+
+        if not has_truth(self.dataset):
+            raise InputError(
+                "this recording has no ground truth: a study needs it (import the recording "
+                "with --truth CSV and replay the data set)"
+            )
+        return self.dataset.save(path)
+
     def simulate(self, scene, *, fidelity: str = "exact") -> Iterator[FrameData]:
         ds = self.dataset
         for f in range(ds.n_frames):

@@ -66,6 +66,17 @@ def test_replay_plays_a_uart_log(qtbot, settings, tmp_path) -> None:
         w.shutdown()
 
 
+def test_a_study_on_a_replay_needs_truth(tmp_path) -> None:
+    from app.replay import ReplayEngine, load_recording
+
+    log = tmp_path / "walk.dat"
+    _log(log)
+    engine = ReplayEngine(load_recording(log))
+    with pytest.raises(InputError, match="no ground truth"):
+        engine.scene_dataset([], None, tmp_path / "s.npz")
+    assert not (tmp_path / "s.npz").exists()
+
+
 def test_bad_recording_is_one_line(tmp_path) -> None:
     from app.replay import load_recording
 
