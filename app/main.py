@@ -23,6 +23,13 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument("--paused", action="store_true", help="open without playing")
     p.add_argument(
+        "--replay",
+        metavar="FILE",
+        help="play a recording instead of simulating: a data set .npz or a file radartune "
+        "import reads (TI UART log, visualizer replay)",
+    )
+    p.add_argument("--cfg", metavar="CFG", help="with --replay: the TI .cfg of the recording")
+    p.add_argument(
         "--settings",
         metavar="FILE",
         default=None,
@@ -108,8 +115,21 @@ def run(
     quit_after: float | None = None,
     paused: bool = False,
     settings_file: str | None = None,
+    replay: str | None = None,
+    cfg: str | None = None,
 ) -> int:
     """Create the QApplication and the main window, play, and run the event loop."""
+    engine = None
+    if replay is not None:
+        from app.errors import log_exception, one_line
+        from app.replay import ReplayEngine, load_recording
+
+        try:
+            engine = ReplayEngine(load_recording(replay, cfg))
+        except Exception as exc:
+            log_exception(f"cannot replay {replay}", exc)
+            print(f"radartune gui: error: {one_line(exc, replay)}", file=sys.stderr)
+            return 2
     if scene is not None:
         problem = scene_error(scene)
         if problem is not None:
@@ -140,7 +160,7 @@ def run(
         settings = QtCore.QSettings(
             QtCore.QSettings.IniFormat, QtCore.QSettings.UserScope, "RadarTune", "RadarTune"
         )
-    window = MainWindow(settings, scene_path=scene)
+    window = MainWindow(settings, engine, scene_path=scene)
     restore_hooks = install_excepthooks(window.show_error)  # a message box, never a crash
     window.show()
     if not paused:
@@ -161,7 +181,7 @@ def main(argv: list[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
     setup_logging(debug=args.debug)
     try:
-        return run(args.scene, args.quit_after, args.paused, args.settings)
+        return run(args.scene, args.quit_after, args.paused, args.settings, args.replay, args.cfg)
     except Exception as exc:
         log_exception("the app failed", exc)
         print(

@@ -30,6 +30,8 @@ COMMANDS = {
     "worker": "core.cli.worker",
     "dashboard": "core.cli.dashboard",
     "report": "core.cli.report",
+    "import": "core.cli.imports",
+    "export": "core.cli.export",
     "bench": "core.cli.bench",
     "gui": "core.cli.gui",
 }
@@ -98,7 +100,7 @@ def main(argv: list[str] | None = None) -> int:
 
 
 #: Arguments that name input files, in the order they are worth naming.
-INPUT_ARGUMENTS = ("scene", "data", "dataset", "params", "cfg", "settings")
+INPUT_ARGUMENTS = ("scene", "data", "dataset", "params", "cfg", "settings", "file", "truth")
 
 
 def _input_files(args: argparse.Namespace) -> list[str]:

@@ -16,7 +16,9 @@ from pathlib import Path
 
 from core.files import write_json_atomic
 
-BENCHMARKS = ("sim", "track", "tune", "fidelity", "dataset", "false_alarms", "cvca")
+BENCHMARKS = ("sim", "track", "tune", "fidelity", "dataset", "false_alarms", "cvca", "import")
+#: benchmark name -> module in core.benchmarks, where the name is a Python keyword
+MODULES = {"import": "import_"}
 #: not part of ``all``: hours of studies (16 x 1000 trials)
 LONG = ("cvca_seeds",)
 
@@ -24,7 +26,8 @@ LONG = ("cvca_seeds",)
 def add_parser(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "bench",
-        help="measure speed (and error against run time); cvca, cvca_seeds: CV against CA",
+        help="measure speed (and error against run time); cvca, cvca_seeds: CV against CA; "
+        "import: reading real recordings",
     )
     p.add_argument("name", choices=(*BENCHMARKS, *LONG, "all"))
     p.add_argument(
@@ -53,7 +56,7 @@ def run(args: argparse.Namespace) -> int:
     out_dir = Path(args.out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     for name in names:
-        module = importlib.import_module(f"core.benchmarks.{name}")
+        module = importlib.import_module(f"core.benchmarks.{MODULES.get(name, name)}")
         extra, flags = {}, ""
         if name == "fidelity":
             extra = {"params_cv": args.params_cv, "params_ca": args.params_ca}

@@ -28,6 +28,8 @@ def run(args: argparse.Namespace) -> int:
     import time
     from pathlib import Path
 
+    import numpy as np
+
     from core.dataset import Dataset
     from core.errors import InputError
     from core.evaluation import evaluate
@@ -63,6 +65,27 @@ def run(args: argparse.Namespace) -> int:
     t0 = time.perf_counter()
     est = track_dataset(ds, params, trajectories=traj, engine=args.engine)
     elapsed = time.perf_counter() - t0
+    from core.formats.recording import has_truth
+
+    if not has_truth(ds):
+        n_conf = int(np.sum(np.isfinite(est.confirmed_xy[..., 0]).any(axis=1)))
+        print(
+            f"{args.data}: {len(est.trajectories)} trajectories, {len(est.frame_index)} frames, "
+            f"model {params.model}, tracked in {elapsed * 1e3:.1f} ms; {n_conf} frames with a "
+            "confirmed track; no ground truth, so no loss table (import with --truth to score)"
+        )
+        if args.out:
+            doc = {
+                "data": str(args.data),
+                "params": params.to_dict(),
+                "engine": args.engine,
+                "elapsed_s": elapsed,
+                "frames_with_confirmed_track": n_conf,
+                "truth": False,
+            }
+            write_json_atomic(Path(args.out), doc)
+            print(f"written: {args.out}")
+        return 0
     ev = evaluate(ds, est)
     print(
         f"{args.data}: {len(est.trajectories)} trajectories, {len(est.frame_index)} frames, "

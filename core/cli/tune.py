@@ -170,6 +170,8 @@ def run(args: argparse.Namespace) -> int:
             )
         sets = _training_sets(args)
         paths = [resolve_dataset(d, person_model=args.person_model) for d in sets]
+        for train_path in dict.fromkeys(paths):
+            require_truth(train_path)
         val_arg = args.validation
         if val_arg is None and _paper_seed(args.dataset) is not None:
             model = str(args.dataset).split(":")[2:] if args.dataset else []
@@ -182,6 +184,7 @@ def run(args: argparse.Namespace) -> int:
                     "training sets; use paper:SEED with SEED >= 1000"
                 )
             validation = resolve_dataset(val_arg, person_model=args.person_model)
+            require_truth(validation)
             if validation in paths:
                 raise InputError(f"--validation {val_arg!r} is a training set of this run")
             check_same_radar(paths[0], validation, "validation")
@@ -343,3 +346,18 @@ def exit_code(
             file=sys.stderr,
         )
     return EXIT_WORKER_LOST
+
+
+def require_truth(path: str) -> None:
+    """A study scores tracks against ground truth: refuse a data set without any (an imported
+    recording without ``--truth``) with one line."""
+    from core.dataset import Dataset
+    from core.errors import InputError
+    from core.formats.recording import has_truth
+
+    if not has_truth(Dataset.load(path)):
+        raise InputError(
+            "the data set has no ground truth (imported without --truth?): a study needs "
+            "truth to score; import it again with --truth CSV",
+            str(path),
+        )
