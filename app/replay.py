@@ -28,11 +28,9 @@ def load_recording(path: str | Path, cfg: str | None = None) -> Dataset:
     if path.suffix == ".npz":
         return Dataset.load(path)
     from core.formats.recording import to_dataset
-    from core.formats.table import read_recording
-    from core.formats.ti_cfg import read_ti_cfg
+    from core.recordings import read_recording
 
-    radar = read_ti_cfg(cfg) if cfg else None
-    return to_dataset(read_recording(path, fmt=None, radar=radar), source_name=str(path))
+    return to_dataset(read_recording(path, fmt=None, cfg=cfg), source_name=str(path))
 
 
 class ReplayEngine(Engine):

@@ -7,7 +7,7 @@ import argparse
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
-    from core.formats.table import FORMATS
+    from core.recordings import FORMATS
 
     writable = tuple(
         n for n, row in FORMATS.items() if row.write is not None or row.write_scene is not None
@@ -38,8 +38,8 @@ def run(args: argparse.Namespace) -> int:
     from core.cli.progress import ProgressBar
     from core.errors import InputError
     from core.files import check_output_path
-    from core.formats.table import FORMATS
     from core.pipeline import plan, simulate_scene
+    from core.recordings import FORMATS
     from core.scene import Scene
 
     t0 = time.perf_counter()

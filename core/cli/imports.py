@@ -7,11 +7,12 @@ import argparse
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
-    from core.formats.table import FORMATS
+    from core.recordings import FORMATS
 
     p = sub.add_parser(
         "import",
-        help="turn a real recording (TI UART log, visualizer replay) into a data set .npz",
+        help="turn a real recording (TI UART log, visualizer replay, DCA1000 capture) into a "
+        "data set .npz",
         description="Read a recording (format detected from its content, or --format), "
         "optionally with the TI .cfg it was recorded with and a ground-truth CSV "
         "(time_s,person,x_m,y_m), and write it as a RadarTune data set. Dropped frames and "
@@ -30,14 +31,12 @@ def run(args: argparse.Namespace) -> int:
 
     from core.files import check_output_path
     from core.formats.recording import read_truth_csv, to_dataset
-    from core.formats.table import read_recording
-    from core.formats.ti_cfg import read_ti_cfg
+    from core.recordings import read_recording
 
     t0 = time.perf_counter()
     check_output_path(args.out, what="data set")
-    radar = read_ti_cfg(args.cfg) if args.cfg else None
     truth = read_truth_csv(args.truth) if args.truth else None
-    rec = read_recording(args.file, fmt=args.format, radar=radar)
+    rec = read_recording(args.file, fmt=args.format, cfg=args.cfg)
     ds = to_dataset(rec, truth=truth, source_name=str(args.file))
     ds.save(args.out)
     for line in rec.notes:

@@ -39,6 +39,10 @@ WORD_BYTES = 2
 COMPLEX_16BIT = AdcFormat()
 
 
+#: The format's name in the table of recording formats (:data:`core.recordings.FORMATS`).
+CAPTURE_FORMAT = "dca1000"
+
+
 @dataclass(frozen=True, slots=True, kw_only=True)
 class CaptureLayout:
     """The shape of one frame of a DCA1000 capture.

@@ -5,7 +5,7 @@ configuration, what it dropped); :func:`to_dataset` adds the optional ground tru
 ``time_s, person, x_m, y_m``) and builds a :class:`~core.dataset.Dataset` that ``radartune
 track``, the report and (with truth) studies use like a simulated one.
 
-The table of formats is :mod:`core.formats.table`.
+The table of formats is :mod:`core.recordings`.
 """
 
 from __future__ import annotations

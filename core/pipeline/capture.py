@@ -14,7 +14,6 @@ the radar chain, which the formats layer sits below (see docs/decisions/inputs-0
 from __future__ import annotations
 
 import dataclasses
-import json
 import os
 import warnings
 from collections.abc import Callable, Iterator
@@ -27,14 +26,15 @@ from core.dataset import Dataset
 from core.errors import InputError
 from core.files import check_output_path, printable, write_text_atomic
 from core.formats.dca1000 import (
+    CAPTURE_FORMAT,
     Capture,
     CaptureLayout,
     iter_capture_frames,
     open_capture,
     write_capture_frames,
 )
+from core.formats.recording import Recording, read_truth_csv, to_dataset
 from core.formats.ti_cfg import adc_format, parse_ti_cfg, read_ti_capture_cfg, ti_cfg_text
-from core.formats.truth_csv import read_truth_rows, truth_at_frames
 from core.limits import MAX_DATASET_FRAMES
 from core.pipeline.frames import frame_inputs
 from core.pipeline.plan import plan
@@ -49,10 +49,6 @@ ADC_NOISE_RMS_COUNTS = 8.0
 #: of written captures (sampleSwap 0: I before Q, TI's documented DCA1000 order).
 SDK_ADCBUF_CFG = "adcbufCfg -1 0 1 1 1"
 CAPTURE_ADCBUF_CFG = "adcbufCfg -1 0 0 1 1"
-#: The trajectory class of a recorded data set.
-RECORDED_CLASS = "real"
-#: The ``fidelity`` a data set read from a capture records.
-CAPTURE_FIDELITY = "dca1000"
 
 NoteCallback = Callable[[str], None]
 
@@ -119,6 +115,63 @@ def iter_capture_clouds(
         yield process_cube(cube, radar, settings=s, elevation=el).point_cloud
 
 
+def recording_from_capture(
+    bin_path: str | os.PathLike,
+    cfg_path: str | os.PathLike,
+    *,
+    settings: ProcessingSettings | None = None,
+    elevation: bool | None = None,
+    note: NoteCallback | None = None,
+) -> Recording:
+    """A DCA1000 capture through the exact chain's processing half, as a one-run recording.
+
+    Parameters
+    ----------
+    bin_path, cfg_path
+        The capture and the TI ``.cfg`` that made it (:mod:`core.formats.dca1000` for the
+        layout it implies).
+    settings
+        Processing settings (default: the chain's defaults, SPEC §3).
+    elevation
+        Estimate elevation (default: when the virtual array can).
+    note
+        Receives one line per thing skipped (a trailing partial frame); default: a
+        :class:`CaptureWarning`. The line is also among the recording's ``notes``.
+
+    Returns
+    -------
+    Recording
+        Format ``"dca1000"``; frame ``f`` at ``f * frame_period_s``; the cfg's radar.
+
+    Raises
+    ------
+    InputError
+        One line: a malformed cfg (file, line, field), a capture whose size does not fit the cfg
+        (both files, the sizes), more frames than a data set may hold.
+    """
+    radar, capture = open_capture_with_cfg(bin_path, cfg_path)
+    if capture.n_frames > MAX_DATASET_FRAMES:
+        raise InputError(
+            f"{capture.n_frames} frames, more than the data-set limit {MAX_DATASET_FRAMES}",
+            printable(str(bin_path)),
+        )
+    notes = []
+    if capture.dropped_note:
+        (note or _warn)(capture.dropped_note)
+        notes.append(capture.dropped_note)
+    clouds = list(iter_capture_clouds(radar, capture, settings=settings, elevation=elevation))
+    counts = np.array([len(c) for c in clouds], dtype=np.int64)
+    return Recording(
+        format=CAPTURE_FORMAT,
+        cloud=PointCloud.concatenate(clouds),
+        counts=counts,
+        t_s=np.arange(capture.n_frames) * radar.frame_period_s,
+        trajectory=np.zeros(capture.n_frames, dtype=np.int64),
+        radar=radar,
+        notes=tuple(notes),
+    )
+
+
 def dataset_from_capture(
     bin_path: str | os.PathLike,
     cfg_path: str | os.PathLike,
@@ -128,60 +181,15 @@ def dataset_from_capture(
     elevation: bool | None = None,
     note: NoteCallback | None = None,
 ) -> Dataset:
-    """A DCA1000 capture as a one-trajectory data set.
-
-    Parameters
-    ----------
-    bin_path, cfg_path
-        The capture and the TI ``.cfg`` that made it (:mod:`core.formats.dca1000` for the
-        layout it implies).
-    truth
-        Optional CSV ``time_s,person,x_m,y_m`` (:mod:`core.formats.truth_csv`), times from the
-        first frame's start; without it the data set has no persons.
-    settings
-        Processing settings (default: the chain's defaults, SPEC §3).
-    elevation
-        Estimate elevation (default: when the virtual array can).
-    note
-        Receives one line per thing skipped (a trailing partial frame); default: a
-        :class:`CaptureWarning`.
-
-    Returns
-    -------
-    Dataset
-        Frame ``f`` at ``f * frame_period_s``; ``fidelity`` ``"dca1000"``, class ``"real"``,
-        every point's ``source`` ``SOURCE_OTHER``, ``radar_json`` the cfg's radar.
-
-    Raises
-    ------
-    InputError
-        One line: a malformed cfg (file, line, field), a capture whose size does not fit the cfg
-        (both files, the sizes), a malformed truth CSV (file, line).
-    """
-    radar, capture = open_capture_with_cfg(bin_path, cfg_path)
-    if capture.n_frames > MAX_DATASET_FRAMES:
-        raise InputError(
-            f"{capture.n_frames} frames, more than the data-set limit {MAX_DATASET_FRAMES}",
-            printable(str(bin_path)),
-        )
-    rows = read_truth_rows(truth) if truth is not None else {}
-    if capture.dropped_note:
-        (note or _warn)(capture.dropped_note)
-    clouds = list(iter_capture_clouds(radar, capture, settings=settings, elevation=elevation))
-    t_s = np.arange(capture.n_frames) * radar.frame_period_s
-    xy, v = truth_at_frames(rows, t_s)
-    return Dataset.from_frames(
-        clouds=clouds,
-        trajectory=np.zeros(capture.n_frames, dtype=np.int32),
-        truth_t_s=t_s,
-        truth_xy_m=xy,
-        truth_v_mps=v,
-        trajectory_class=[RECORDED_CLASS],
-        scene_json="",
-        radar_json=json.dumps(radar.to_dict()),
-        fidelity=CAPTURE_FIDELITY,
-        seed=0,
+    """A DCA1000 capture as a data set (:func:`recording_from_capture`, then
+    :func:`core.formats.recording.to_dataset`), with the truth CSV ``time_s,person,x_m,y_m``
+    (:func:`core.formats.recording.read_truth_csv`; times from the first frame's start) if
+    given; without it the data set has no persons."""
+    rows = read_truth_csv(truth) if truth is not None else None
+    rec = recording_from_capture(
+        bin_path, cfg_path, settings=settings, elevation=elevation, note=note
     )
+    return to_dataset(rec, truth=rows, source_name=printable(str(bin_path)))
 
 
 # ---- writing ------------------------------------------------------------------------------------

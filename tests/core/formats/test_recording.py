@@ -13,8 +13,8 @@ from core.cli import main
 from core.dataset import Dataset
 from core.errors import InputError
 from core.formats.recording import read_truth_csv, truth_on_frames
-from core.formats.table import FORMATS
 from core.formats.ti_replay import read as read_replay
+from core.recordings import FORMATS
 from tests.scenes import small_scene
 
 
@@ -172,8 +172,15 @@ def test_import_without_truth_tracks_and_refuses_a_study(simulated, capsys) -> N
 
 def test_import_refuses_unknown_and_empty_files(tmp_path, capsys) -> None:
     (tmp_path / "e.dat").write_bytes(b"")
+    (tmp_path / "j.xyz").write_bytes(b"\x00" * 1000)
+    # raw ADC samples carry no signature: a .bin without the UART magic word is taken as a
+    # DCA1000 capture, which cannot be read without its .cfg
     (tmp_path / "j.bin").write_bytes(b"\x00" * 1000)
-    for name, message in (("e.dat", "empty file"), ("j.bin", "format not recognised")):
+    for name, message in (
+        ("e.dat", "empty file"),
+        ("j.xyz", "format not recognised"),
+        ("j.bin", "DCA1000 capture holds raw ADC samples only: give --cfg"),
+    ):
         code = run_cli("import", tmp_path / name, "--out", tmp_path / "o.npz")
         err = capsys.readouterr().err
         assert code == 2 and message in err and len(err.strip().splitlines()) == 1

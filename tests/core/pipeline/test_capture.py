@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from core.config import SPEED_OF_LIGHT_MPS
+from core.dataset import Dataset
 from core.errors import InputError
 from core.formats.dca1000 import CaptureLayout, open_capture, write_capture_frames
 from core.formats.ti_cfg import AdcFormat, read_ti_capture_cfg
@@ -118,28 +119,28 @@ def test_truth_csv_interpolated_to_frames(scene: Scene, tmp_path: Path) -> None:
     bin_path, cfg_path = write_capture(scene, tmp_path / "s.bin")
     t = scene.radar.frame_period_s
     csv = tmp_path / "truth.csv"
-    # person 3 walks x = 1 + 2 t from t = 0 to 2 frames; person 0 stands from frame 1 on
+    # person 1 walks x = 1 + 2 t from t = 0 to 2 frames; person 0 stands from frame 1 on
     csv.write_text(
-        f"person,time_s,x_m,y_m\n3,0,1,5\n3,{2 * t},{1 + 4 * t},5\n0,{t},-1,2\n0,{9 * t},-1,2\n"
+        f"time_s,person,x_m,y_m\n0,1,1,5\n{2 * t},1,{1 + 4 * t},5\n{t},0,-1,2\n{9 * t},0,-1,2\n"
     )
     ds = dataset_from_capture(bin_path, cfg_path, truth=csv)
     assert ds.truth_xy_m.shape == (4, 2, 2)
     assert np.isnan(ds.truth_xy_m[0, 0]).all() and ds.truth_xy_m[1, 0].tolist() == [-1, 2]
     assert ds.truth_xy_m[1, 1, 0] == pytest.approx(1 + 2 * t)
     assert ds.truth_v_mps[1, 1].tolist() == pytest.approx([2.0, 0.0])
-    assert np.isnan(ds.truth_xy_m[3, 1]).all()  # after person 3's last row
-    assert ds.fidelity == "dca1000" and ds.trajectory_class.tolist() == ["real"]
+    assert np.isnan(ds.truth_xy_m[3, 1]).all()  # after person 1's last row
+    assert ds.fidelity == "real" and ds.trajectory_class.tolist() == ["real"]
+    assert ds.scene()["imported"]["format"] == "dca1000"
 
 
 @pytest.mark.parametrize(
     ("text", "expected"),
     [
-        ("time_s,person,x_m\n0,0,1\n", "lacks column"),
-        ("time_s,person,x_m,y_m\n0,0,1,nan\n1,0,1,1\n", ":2: y_m: not finite"),
-        ("time_s,person,x_m,y_m\n0,-1,1,1\n", ":2: person"),
-        ("time_s,person,x_m,y_m\n0,0,1,1\n", "one row"),
-        ("time_s,person,x_m,y_m\n0,0,1,1\n0,0,2,2\n", ":3: person 0 has time_s"),
-        ("", "empty truth CSV"),
+        ("time_s,person,x_m\n0,0,1\n", ":1: the first line must name the columns"),
+        ("time_s,person,x_m,y_m\n0,0,1,nan\n1,0,1,1\n", ":2: y_m must be finite"),
+        ("time_s,person,x_m,y_m\n0,-1,1,1\n", ":2: person must be an integer"),
+        ("time_s,person,x_m,y_m\n-1,0,1,1\n", ":2: time_s must be >= 0"),
+        ("", "no header line time_s,person,x_m,y_m"),
     ],
 )
 def test_bad_truth_csv_is_one_line(scene: Scene, tmp_path: Path, text: str, expected: str) -> None:
@@ -321,3 +322,41 @@ def test_settings_are_taken(scene: Scene, tmp_path: Path) -> None:
     bin_path, cfg_path = write_capture(scene, tmp_path / "s.bin")
     near = dataclasses.replace(processing_settings(scene), max_range_m=3.0)
     assert len(dataset_from_capture(bin_path, cfg_path, settings=near).frame) == 0
+
+
+def test_import_and_export_a_capture_through_the_cli(scene: Scene, tmp_path: Path, capsys) -> None:
+    """`radartune export --format dca1000` then `radartune import --cfg`: the points of the
+    capture processed directly."""
+    from core.cli import main
+
+    scene_file = tmp_path / "scene.json"
+    scene.to_json(scene_file)
+    out = tmp_path / "cap.bin"
+    assert (
+        main(["export", "--scene", str(scene_file), "--format", "dca1000", "--out", str(out)]) == 0
+    )
+    cfg = out.with_suffix(".cfg")
+    assert cfg.is_file()
+    ds_path = tmp_path / "cap.npz"
+    assert main(["import", str(out), "--cfg", str(cfg), "--out", str(ds_path)]) == 0
+    direct = dataset_from_capture(out, cfg)
+    ds = Dataset.load(ds_path)
+    assert ds.n_frames == scene.n_frames == direct.n_frames
+    np.testing.assert_array_equal(ds.range_m, direct.range_m)
+    np.testing.assert_array_equal(ds.radial_velocity_mps, direct.radial_velocity_mps)
+    # the ADC samples are the exact chain's: another fidelity is refused with one line
+    code = main(
+        [
+            "export",
+            "--scene",
+            str(scene_file),
+            "--format",
+            "dca1000",
+            "--out",
+            str(tmp_path / "b.bin"),
+            "--fidelity",
+            "fast",
+        ]
+    )
+    err = capsys.readouterr().err
+    assert code == 2 and "--fidelity must be exact for dca1000" in err

@@ -11,12 +11,18 @@ import os
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from core.config import RadarConfig
 from core.errors import InputError
-from core.formats import ti_replay, ti_uart_import
+from core.formats import ti_replay, ti_uart, ti_uart_import
+from core.formats.dca1000 import CAPTURE_FORMAT
 from core.formats.recording import Recording
+from core.formats.ti_cfg import read_ti_cfg
 from core.pointcloud import PointCloud
+
+if TYPE_CHECKING:
+    from core.scene import Scene
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -24,7 +30,8 @@ class FileFormat:
     """One row of :data:`FORMATS`.
 
     ``sniff(head, path)``: True when a file whose first bytes are ``head`` is in this format.
-    ``read(path, radar)``: the :class:`Recording` (``radar`` from ``--cfg`` or None).
+    ``read(path, cfg)``: the :class:`Recording` (``cfg``: the TI ``.cfg`` given with ``--cfg``,
+    or None).
     ``write(path, clouds, radar, variant)``: the files written for a simulated scene's point
     clouds, one per frame (the data file and its ``.cfg``), or None when the format cannot be
     written; ``variants``: the values ``--variant`` accepts (first: the default).
@@ -37,7 +44,7 @@ class FileFormat:
     description: str
     suffixes: tuple[str, ...]
     sniff: Callable[[bytes, Path], bool]
-    read: Callable[[Path, RadarConfig | None], Recording]
+    read: Callable[[Path, Path | None], Recording]
     write: Callable[[Path, Sequence[PointCloud], RadarConfig, str | None], list[Path]] | None = None
     variants: tuple[str, ...] = ()
     write_scene: Callable[..., list[Path]] | None = None
@@ -49,7 +56,7 @@ def _uart_row() -> FileFormat:
         description="TI mmWave demo UART stream (Demo Visualizer .dat, serial dumps), every SDK",
         suffixes=(".dat", ".bin", ".uart", ".log"),
         sniff=ti_uart_import.sniff,
-        read=ti_uart_import.read,
+        read=lambda path, cfg: ti_uart_import.read(path, _radar(cfg)),
         write=ti_uart_import.write,
         variants=ti_uart_import.VARIANTS,
     )
@@ -61,13 +68,59 @@ def _replay_row() -> FileFormat:
         description="TI Industrial Visualizer replay (replay_N.json, or a folder of them)",
         suffixes=(".json",),
         sniff=ti_replay.sniff,
-        read=ti_replay.read,
+        read=lambda path, cfg: ti_replay.read(path, _radar(cfg)),
         write=ti_replay.write,
     )
 
 
-#: name -> row, in the order auto-detection tries them. The DCA1000 reader adds its row here.
-FORMATS: dict[str, FileFormat] = {row.name: row for row in (_uart_row(), _replay_row())}
+def _radar(cfg: Path | None) -> RadarConfig | None:
+    return read_ti_cfg(cfg) if cfg is not None else None
+
+
+def _read_capture(path: Path, cfg: Path | None) -> Recording:
+    if cfg is None:
+        raise InputError(
+            "a DCA1000 capture holds raw ADC samples only: give --cfg, the TI .cfg it was "
+            "captured with",
+            str(path),
+        )
+
+    from core.pipeline.capture import recording_from_capture  # the radar chain: heavy import
+
+    return recording_from_capture(path, cfg)
+
+
+def _write_capture(
+    path: Path, scene: Scene, *, seed: int | None, fidelity: str, variant: str | None
+) -> list[Path]:
+
+    if fidelity != "exact":
+        raise InputError(
+            f"--fidelity must be exact for dca1000 (the ADC samples are the exact chain's), "
+            f"got {fidelity!r}"
+        )
+    from core.pipeline.capture import write_capture  # the radar chain: heavy import
+
+    return write_capture(scene, path, seed=seed)
+
+
+def _dca1000_row() -> FileFormat:
+    return FileFormat(
+        name=CAPTURE_FORMAT,
+        description="TI DCA1000 raw ADC capture (.bin) with the TI .cfg that made it, processed "
+        "by RadarTune's own chain",
+        suffixes=(".bin",),
+        # raw samples carry no signature: a .bin without the UART magic word (tried first)
+        sniff=lambda head, path: path.suffix.lower() == ".bin" and ti_uart.MAGIC not in head,
+        read=_read_capture,
+        write_scene=_write_capture,
+    )
+
+
+#: name -> row, in the order auto-detection tries them.
+FORMATS: dict[str, FileFormat] = {
+    row.name: row for row in (_uart_row(), _replay_row(), _dca1000_row())
+}
 
 #: Bytes read from the start of a file to recognise its format.
 SNIFF_BYTES = 1 << 16
@@ -95,7 +148,7 @@ def detect_format(path: Path) -> FileFormat:
 
 
 def read_recording(
-    path: str | os.PathLike, *, fmt: str | None, radar: RadarConfig | None
+    path: str | os.PathLike, *, fmt: str | None, cfg: str | os.PathLike | None
 ) -> Recording:
     path = Path(path)
     if not path.exists():
@@ -106,4 +159,4 @@ def read_recording(
         row = FORMATS[fmt]
     else:
         raise InputError(f"--format must be one of {list(FORMATS)}, got {fmt!r}")
-    return row.read(path, radar)
+    return row.read(path, None if cfg is None else Path(cfg))
