@@ -108,7 +108,8 @@ class QuadraticLosses:
 
 
 class TrackerLosses:
-    """The paper's loss of the real IPDA tracker on a cached data set.
+    """The paper's loss of the real IPDA tracker on a cached data set (with several persons, its
+    multi-person form: :mod:`core.evaluation.loss`).
 
     Parameters
     ----------
@@ -133,21 +134,20 @@ class TrackerLosses:
         self.losses(tracker_params_dict(flat, model), [0])
 
     def losses(self, params: dict[str, Any], ks: Sequence[int]) -> list[tuple[float, float, int]]:
-        from core.evaluation import tracked_person_xy, trajectory_loss
+        from core.evaluation import trajectory_loss_terms
         from core.tracking import TrackerParams, track_dataset
 
         if not len(ks):
             return []
         tp = TrackerParams.from_dict({**self.base_params, **params})
-        est = track_dataset(self.dataset, tp, trajectories=list(ks))
-        # person 0 is the tracked person (NaN where absent); est.frame_index: the tracked frames
-        truth = tracked_person_xy(self.dataset.truth_xy_m[est.frame_index])
-        out = []
-        for i in range(len(ks)):
-            s = slice(int(est.offsets[i]), int(est.offsets[i + 1]))
-            value, mse, n_c = trajectory_loss(est.estimate_xy[s], est.has_estimate[s], truth[s])
-            out.append((float(value), float(mse), int(n_c)))
-        return out
+        # several persons are scored from every confirmed track (the multi-person loss); one
+        # person from the single-person estimate, as ever (the same numbers bit for bit)
+        several = self.dataset.n_persons > 1
+        est = track_dataset(self.dataset, tp, trajectories=list(ks), with_tracks=several)
+        return [
+            (float(value), float(mse), int(n_c))
+            for value, mse, n_c in trajectory_loss_terms(self.dataset, est)
+        ]
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
