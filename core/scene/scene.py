@@ -443,6 +443,8 @@ def _parse_scene(data: Any, base_dir: Path) -> Scene:
         raise InputError("persons must be a list")
     if len(persons_d) > MAX_PERSONS:
         raise InputError(f"persons lists {len(persons_d)}, more than the limit {MAX_PERSONS}")
+    if not persons_d:
+        raise InputError(f"persons lists none; a scene holds 1 to {MAX_PERSONS} persons")
     persons = []
     for i, p in enumerate(persons_d):
         where = f"persons[{i}]"
