@@ -3,6 +3,8 @@
 - :mod:`~core.evaluation.loss` — the paper's loss L(k) and L_t (eqs. 12–14)
 - :mod:`~core.evaluation.metrics` — OSPA, GOSPA and the far-frame threshold
 - :mod:`~core.evaluation.assignment` — tracks assigned to people, identity switches
+- :mod:`~core.evaluation.people` — GOSPA, count error, identities per frame and per person
+  (:func:`people_run`: one run, for the GUI)
 - :mod:`~core.evaluation.table` — :func:`evaluate`: the loss table (Table I) and every metric of
   one run (:class:`Evaluation`)
 - :mod:`~core.evaluation.comparison` — two runs compared: loss breakdown by kind of frame,
@@ -42,6 +44,7 @@ from core.evaluation.metrics import (
     gospa,
     ospa,
 )
+from core.evaluation.people import FrameMetrics, PeopleRun, frame_metrics, people_run
 from core.evaluation.spread import PointSpread, person_point_spread
 from core.evaluation.table import ClassRow, Evaluation, PersonMetrics, evaluate
 
@@ -57,6 +60,8 @@ __all__ = [
     "OSPA_P",
     "ClassRow",
     "Evaluation",
+    "FrameMetrics",
+    "PeopleRun",
     "GospaTerms",
     "IdentityAssignment",
     "LossBreakdown",
@@ -66,10 +71,12 @@ __all__ = [
     "PointSpread",
     "assign_identities",
     "evaluate",
+    "frame_metrics",
     "gospa",
     "loss_breakdown",
     "ospa",
     "paired_comparison",
+    "people_run",
     "people_trajectory_loss",
     "person_estimates",
     "person_point_spread",

@@ -121,7 +121,7 @@ def assign_identities(
             free_p = np.ones(len(persons), dtype=bool)
             # 1. keep the previous pairing while it is confirmed and within c
             for b, j in enumerate(persons):
-                hit = np.flatnonzero(ids[f, cols] == last[j]) if last[j] >= 0 else ()
+                hit = np.flatnonzero(ids[f, cols] == last[j]) if last[j] >= 0 else np.zeros(0, int)
                 if len(hit) and d[hit[0], b] <= cutoff_m:
                     a = hit[0]
                     out_id[f, j], out_d[f, j] = last[j], d[a, b]

@@ -15,9 +15,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from core.evaluation.assignment import IDENTITY_CUTOFF_M, IdentityAssignment, assign_identities
+from core.evaluation.loss import PeopleLoss, people_trajectory_loss, person_estimates
 from core.evaluation.metrics import GOSPA_C_M, GOSPA_P, gospa
 
-__all__ = ["FrameMetrics", "PersonMetrics", "frame_metrics", "person_metrics"]
+__all__ = ["FrameMetrics", "PeopleRun", "PersonMetrics", "frame_metrics", "people_run",
+           "person_metrics"]  # fmt: skip
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -281,3 +283,51 @@ def person_metrics(
 def _trajectory_of(offsets: np.ndarray, n: int) -> np.ndarray:
     """(n,) index of the trajectory of every frame."""
     return np.searchsorted(np.asarray(offsets)[1:], np.arange(n), side="right")
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class PeopleRun:
+    """Every several-person metric of one tracker run over one trajectory (what the GUI shows).
+
+    Attributes
+    ----------
+    loss
+        The paper's loss in its several-person form (:class:`core.evaluation.loss.PeopleLoss`).
+    frames
+        Per-frame GOSPA, decomposition, count error and identities (:class:`FrameMetrics`).
+    persons
+        One :class:`PersonMetrics` per person.
+    estimate_xy
+        (N, P, 2) estimate of each person scored by the loss (m), NaN where none.
+    """
+
+    loss: PeopleLoss
+    frames: FrameMetrics
+    persons: tuple[PersonMetrics, ...]
+    estimate_xy: np.ndarray
+
+
+def people_run(truth_xy: np.ndarray, tracks) -> PeopleRun:
+    """Several-person metrics of one run (one trajectory).
+
+    Parameters
+    ----------
+    truth_xy
+        (N, P, 2) true positions (m), NaN where absent.
+    tracks
+        :class:`core.tracking.batch.ConfirmedTracks` of the N frames (for a readable-tracker run:
+        ``ConfirmedTracks.from_frames(result.frames)``).
+    """
+    truth = np.asarray(truth_xy, dtype=np.float64)
+    n = len(truth)
+    est = person_estimates(tracks.xy, truth)
+    loss = people_trajectory_loss(est, truth)
+    offsets = np.array([0, n], dtype=np.int64)
+    fm = frame_metrics(truth, tracks.xy, tracks.ids, offsets)
+    scored = np.all(np.isfinite(est), axis=2) & fm.present
+    sse = np.array([np.sum((est[:, j] - truth[:, j])[scored[:, j]] ** 2)
+                    for j in range(truth.shape[1])])  # fmt: skip
+    persons = person_metrics(
+        fm, loss.person_loss[None], loss.counted[None], loss.person_n_c[None], sse, offsets
+    )
+    return PeopleRun(loss=loss, frames=fm, persons=persons, estimate_xy=est)

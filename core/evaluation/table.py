@@ -141,10 +141,10 @@ class Evaluation:
                    f"– ({no_id})"),
             ]  # fmt: skip
         if self.persons:
-            head = ("person", "L x1e-3", "traj", "no conf", "N_c", "RMSE m", "present", "missed",
+            p_head = ("person", "L x1e-3", "traj", "no conf", "N_c", "RMSE m", "present", "missed",
                     "switches", "ids")  # fmt: skip
             widths = (6, 10, 5, 8, 7, 8, 8, 7, 9, 4)
-            lines.append(" ".join(f"{h:>{w}}" for h, w in zip(head, widths)))
+            lines.append(" ".join(f"{h:>{w}}" for h, w in zip(p_head, widths)))
             for m in self.persons:
                 lines.append(
                     f"{m.person:>6} {_cell(m.loss * 1e3, 10, '.4f')} {m.n_trajectories:5d} "

@@ -18,6 +18,7 @@ import numpy as np
 from core.dataset import Dataset
 from core.errors import InputError
 from core.tracking.params import TrackerParams
+from core.tracking.results import FrameTracks
 
 __all__ = [
     "ConfirmedTracks",
@@ -79,6 +80,22 @@ class ConfirmedTracks:
         out_psi = np.where(keep_s, np.asarray(psi)[rows, order], np.nan)
         width = max(int(keep.sum(axis=1).max(initial=0)), 1) if f else s
         return cls(ids=out_ids[:, :width], xy=out_xy[:, :width], psi=out_psi[:, :width])
+
+    @classmethod
+    def from_frames(cls, frames: Sequence[FrameTracks]) -> ConfirmedTracks:
+        """The confirmed tracks of a readable-tracker run (``TrackerResult.frames``), ranked."""
+        width = max((len(ft) for ft in frames), default=0) or 1
+        n = len(frames)
+        ids = np.full((n, width), -1, np.int64)
+        xy = np.full((n, width, 2), np.nan)
+        psi = np.full((n, width), np.nan)
+        conf = np.zeros((n, width), dtype=bool)
+        for f, ft in enumerate(frames):
+            k = len(ft)
+            ids[f, :k], xy[f, :k], psi[f, :k], conf[f, :k] = (
+                ft.ids, ft.state[:, :2], ft.psi, ft.confirmed
+            )  # fmt: skip
+        return cls.from_slots(ids, xy, psi, conf)
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)

@@ -292,3 +292,26 @@ def test_every_metric_defined(case) -> None:
     if case == "two persons":
         assert np.isfinite(ev.loss_total) and ev.loss_total < 1.0
         assert [m.frames_present for m in ev.persons] == [ds.n_frames, ds.n_frames - 20]
+
+
+def test_people_run_of_one_readable_tracker_run_matches_the_batch(one_person) -> None:
+    """The GUI's result type (one run of the readable tracker) gives the batch's numbers."""
+    from core.evaluation import people_run
+    from core.tracking import run_tracker
+    from core.tracking.batch import dataset_frame_period_s
+
+    params = TrackerParams.default("cv")
+    ds = one_person
+    a, b = int(ds.trajectory_offsets[2]), int(ds.trajectory_offsets[3])
+    f_off = ds.frame_offsets
+    res = run_tracker(
+        (ds.measurements()[f_off[a] : f_off[b]], f_off[a : b + 1] - f_off[a]),
+        params,
+        dataset_frame_period_s(ds),
+    )
+    run = people_run(ds.truth_xy_m[a:b], ConfirmedTracks.from_frames(res.frames))
+    ev = evaluate(ds, track_dataset(ds, params, trajectories=[2], with_tracks=True))
+    assert run.loss.loss == pytest.approx(ev.loss[0], rel=1e-9)
+    np.testing.assert_allclose(run.frames.gospa_m, ev.frames.gospa_m, atol=1e-9)
+    assert run.persons[0].identity_switches == ev.persons[0].identity_switches
+    assert run.persons[0].n_c == ev.persons[0].n_c
