@@ -154,14 +154,32 @@ def person_estimates(ranked_xy: np.ndarray, truth_xy: np.ndarray) -> np.ndarray:
     n, p = truth.shape[:2]
     out = np.full((n, p, 2), np.nan)
     present = np.all(np.isfinite(truth), axis=2)
+    n_present = present.sum(axis=1)
     n_tracks = np.sum(np.all(np.isfinite(ranked), axis=2), axis=1)
-    for f in np.flatnonzero((n_tracks > 0) & present.any(axis=1)):
+    k = np.minimum(n_present, n_tracks)  # pairs in each frame
+    # one pair: the most probable track goes to the nearest person present
+    f1 = np.flatnonzero(k == 1)
+    if len(f1):
+        e = ranked[f1, 0][:, None, :] - truth[f1]
+        d2 = np.where(present[f1], np.sum(e * e, axis=2), np.inf)
+        out[f1, np.argmin(d2, axis=1)] = ranked[f1, 0]
+    # two tracks, two persons: the cheaper of the two pairings
+    f2 = np.flatnonzero((k == 2) & (n_present == 2))
+    if len(f2):
+        ab = np.argsort(~present[f2], axis=1, kind="stable")[:, :2]  # the two persons present
+        pa, pb = truth[f2, ab[:, 0]], truth[f2, ab[:, 1]]
+        t0, t1 = ranked[f2, 0], ranked[f2, 1]
+
+        def sq(u: np.ndarray, v: np.ndarray) -> np.ndarray:
+            return np.sum((u - v) ** 2, axis=1)
+
+        keep = sq(t0, pa) + sq(t1, pb) <= sq(t0, pb) + sq(t1, pa)
+        out[f2, ab[:, 0]] = np.where(keep[:, None], t0, t1)
+        out[f2, ab[:, 1]] = np.where(keep[:, None], t1, t0)
+    for f in np.flatnonzero((k >= 2) & ~((k == 2) & (n_present == 2))):
         persons = np.flatnonzero(present[f])
         # the P_f most probable confirmed tracks (ranked first: finite rows come first)
-        top = ranked[f, : min(len(persons), int(n_tracks[f]))]
-        if len(top) == 1 and len(persons) == 1:
-            out[f, persons[0]] = top[0]
-            continue
+        top = ranked[f, : k[f]]
         e = top[:, None, :] - truth[f, persons][None, :, :]
         # pairing of least Σ‖x̂ − x‖²
         rows, cols = linear_sum_assignment(np.sum(e * e, axis=2))

@@ -315,3 +315,30 @@ def test_people_run_of_one_readable_tracker_run_matches_the_batch(one_person) ->
     np.testing.assert_allclose(run.frames.gospa_m, ev.frames.gospa_m, atol=1e-9)
     assert run.persons[0].identity_switches == ev.persons[0].identity_switches
     assert run.persons[0].n_c == ev.persons[0].n_c
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_person_estimates_equal_brute_force(seed: int) -> None:
+    """The vectorised pairings (one pair; two tracks and two persons) and the general loop give
+    the pairing of least Σ d² over the P_f most probable tracks, checked by enumeration."""
+    rng = np.random.default_rng(seed)
+    n, p, c = 200, 4, 5
+    truth = rng.uniform(-3, 3, (n, p, 2))
+    truth[rng.random((n, p)) < 0.4] = np.nan
+    ranked = rng.uniform(-3, 3, (n, c, 2))
+    n_tracks = rng.integers(0, c + 1, n)
+    ranked[np.arange(c)[None, :] >= n_tracks[:, None]] = np.nan
+    est = person_estimates(ranked, truth)
+    for f in range(n):
+        persons = np.flatnonzero(np.isfinite(truth[f, :, 0]))
+        k = min(len(persons), int(n_tracks[f]))
+        best, best_cost = {}, math.inf
+        for chosen in itertools.permutations(persons, k):  # track i → person chosen[i]
+            cost = sum(np.sum((ranked[f, i] - truth[f, j]) ** 2) for i, j in enumerate(chosen))
+            if cost < best_cost:
+                best, best_cost = dict(zip(chosen, range(k))), cost
+        for j in range(p):
+            if j in best:
+                np.testing.assert_array_equal(est[f, j], ranked[f, best[j]])
+            else:
+                assert np.isnan(est[f, j]).all()
