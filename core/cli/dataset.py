@@ -26,6 +26,13 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         help="person scattering model: point (the paper's, default) or extended (torso, arms, "
         "legs, micro-Doppler); the trajectories and seeds stay those of the point set",
     )
+    p.add_argument(
+        "--persons",
+        type=int,
+        default=1,
+        help="persons per trajectory, 1-8 (default 1: the paper's set); person j of trajectory "
+        "k walks class abcde[(k+j) %% 5], person 0 is the one-person set's",
+    )
     p.set_defaults(func=run)
 
 
@@ -35,7 +42,7 @@ def run(args: argparse.Namespace) -> int:
     from core.cli.progress import ProgressBar
     from core.errors import InputError
     from core.files import check_output_path
-    from core.limits import MAX_DATASET_TRAJECTORIES, MAX_JOBS
+    from core.limits import MAX_DATASET_TRAJECTORIES, MAX_JOBS, MAX_PERSONS
     from core.pipeline import paper_dataset
 
     t0 = time.perf_counter()
@@ -45,6 +52,8 @@ def run(args: argparse.Namespace) -> int:
         raise InputError(
             f"--trajectories must be in [1, {MAX_DATASET_TRAJECTORIES}], got {args.trajectories}"
         )
+    if not 1 <= args.persons <= MAX_PERSONS:
+        raise InputError(f"--persons must be in [1, {MAX_PERSONS}], got {args.persons}")
     if args.jobs is not None and not 1 <= args.jobs <= MAX_JOBS:
         raise InputError(f"--jobs must be in [1, {MAX_JOBS}], got {args.jobs}")
     check_output_path(args.out, what="data set")
@@ -62,11 +71,13 @@ def run(args: argparse.Namespace) -> int:
         progress=ProgressBar("dataset"),
         use_cache=not args.no_cache,
         person_model=args.person_model,
+        n_persons=args.persons,
     )
     ds.save(args.out)
     per_class = {c: int(np.sum(ds.trajectory_class == c)) for c in "abcde"}
     print(
-        f"wrote {args.out}: {ds.n_trajectories} trajectories {per_class}, {ds.n_frames} frames, "
+        f"wrote {args.out}: {ds.n_trajectories} trajectories {per_class}, "
+        f"{ds.n_persons} person(s), {ds.n_frames} frames, "
         f"{len(ds.frame)} points; elapsed {time.perf_counter() - t0:.1f} s"
     )
     return 0

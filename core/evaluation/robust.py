@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
 
@@ -89,6 +90,37 @@ def capped_loss(
     return float(np.sum(d) / n)
 
 
+def trajectory_capped_losses(dataset: Any, estimates: Any) -> list[float]:
+    """``C(k)`` of every tracked trajectory, in the order tracked (m²).
+
+    One person (or none): :func:`capped_loss` of the single-person estimate against person 0.
+    Several: each person's :func:`capped_loss` against the estimate the paper's multi-person
+    loss gives them (:func:`core.evaluation.loss.person_estimates`), averaged over the persons
+    present in the trajectory (0 when nobody is).
+    """
+    from core.evaluation.loss import person_estimates, tracked_person_xy
+
+    truth_all = dataset.truth_xy_m[estimates.frame_index]  # (F_sel, P, 2) m
+    off = estimates.offsets
+    out: list[float] = []
+    if truth_all.shape[1] <= 1:
+        truth = tracked_person_xy(truth_all)  # (F_sel, 2) m
+        for i in range(len(estimates.trajectories)):
+            s = slice(off[i], off[i + 1])
+            out.append(capped_loss(estimates.estimate_xy[s], estimates.has_estimate[s], truth[s]))
+        return out
+    est = person_estimates(estimates.tracks.xy, truth_all)  # (F_sel, P, 2) m, NaN: none
+    for i in range(len(estimates.trajectories)):
+        s = slice(off[i], off[i + 1])
+        per_person = [
+            capped_loss(est[s, p], np.all(np.isfinite(est[s, p]), axis=1), truth_all[s, p])
+            for p in range(truth_all.shape[1])
+            if np.isfinite(truth_all[s, p]).all(axis=1).any()
+        ]
+        out.append(float(np.mean(per_person)) if per_person else 0.0)
+    return out
+
+
 def trimmed_mean(values: Sequence[float], fraction: float = TRIM_FRACTION) -> float:
     """Mean of ``values`` without their largest ``floor(fraction · n)`` (at least one stays)."""
     v = np.sort(np.asarray(values, dtype=np.float64))
@@ -116,5 +148,6 @@ __all__ = [
     "aggregate",
     "capped_loss",
     "check_objective",
+    "trajectory_capped_losses",
     "trimmed_mean",
 ]

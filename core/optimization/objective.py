@@ -117,7 +117,8 @@ class QuadraticLosses:
 
 
 class TrackerLosses:
-    """The paper's loss of the real IPDA tracker on a cached data set.
+    """The paper's loss of the real IPDA tracker on a cached data set (with several persons, its
+    multi-person form: :mod:`core.evaluation.loss`).
 
     Parameters
     ----------
@@ -147,23 +148,23 @@ class TrackerLosses:
         )
 
     def losses(self, params: dict[str, Any], ks: Sequence[int]) -> list[TrajectoryScore]:
-        from core.evaluation import tracked_person_xy, trajectory_loss
-        from core.evaluation.robust import capped_loss
+        from core.evaluation import trajectory_loss_terms
+        from core.evaluation.robust import trajectory_capped_losses
         from core.tracking import TrackerParams, track_dataset
 
         if not len(ks):
             return []
         tp = TrackerParams.from_dict({**self.base_params, **params})
-        est = track_dataset(self.dataset, tp, trajectories=list(ks))
-        # person 0 is the tracked person (NaN where absent); est.frame_index: the tracked frames
-        truth = tracked_person_xy(self.dataset.truth_xy_m[est.frame_index])
-        out = []
-        for i in range(len(ks)):
-            s = slice(int(est.offsets[i]), int(est.offsets[i + 1]))
-            value, mse, n_c = trajectory_loss(est.estimate_xy[s], est.has_estimate[s], truth[s])
-            capped = capped_loss(est.estimate_xy[s], est.has_estimate[s], truth[s])
-            out.append(TrajectoryScore(float(value), float(mse), int(n_c), capped))
-        return out
+        # several persons are scored from every confirmed track (the multi-person loss); one
+        # person from the single-person estimate, as ever (the same numbers bit for bit)
+        several = self.dataset.n_persons > 1
+        est = track_dataset(self.dataset, tp, trajectories=list(ks), with_tracks=several)
+        terms = trajectory_loss_terms(self.dataset, est)
+        capped = trajectory_capped_losses(self.dataset, est)
+        return [
+            TrajectoryScore(float(value), float(mse), int(n_c), c)
+            for (value, mse, n_c), c in zip(terms, capped, strict=True)
+        ]
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)

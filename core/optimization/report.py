@@ -6,7 +6,9 @@ second data set of another seed with the best parameters, and writes into one fo
 
 - ``report.md`` — Table I (×10⁻³) next to the paper's values, each class's loss decomposed into
   mean MSE and mean N_c, the other metrics (RMSE, confirmed fraction, OSPA, far frames, time to
-  first confirmation), generalisation, the CV-vs-CA conclusion and the studies' run times;
+  first confirmation), GOSPA with its decomposition, the people-count error, identity switches
+  and the metrics of every person, generalisation, the CV-vs-CA conclusion and the studies' run
+  times;
 - ``best_cv.json`` / ``best_ca.json`` — TrackerParams JSON of the best trial;
 - ``loss_vs_time_<model>.png`` — best loss so far against wall-clock seconds for every study of
   the model (TPE / random sampling, with / without pruning);
@@ -137,11 +139,14 @@ def _f(v: float | None, fmt: str) -> str:
 
 # ---- evaluation -------------------------------------------------------------------------------
 def evaluate_params(dataset: Any, params: dict[str, Any]) -> tuple[Any, Any]:
-    """Track the whole data set with TrackerParams JSON; return (estimates, Evaluation)."""
+    """Track the whole data set with TrackerParams JSON; return (estimates, Evaluation).
+
+    Every confirmed track is kept with its id, for the identities and the several-person loss.
+    """
     from core.evaluation import evaluate
     from core.tracking import TrackerParams, track_dataset
 
-    est = track_dataset(dataset, TrackerParams.from_dict(params))
+    est = track_dataset(dataset, TrackerParams.from_dict(params), with_tracks=True)
     return est, evaluate(dataset, est)
 
 
@@ -286,7 +291,8 @@ def write_report(
         "command": command,
         "storage": redact(storage),
         "training_dataset": {"file": Path(train_path).name, "seed": int(train.seed),
-                             "trajectories": train.n_trajectories, "frames": train.n_frames},
+                             "trajectories": train.n_trajectories, "frames": train.n_frames,
+                             "persons": train.n_persons},
         "paper_table_i_x1e3": PAPER_TABLE_I,
         "models": {},
         "studies": [],
@@ -297,6 +303,7 @@ def write_report(
             "seed": int(other.seed),
             "trajectories": other.n_trajectories,
             "frames": other.n_frames,
+            "persons": other.n_persons,
         }
     estimates = {}
     for model, study in mains.items():
@@ -367,7 +374,13 @@ def render_markdown(r: dict[str, Any]) -> str:
         "",
         f"Training data set: the paper's data set, seed {r['training_dataset']['seed']}, "
         f"{r['training_dataset']['trajectories']} trajectories, "
-        f"{r['training_dataset']['frames']} frames.",
+        f"{r['training_dataset']['frames']} frames"
+        + (
+            f", {r['training_dataset']['persons']} persons per trajectory (the loss is the "
+            "several-person form: eq. (13) per person, mean over the persons)."
+            if r["training_dataset"].get("persons", 1) > 1
+            else "."
+        ),
         "",
         "## Table I — mean loss per class, ×10⁻³",
         "",
@@ -452,6 +465,7 @@ def render_markdown(r: dict[str, Any]) -> str:
                 f"{_f(e['mean_first_confirmation_s'], '.2f')} | {e['far_frames']} | "
                 f"{_f(e['ospa_mean_m'], '.3f')} |"
             )
+    lines += _people_section(r)
     lines += ["", "## Best parameters", ""]
     for model in ("cv", "ca"):
         if model not in models:
@@ -483,3 +497,59 @@ def render_markdown(r: dict[str, Any]) -> str:
     for p in r.get("plots", []):
         lines += [f"![{p}]({p})", ""]
     return "\n".join(lines)
+
+
+def _people_section(r: dict[str, Any]) -> list[str]:
+    """GOSPA, count error, identities and per-person metrics (several-person evaluation)."""
+    models = r["models"]
+    runs = []
+    for model in ("cv", "ca"):
+        for key in ("training", "generalisation"):
+            if model in models and key in models[model]:
+                label = (
+                    key
+                    if key == "training"
+                    else f"generalisation ({r['generalisation_dataset']['spec']})"
+                )
+                runs.append((model, label, models[model][key]))  # fmt: skip
+    if not runs:
+        return []
+    lines = [
+        "",
+        "## Persons: GOSPA, people count, identities (best parameters)",
+        "",
+        "GOSPA (α = 2, c = 1 m, p = 2; mean over frames) with its decomposition in m² a frame; "
+        "count error = confirmed tracks − persons present; identity switches by the "
+        "track-to-person assignment with hysteresis ([people](../people.md)).",
+        "",
+        "| model | data set | GOSPA (m) | localisation | missed | false | mean count error | "
+        "mean abs. count error | frames counted exactly | identity switches |",
+        "|---|---|---|---|---|---|---|---|---|---|",
+    ]
+    for model, label, e in runs:
+        g = e.get("gospa") or {}
+        exact = g.get("count_exact_fraction")
+        lines.append(
+            f"| {model.upper()} | {label} | {_f(g.get('gospa_m'), '.3f')} | "
+            f"{_f(g.get('localisation'), '.4f')} | {_f(g.get('missed'), '.4f')} | "
+            f"{_f(g.get('false'), '.4f')} | {_f(g.get('count_error'), '+.3f')} | "
+            f"{_f(g.get('count_abs_error'), '.3f')} | "
+            f"{_f(None if exact is None else 100 * exact, '.1f')} % | "
+            f"{'–' if e.get('identity_switches') is None else e['identity_switches']} |"
+        )
+    lines += [
+        "",
+        "| model | data set | person | L ×10⁻³ | trajectories | never estimated | N_c | "
+        "RMSE (m) | frames present | frames missed | identity switches |",
+        "|---|---|---|---|---|---|---|---|---|---|---|",
+    ]
+    for model, label, e in runs:
+        for m in e.get("persons", []):
+            sw = m.get("identity_switches")
+            lines.append(
+                f"| {model.upper()} | {label} | {m['person']} | {_f(m['loss_x1e3'], '.4f')} | "
+                f"{m['n_trajectories']} | {m['n_unconfirmed']} | {m['n_c']} | "
+                f"{_f(m['rmse_m'], '.3f')} | {m['frames_present']} | {m['frames_missed']} | "
+                f"{'–' if sw is None else sw} |"
+            )
+    return lines

@@ -230,14 +230,16 @@ def paper_dataset(
     progress: ProgressCallback | None = None,
     use_cache: bool = True,
     person_model: str = "point",
+    n_persons: int = 1,
 ) -> Dataset:
     """The paper's data set: :func:`core.scene.paper_scenes` simulated (cached).
 
     Each trajectory is simulated with its scene's own seed, so ``simulate_scene(scene)`` of any
     of the scenes reproduces its frames of the data set bit for bit. ``person_model``
-    (``"point"`` or ``"extended"``) changes only the person's scattering model.
+    (``"point"`` or ``"extended"``) changes only the person's scattering model; ``n_persons``
+    puts that many persons in every scene (:func:`core.scene.paper_scenes`).
     """
-    scenes = paper_scenes(seed, n_trajectories, person_model=person_model)
+    scenes = paper_scenes(seed, n_trajectories, person_model=person_model, n_persons=n_persons)
     return build_dataset(
         scenes,
         seeds=[s.seed for s in scenes],
@@ -259,14 +261,15 @@ def paper_dataset_file(
     jobs: int | None = None,
     progress: ProgressCallback | None = None,
     person_model: str = "point",
+    n_persons: int = 1,
 ) -> Path:
     """Path of the cached paper data set (simulated first if not cached).
 
     For study workers, which should receive a file path rather than an in-memory data set: the
     file lives in the cache under its content key, so it is never stale. ``person_model`` as in
-    :func:`paper_dataset`.
+    :func:`paper_dataset`, and ``n_persons``.
     """
-    scenes = paper_scenes(seed, n_trajectories, person_model=person_model)
+    scenes = paper_scenes(seed, n_trajectories, person_model=person_model, n_persons=n_persons)
     seeds = [s.seed for s in scenes]
     root = Path(cache_dir) if cache_dir is not None else default_cache_dir()
     key = dataset_key(scenes, fidelity=fidelity, seed=seed, seeds=seeds)

@@ -443,6 +443,8 @@ def _parse_scene(data: Any, base_dir: Path) -> Scene:
         raise InputError("persons must be a list")
     if len(persons_d) > MAX_PERSONS:
         raise InputError(f"persons lists {len(persons_d)}, more than the limit {MAX_PERSONS}")
+    if not persons_d:
+        raise InputError(f"persons lists none; a scene holds 1 to {MAX_PERSONS} persons")
     persons = []
     for i, p in enumerate(persons_d):
         where = f"persons[{i}]"
@@ -532,7 +534,7 @@ def class_scene(
 
 
 def paper_scenes(
-    seed: int, n_trajectories: int = 35, *, person_model: str = "point"
+    seed: int, n_trajectories: int = 35, *, person_model: str = "point", n_persons: int = 1
 ) -> list[Scene]:
     """The paper's data set: 7 trajectories per class, ordered round-robin a, b, c, d, e, a, …
 
@@ -543,15 +545,35 @@ def paper_scenes(
     ``person_model`` (``"point"``, the paper's, or ``"extended"``) changes only the person's
     scattering model (:class:`Person` ``model``): trajectories, scene seeds and everything else
     are those of the point-model set of the same ``seed``.
+
+    ``n_persons`` > 1 (at most :data:`core.limits.MAX_PERSONS`) adds persons 1 … N−1 to every
+    scene: person j walks a trajectory of class ``"abcde"[(k + j) % 5]`` drawn with the seed
+    ``child_k.spawn(N − 1)[j − 1]`` (one 32-bit word). Person 0, the scene seed and the class of
+    the trajectory are those of the one-person set of the same ``seed``; each person leaves the
+    scene when its trajectory ends (the scene lasts as long as the longest).
     """
     if n_trajectories < 1:
         raise InputError(f"n_trajectories must be >= 1, got {n_trajectories}")
     if person_model not in PERSON_MODELS:
         raise InputError(f"person_model must be one of {list(PERSON_MODELS)}, got {person_model!r}")
+    if not (isinstance(n_persons, int) and 1 <= n_persons <= MAX_PERSONS):
+        raise InputError(f"n_persons must be in [1, {MAX_PERSONS}], got {n_persons!r}")
     scenes = []
     for k, child in enumerate(np.random.SeedSequence(seed).spawn(n_trajectories)):
         traj_seed, scene_seed = (int(s) for s in child.generate_state(2))
         scene = class_scene(TRAJECTORY_CLASSES[k % 5], traj_seed, seed=scene_seed)
+        if n_persons > 1:
+            extra = []
+            for j, sub in enumerate(child.spawn(n_persons - 1), start=1):
+                cls, s = TRAJECTORY_CLASSES[(k + j) % 5], int(sub.generate_state(1)[0])
+                traj = generate_trajectory(
+                    cls,
+                    np.random.default_rng(s),
+                    aoi=scene.aoi,
+                    frame_period_s=scene.radar.frame_period_s,
+                )
+                extra.append(Person(trajectory=traj, spec={"class": cls, "seed": s}))
+            scene = dataclasses.replace(scene, persons=(*scene.persons, *extra))
         if person_model != "point":
             scene = dataclasses.replace(
                 scene,

@@ -18,10 +18,84 @@ import numpy as np
 from core.dataset import Dataset
 from core.errors import InputError
 from core.tracking.params import TrackerParams
+from core.tracking.results import FrameTracks
 
-__all__ = ["DatasetEstimates", "track_dataset", "estimate_track_ids", "dataset_frame_period_s"]
+__all__ = [
+    "ConfirmedTracks",
+    "DatasetEstimates",
+    "track_dataset",
+    "estimate_track_ids",
+    "dataset_frame_period_s",
+]
 
 DEFAULT_FRAME_PERIOD_S = 0.08
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class ConfirmedTracks:
+    """Every confirmed track of every output frame, ranked, with its identity (F_sel frames).
+
+    Column j of frame f is the confirmed track of rank j: ranked by existence probability ψ,
+    highest first, ties by the lower id — the order in which the tracker picks its single-person
+    estimate (:func:`core.tracking.management.best_confirmed`), so column 0 is the estimate.
+    Columns ``j >= n[f]`` are padding.
+
+    Attributes
+    ----------
+    ids
+        (F_sel, C) int64 track ids (per trajectory, from 0 in order of birth), −1 padded.
+    xy
+        (F_sel, C, 2) positions in m, NaN padded.
+    psi
+        (F_sel, C) existence probabilities ψ, NaN padded.
+    """
+
+    ids: np.ndarray
+    xy: np.ndarray
+    psi: np.ndarray
+
+    @property
+    def n(self) -> np.ndarray:
+        """(F_sel,) confirmed tracks per frame."""
+        return np.sum(self.ids >= 0, axis=1)
+
+    @classmethod
+    def from_slots(
+        cls, ids: np.ndarray, xy: np.ndarray, psi: np.ndarray, confirmed: np.ndarray
+    ) -> ConfirmedTracks:
+        """Rank the confirmed ones among live track slots (F, S): ids, xy (F, S, 2), psi, status.
+
+        Slots that are not confirmed (or padding, id < 0) are dropped; the rest are sorted by
+        (−ψ, id) per frame.
+        """
+        ids = np.asarray(ids, dtype=np.int64)
+        keep = np.asarray(confirmed, dtype=bool) & (ids >= 0)
+        f, s = ids.shape
+        # sort key: confirmed first, then −ψ, then id (lexsort: the last key is the primary one)
+        order = np.lexsort((ids, -np.where(keep, psi, 0.0), ~keep), axis=1)
+        rows = np.arange(f)[:, None]
+        keep_s = keep[rows, order]
+        out_ids = np.where(keep_s, ids[rows, order], -1)
+        out_xy = np.where(keep_s[..., None], np.asarray(xy)[rows, order], np.nan)
+        out_psi = np.where(keep_s, np.asarray(psi)[rows, order], np.nan)
+        width = max(int(keep.sum(axis=1).max(initial=0)), 1) if f else s
+        return cls(ids=out_ids[:, :width], xy=out_xy[:, :width], psi=out_psi[:, :width])
+
+    @classmethod
+    def from_frames(cls, frames: Sequence[FrameTracks]) -> ConfirmedTracks:
+        """The confirmed tracks of a readable-tracker run (``TrackerResult.frames``), ranked."""
+        width = max((len(ft) for ft in frames), default=0) or 1
+        n = len(frames)
+        ids = np.full((n, width), -1, np.int64)
+        xy = np.full((n, width, 2), np.nan)
+        psi = np.full((n, width), np.nan)
+        conf = np.zeros((n, width), dtype=bool)
+        for f, ft in enumerate(frames):
+            k = len(ft)
+            ids[f, :k], xy[f, :k], psi[f, :k], conf[f, :k] = (
+                ft.ids, ft.state[:, :2], ft.psi, ft.confirmed
+            )  # fmt: skip
+        return cls.from_slots(ids, xy, psi, conf)
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -48,6 +122,9 @@ class DatasetEstimates:
         (F_sel,) counts of confirmed and live tracks.
     model
         ``"cv"`` or ``"ca"``.
+    tracks
+        Every confirmed track with its id (:class:`ConfirmedTracks`), or None unless asked for
+        (``track_dataset(..., with_tracks=True)``): the identities several-person metrics need.
     """
 
     trajectories: np.ndarray
@@ -60,6 +137,7 @@ class DatasetEstimates:
     n_confirmed: np.ndarray
     n_tracks: np.ndarray
     model: str = "cv"
+    tracks: ConfirmedTracks | None = None
 
 
 def dataset_frame_period_s(dataset: Dataset) -> float:
@@ -117,6 +195,7 @@ def track_dataset(
     *,
     trajectories: Sequence[int] | None = None,
     engine: str = "numba",
+    with_tracks: bool = False,
 ) -> DatasetEstimates:
     """Track every selected trajectory of a data set from scratch.
 
@@ -130,6 +209,8 @@ def track_dataset(
         Indices of the trajectories to track (default: all, in order).
     engine
         ``"numba"`` (compiled kernel, default) or ``"numpy"`` (readable reference).
+    with_tracks
+        Also return every confirmed track with its id (``tracks``); off on the optimiser's path.
 
     Returns
     -------
@@ -137,6 +218,7 @@ def track_dataset(
     """
     sel = _selection(dataset, trajectories)
     z, f_off, t_off, period = _prepare(dataset)
+    tracks: ConfirmedTracks | None = None
     lengths = t_off[sel + 1] - t_off[sel]
     offsets = np.concatenate(([0], np.cumsum(lengths))).astype(np.int64)
     frame_index = (
@@ -147,8 +229,13 @@ def track_dataset(
     if engine == "numba":
         from core.tracking.kernel import track_frames
 
-        out = track_frames(z, f_off, t_off, sel, params, period)
+        out = track_frames(z, f_off, t_off, sel, params, period, record=with_tracks)
         est_xy, has, psi, conf_xy, n_conf, n_tr = out[:6]
+        if with_tracks:
+            rec = out[-1]
+            tracks = ConfirmedTracks.from_slots(
+                rec.ids, rec.state[..., :2], rec.psi, _live(rec.n_tracks, rec.confirmed)
+            )
     elif engine == "numpy":
         from core.tracking.tracker import run_tracker
 
@@ -159,17 +246,28 @@ def track_dataset(
         conf_xy = np.full((n_sel, params.max_tracks, 2), np.nan)
         n_conf = np.zeros(n_sel, dtype=np.int64)
         n_tr = np.zeros(n_sel, dtype=np.int64)
+        cap = params.max_tracks
+        t_ids = np.full((n_sel, cap), -1, np.int64)
+        t_xy = np.full((n_sel, cap, 2), np.nan)
+        t_psi = np.full((n_sel, cap), np.nan)
+        t_conf = np.zeros((n_sel, cap), dtype=bool)
         for i, k in enumerate(sel):
             a, b = t_off[k], t_off[k + 1]
             res = run_tracker(
                 (z[f_off[a] : f_off[b]], f_off[a : b + 1] - f_off[a]),
                 params,
                 period,
-                keep_tracks=False,
+                keep_tracks=with_tracks,
             )
             s = slice(offsets[i], offsets[i + 1])
             est_xy[s], has[s], psi[s] = res.estimate_xy, res.has_estimate, res.estimate_psi
             conf_xy[s], n_conf[s], n_tr[s] = res.confirmed_xy, res.n_confirmed, res.n_tracks
+            for j, ft in enumerate(res.frames or ()):
+                row, n = offsets[i] + j, len(ft)
+                t_ids[row, :n], t_xy[row, :n], t_psi[row, :n] = ft.ids, ft.state[:, :2], ft.psi
+                t_conf[row, :n] = ft.confirmed
+        if with_tracks:
+            tracks = ConfirmedTracks.from_slots(t_ids, t_xy, t_psi, t_conf)
     else:
         raise InputError(f"engine must be 'numba' or 'numpy', got engine={engine!r}")
     return DatasetEstimates(
@@ -183,7 +281,13 @@ def track_dataset(
         n_confirmed=n_conf,
         n_tracks=n_tr,
         model=params.model,
+        tracks=tracks,
     )
+
+
+def _live(n_tracks: np.ndarray, confirmed: np.ndarray) -> np.ndarray:
+    """(F, S) True for the confirmed tracks among the live slots ``t < n_tracks[f]``."""
+    return confirmed & (np.arange(confirmed.shape[1])[None, :] < n_tracks[:, None])
 
 
 def estimate_track_ids(

@@ -30,7 +30,9 @@ def profile(frames: int) -> dict:
 
 
 def scene(**fields) -> Scene:
-    return Scene.from_dict({"schema_version": 1, "clutter_density_per_m2": 0.0, **fields})
+    """A scene of these fields (one standing person unless ``persons`` is given)."""
+    doc = {"schema_version": 1, "clutter_density_per_m2": 0.0, "persons": [profile(2)]}
+    return Scene.from_dict({**doc, **fields})
 
 
 def test_persons() -> None:
@@ -39,6 +41,11 @@ def test_persons() -> None:
         InputError, match=f"persons lists 9, more than the limit {limits.MAX_PERSONS}"
     ):
         scene(persons=[profile(2)] * (limits.MAX_PERSONS + 1))
+    # and at least one: a scene of nobody is one line too (issue 14: 1–8 persons)
+    with pytest.raises(
+        InputError, match=f"persons lists none; a scene holds 1 to {limits.MAX_PERSONS}"
+    ):
+        scene(persons=[])
 
 
 def test_static_reflectors() -> None:

@@ -87,3 +87,22 @@ def test_a_non_finite_capped_loss_is_an_error() -> None:
     src.scores[0] = TrajectoryScore(1e-3, 1e-2, 10, math.inf)
     with pytest.raises(FloatingPointError, match="capped loss"):
         evaluate(src, {}, loss="capped")
+
+
+def test_capped_loss_of_several_people_is_the_mean_over_the_people_present() -> None:
+    from types import SimpleNamespace
+
+    from core.evaluation.robust import trajectory_capped_losses
+
+    truth = np.array([[[0.0, 2.0], [3.0, 4.0], [np.nan, np.nan]]] * 3)  # (3 frames, 3 persons, 2)
+    ranked = np.full((3, 2, 2), np.nan)
+    ranked[:, 0] = [0.1, 2.0]  # one confirmed track, 0.1 m from person 0; person 1 has none
+    est = SimpleNamespace(
+        frame_index=np.arange(3),
+        offsets=np.array([0, 3]),
+        trajectories=np.array([0]),
+        tracks=SimpleNamespace(xy=ranked),
+    )
+    # person 0: 0.1² a frame; person 1: c²/2 = 0.125 a frame; person 2 never present
+    (value,) = trajectory_capped_losses(SimpleNamespace(truth_xy_m=truth), est)
+    assert value == pytest.approx((0.01 + 0.125) / 2)

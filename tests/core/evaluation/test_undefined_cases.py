@@ -13,7 +13,7 @@ import pytest
 
 from core.cli import main
 from core.evaluation import evaluate, ospa, trajectory_loss
-from core.tracking.batch import DatasetEstimates
+from core.tracking.batch import ConfirmedTracks, DatasetEstimates
 from core.tracking.synthetic import SyntheticScene, synthetic_dataset
 
 
@@ -25,7 +25,14 @@ def ds():
 
 
 def _estimates(ds, est_xy, has, conf_xy):
-    """DatasetEstimates over every trajectory; est_xy (F, 2), has (F,), conf_xy (F, C, 2)."""
+    """DatasetEstimates over every trajectory; est_xy (F, 2), has (F,), conf_xy (F, C, 2).
+
+    Column c of conf_xy is the track with id c, ranked by ψ in column order."""
+    ok = np.isfinite(conf_xy[..., 0])
+    c = conf_xy.shape[1]
+    tracks = ConfirmedTracks.from_slots(
+        np.where(ok, np.arange(c), -1), conf_xy, np.where(ok, 1.0 - 0.1 * np.arange(c), 0.0), ok
+    )
     return DatasetEstimates(
         trajectories=np.arange(ds.n_trajectories),
         frame_index=np.arange(ds.n_frames),
@@ -36,6 +43,7 @@ def _estimates(ds, est_xy, has, conf_xy):
         confirmed_xy=conf_xy,
         n_confirmed=np.isfinite(conf_xy[..., 0]).sum(1),
         n_tracks=np.isfinite(conf_xy[..., 0]).sum(1),
+        tracks=tracks,
     )
 
 
@@ -136,7 +144,9 @@ def test_several_persons_ospa_over_the_persons_present(ds) -> None:
     _no_nan_anywhere(ev)
     # frames < 30: one person, two tracks → one false track: sqrt((0 + c²)/2); later: 0
     assert ev.ospa_mean_m == pytest.approx(30 * math.sqrt(0.5) / f, abs=1e-12)
-    assert ev.loss_total == 0.0 and ev.rmse_m == 0.0  # the loss scores person 0
+    # each person has a perfect estimate whenever present: the multi-person loss is 0
+    assert ev.loss_total == 0.0 and ev.rmse_m == 0.0
+    assert [m.n_c for m in ev.persons] == [f, f - 30]
     assert ev.far_frames_total == 30  # the second track is 2 m from person 0 before frame 30
 
 

@@ -48,3 +48,35 @@ def test_report_from_two_small_studies(tmp_path: Path) -> None:
         "cv",
         "ca",
     }
+
+
+def test_report_on_a_two_person_data_set(tmp_path: Path) -> None:
+    """Studies and the report on several persons: the best value is the multi-person loss of
+    the re-tracked run; GOSPA, count error, identities and one row per person are reported."""
+    from dataclasses import replace
+
+    import numpy as np
+
+    base = synthetic_dataset(seed=3, n_per_class=1, classes="ab", n_frames=40)
+    second = base.truth_xy_m + [1.5, 0.0]
+    second[:10] = np.nan  # person 1 absent from the first frames
+    v = base.truth_v_mps.copy()
+    v[:10] = np.nan
+    train = replace(base, truth_xy_m=np.concatenate((base.truth_xy_m, second), axis=1),
+                    truth_v_mps=np.concatenate((base.truth_v_mps, v), axis=1))  # fmt: skip
+    train.save(tmp_path / "two.npz")
+    url = f"memory://{tmp_path}"
+    s = StudySettings(model="cv", n_trials=2, storage=url, study_name="cv-two",
+                      dataset=str(tmp_path / "two.npz"))  # fmt: skip
+    prepare_study(s, dataset_path=s.dataset)
+    run_worker(url, s.name, seed=0)
+    r = write_report(url, tmp_path / "out", generalisation_dataset=None)
+    m = r["models"]["cv"]
+    params = TrackerParams.load(tmp_path / "out" / "best_cv.json")
+    ev = evaluate_table(train, track_dataset(train, params, with_tracks=True))
+    assert m["best_value_in_study"] == pytest.approx(ev.loss_total, rel=1e-12)
+    assert [p["person"] for p in m["training"]["persons"]] == [0, 1]
+    assert m["training"]["persons"][1]["frames_present"] == train.n_frames - 10
+    md = (tmp_path / "out" / "report.md").read_text()
+    assert "## Persons: GOSPA, people count, identities" in md and "2 persons per" in md
+    assert "nan" not in md.lower()
