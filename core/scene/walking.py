@@ -35,9 +35,9 @@ What is approximated (docs/decisions/scene-06-walking-body.md):
   toward the hip along the leg (the foot lifts and slides a few cm at the ends of stance).
 - No pelvis list or tilt, no hands; the legs swing in planes parallel to the walking direction.
 - Standing (speed -> 0): every amplitude scales with ``RV`` and the stride with ``sqrt(RV)``, so
-  the body comes to rest continuously; a standing person sways (``+-1 cm`` at ``0.2 Hz``, the
-  sway growing with height) and breathes (chest ``+-3 mm`` at ``0.25 Hz``), both fading in as the
-  speed falls below 0.3 m/s.
+  the body comes to rest continuously; a standing person sways (the body above the ankles
+  ``+-1 cm`` at ``0.2 Hz``, the legs following by inverse kinematics) and breathes (chest
+  ``+-3 mm`` at ``0.25 Hz``), both fading in as the speed falls below 0.3 m/s.
 
 Segment lengths are fractions of the body height (Drillis & Contini 1966, as tabulated in D. A.
 Winter, *Biomechanics and Motor Control of Human Movement*, 4th ed., Wiley 2009, fig. 4.1):
@@ -113,7 +113,7 @@ _AREA = np.array([length * width for _, length, width in SEGMENTS])
 #: to 1.
 RCS_SHARES = _AREA / _AREA.sum()
 
-#: Standing: sway amplitude (m, at the head, scaled linearly with height above the floor),
+#: Standing: sway amplitude of the pelvis and upper body (m),
 #: sway frequency (Hz), breathing chest amplitude (m) and rate (Hz), speed below which they fade
 #: in (m/s).
 SWAY_AMPLITUDE_M, SWAY_HZ = 0.01, 0.2
@@ -255,28 +255,32 @@ def _ankle_path(psi, v, dc, beta, rho_max, x0, rv_w, height_m):
     return ank_u, ank_z, foot_u, foot_z
 
 
-def _knee(hip_u, hip_z, ank_u, ank_z, height_m):
-    """Two-link inverse kinematics (knee forward): the knee and the reachable ankle ``(u, z)``."""
+def _knee(hip, ankle, height_m):
+    """Two-link inverse kinematics in 3-D, the knee forward.
+
+    ``hip``, ``ankle``: ``(F, 3)`` in the body frame. Returns the knee and the reachable ankle
+    (pulled toward the hip along the leg where it is out of reach), ``(F, 3)`` each; thigh and
+    shank keep their lengths exactly.
+    """
     h = height_m
     l_thigh, l_shank = (HIP_Z - KNEE_Z) * h, (KNEE_Z - ANKLE_Z) * h
-    # two-link inverse kinematics, knee forward
-    du, dz = ank_u - hip_u, ank_z - hip_z
-    d = np.hypot(du, dz)
+    dv = ankle - hip
+    d = np.linalg.norm(dv, axis=-1)
+    e = dv / d[:, None]
     d_max = (l_thigh + l_shank) * (1 - 1e-3)
     d_min = abs(l_thigh - l_shank) + 1e-6 * h
     # smooth saturation below d_max (5 mm softplus): no kink where the leg straightens
     k = 0.005
     d_c = np.maximum(d_max - k * np.logaddexp(0.0, (d_max - d) / k), d_min)
-    # the leg cannot reach: the ankle is pulled along the hip-ankle line
-    ank_u = hip_u + du * d_c / d
-    ank_z = hip_z + dz * d_c / d
-    alpha = np.arctan2(du, -dz)  # hip->ankle line from the downward vertical, forward +
     # law of cosines: angle between the thigh and the hip-ankle line
     delta = np.arccos(np.clip((l_thigh**2 + d_c**2 - l_shank**2) / (2 * l_thigh * d_c), -1.0, 1.0))
-    theta = alpha + delta
-    knee_u = hip_u + l_thigh * np.sin(theta)
-    knee_z = hip_z - l_thigh * np.cos(theta)
-    return (knee_u, knee_z), (ank_u, ank_z)
+    # the knee bends toward the walking direction: f = u - (u . e) e, normalised
+    f = np.zeros_like(e)
+    f[:, 0] = 1.0
+    f -= e[:, 0:1] * e
+    f /= np.linalg.norm(f, axis=-1, keepdims=True)
+    knee = hip + l_thigh * (np.cos(delta)[:, None] * e + np.sin(delta)[:, None] * f)
+    return knee, hip + d_c[:, None] * e
 
 
 def body_frame_segments(
@@ -322,7 +326,7 @@ def body_frame_segments(
     a_t = np.radians(4.0) * rv
     alpha_p = a_t * np.cos(two_pi * phi)
     alpha_t = -0.6 * alpha_p  # thorax against the pelvis
-    hw, sw_half = 0.5 * HIP_WIDTH * h, 0.5 * SHOULDER_WIDTH * h
+    hw = 0.5 * HIP_WIDTH * h
     # the leg's reach sets the stance placement x0 and the pelvis height in double support
     rho_max = 0.9 * np.minimum(rv_w, 1.0)  # heel-rise angle at toe-off, rad
     stance_len = np.where(np.isfinite(dc), v * beta * dc, 0.0)
@@ -365,57 +369,80 @@ def body_frame_segments(
     sway_w = still * 0.5 * SWAY_AMPLITUDE_M * np.sin(two_pi * SWAY_HZ * 0.7 * t + 1.0)
     breath = still * BREATH_AMPLITUDE_M * np.sin(two_pi * BREATH_HZ * t)
 
+    joints = _joints(
+        h, phi, rv, rv_w, legs, pel_u + sway_u, pel_w + sway_w, pel_z, alpha_p, alpha_t
+    )
     out = np.empty((len(phi), N_SEGMENTS, 3))
+    for k, name in enumerate(SEGMENT_NAMES):
+        a, b = SEGMENT_ENDS[name]
+        out[:, k] = 0.5 * (joints[a] + joints[b])
+    out[:, SEGMENT_NAMES.index("torso"), 0] += breath  # the chest wall
+    return out
 
-    def put(name, u, w, z):
-        k = SEGMENT_NAMES.index(name)
-        out[:, k, 0], out[:, k, 1], out[:, k, 2] = u, w, z
 
-    def sway_at(z):
-        # an inverted pendulum about the ankles: displacement grows with height
-        return sway_u * z / h, sway_w * z / h
+#: Each segment between two joints (its scatterer at the midpoint).
+SEGMENT_ENDS = {
+    "head": ("chin", "head_top"),
+    "neck": ("neck_base", "chin"),
+    "torso": ("pelvis", "neck_base"),
+    **{
+        f"{seg}_{s}": ends
+        for s in "rl"
+        for seg, ends in (
+            ("shoulder", ("neck_base", f"shoulder_{s}")),
+            ("upper_arm", (f"shoulder_{s}", f"elbow_{s}")),
+            ("lower_arm", (f"elbow_{s}", f"wrist_{s}")),
+            ("hip", ("pelvis", f"hip_{s}")),
+            ("upper_leg", (f"hip_{s}", f"knee_{s}")),
+            ("lower_leg", (f"knee_{s}", f"ankle_{s}")),
+            ("foot", (f"ankle_{s}", f"toe_{s}")),
+        )
+    },
+}
 
-    su, sw = sway_at(pel_z)
-    pc = (pel_u + su, pel_w + sw, pel_z)  # pelvis centre
-    # upper body
-    neck_z = pel_z + (SHOULDER_Z - HIP_Z) * h
-    nu, nw = sway_at(neck_z)
-    neck = (pel_u + nu, pel_w + nw, neck_z)
-    tu, tw = sway_at(0.5 * (pel_z + neck_z))
-    put("torso", pel_u + tu + breath, pel_w + tw, 0.5 * (pel_z + neck_z))
-    z_n = neck_z + 0.5 * (CHIN_Z - SHOULDER_Z) * h
-    u_n, w_n = sway_at(z_n)
-    put("neck", pel_u + u_n, pel_w + w_n, z_n)
-    z_h = neck_z + (CHIN_Z - SHOULDER_Z) * h + 0.5 * (1 - CHIN_Z) * h
-    u_h, w_h = sway_at(z_h)
-    put("head", pel_u + u_h, pel_w + w_h, z_h)
+
+def _joints(h, phi, rv, rv_w, legs, pel_u, pel_w, pel_z, alpha_p, alpha_t):
+    """Joint positions ``name -> (F, 3)`` in the body frame (u, w, z)."""
+    two_pi = 2 * math.pi
+    hw, sw_half = 0.5 * HIP_WIDTH * h, 0.5 * SHOULDER_WIDTH * h
+    j: dict[str, np.ndarray] = {}
+    pelvis = np.stack([pel_u, pel_w, pel_z], axis=-1)
+    j["pelvis"] = pelvis
+    up = np.array([0.0, 0.0, 1.0])
+    j["neck_base"] = pelvis + (SHOULDER_Z - HIP_Z) * h * up
+    j["chin"] = j["neck_base"] + (CHIN_Z - SHOULDER_Z) * h * up
+    j["head_top"] = j["chin"] + (1 - CHIN_Z) * h * up
     l_ua, l_la = (SHOULDER_Z - ELBOW_Z) * h, (ELBOW_Z - WRIST_Z) * h
     a_s = np.radians(10.0) * rv  # shoulder flexion amplitude
     a_e = np.radians(15.0) * rv_w  # elbow flexion amplitude
+    zero = np.zeros_like(pel_u)
     for side, sign in (("r", -1.0), ("l", 1.0)):
         # shoulder joint: (0, sign * sw_half) turned by the thorax torsion
-        s_u = neck[0] - sign * sw_half * np.sin(alpha_t)
-        s_w = neck[1] + sign * sw_half * np.cos(alpha_t)
-        put(f"shoulder_{side}", 0.5 * (neck[0] + s_u), 0.5 * (neck[1] + s_w), neck_z)
+        sh = j["neck_base"] + np.stack(
+            [-sign * sw_half * np.sin(alpha_t), sign * sw_half * np.cos(alpha_t), zero], axis=-1
+        )
+        j[f"shoulder_{side}"] = sh
         # the right arm forward at the left heel strike (phi = 0.5)
         swing = -np.cos(two_pi * phi) if side == "r" else np.cos(two_pi * phi)
         th_s = a_s * swing
         th_e = np.radians(15.0) + a_e * 0.5 * (1 + swing)
-        e_u, e_z = s_u + l_ua * np.sin(th_s), neck_z - l_ua * np.cos(th_s)
-        put(f"upper_arm_{side}", 0.5 * (s_u + e_u), s_w, 0.5 * (neck_z + e_z))
-        w_u = e_u + l_la * np.sin(th_s + th_e)
-        w_z = e_z - l_la * np.cos(th_s + th_e)
-        put(f"lower_arm_{side}", 0.5 * (e_u + w_u), s_w, 0.5 * (e_z + w_z))
-        j_u, j_w, a_u, a_z, f_u, f_z, _ = legs[side]
-        j_u, j_w = j_u + su, j_w + sw
-        put(f"hip_{side}", 0.5 * (pc[0] + j_u), 0.5 * (pc[1] + j_w), pel_z)
-        (k_u, k_z), (a_u, a_z) = _knee(j_u, pel_z, a_u, a_z, h)
-        toe_u, toe_z = a_u + f_u, a_z + f_z
-        foot_w = sign * hw
-        put(f"upper_leg_{side}", 0.5 * (j_u + k_u), 0.5 * (j_w + foot_w), 0.5 * (pel_z + k_z))
-        put(f"lower_leg_{side}", 0.5 * (k_u + a_u), foot_w, 0.5 * (k_z + a_z))
-        put(f"foot_{side}", 0.5 * (a_u + toe_u), foot_w, 0.5 * (a_z + toe_z))
-    return out
+        el = sh + l_ua * np.stack([np.sin(th_s), zero, -np.cos(th_s)], axis=-1)
+        j[f"elbow_{side}"] = el
+        j[f"wrist_{side}"] = el + l_la * np.stack(
+            [np.sin(th_s + th_e), zero, -np.cos(th_s + th_e)], axis=-1
+        )
+        # hip joint: (0, sign * hw) turned by the pelvis torsion
+        hip = pelvis + np.stack(
+            [-sign * hw * np.sin(alpha_p), sign * hw * np.cos(alpha_p), zero], axis=-1
+        )
+        j[f"hip_{side}"] = hip
+        _, _, a_u, a_z, f_u, f_z, _ = legs[side]
+        ankle = np.stack([a_u, np.full_like(a_u, sign * hw), a_z], axis=-1)
+        knee, ankle = _knee(hip, ankle, h)
+        j[f"knee_{side}"] = knee
+        j[f"ankle_{side}"] = ankle
+        j[f"toe_{side}"] = ankle + np.stack([f_u, zero, f_z], axis=-1)
+    return j
 
 
 def walking_scatterers(
