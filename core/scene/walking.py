@@ -219,8 +219,9 @@ def _ankle_path(psi, v, dc, beta, rho_max, x0, rv_w, height_m):
     """
     h = height_m
     h_a, l_t = ANKLE_Z * h, TOE_PIVOT * h
-    stance_len = v * beta * dc  # floor travelled under the body in stance
-    stance_len = np.where(np.isfinite(stance_len), stance_len, 0.0)
+    with np.errstate(invalid="ignore"):  # standing: v * inf
+        # floor travelled under the body in stance
+        stance_len = np.where(np.isfinite(dc), v * beta * dc, 0.0)
     in_stance = psi < beta
     tau = np.where(in_stance, psi / beta, 0.0)
     # stance: the toe pivot moves back with the floor; after heel-off the foot rolls over it
@@ -283,10 +284,10 @@ def _knee(hip, ankle, height_m):
     return knee, hip + d_c[:, None] * e
 
 
-def body_frame_segments(
+def body_frame_joints(
     phase: np.ndarray, speed_mps: np.ndarray, t_s: np.ndarray, height_m: float
-) -> np.ndarray:
-    """Segment centres in the body frame ``(u, w, z)`` (z above the floor).
+) -> dict[str, np.ndarray]:
+    """Joint positions in the body frame ``(u, w, z)`` (z above the floor).
 
     Parameters
     ----------
@@ -301,8 +302,10 @@ def body_frame_segments(
 
     Returns
     -------
-    numpy.ndarray
-        Shape ``(F, N_SEGMENTS, 3)``, m, in the order of :data:`SEGMENT_NAMES`.
+    dict
+        Joint name (``pelvis``, ``neck_base``, ``chin``, ``head_top``, ``shoulder_r``,
+        ``elbow_r``, ``wrist_r``, ``hip_r``, ``knee_r``, ``ankle_r``, ``toe_r`` and the left
+        ones) -> shape ``(F, 3)``, m.
     """
     h = float(height_m)
     phi = np.mod(np.asarray(phase, dtype=np.float64), 1.0)
@@ -329,7 +332,8 @@ def body_frame_segments(
     hw = 0.5 * HIP_WIDTH * h
     # the leg's reach sets the stance placement x0 and the pelvis height in double support
     rho_max = 0.9 * np.minimum(rv_w, 1.0)  # heel-rise angle at toe-off, rad
-    stance_len = np.where(np.isfinite(dc), v * beta * dc, 0.0)
+    with np.errstate(invalid="ignore"):  # standing: v * inf
+        stance_len = np.where(np.isfinite(dc), v * beta * dc, 0.0)
     x0, reach_z = _stance_geometry(stance_len, rho_max, hw * np.sin(a_t), h)
     legs = {}
     for side, sign in (("r", -1.0), ("l", 1.0)):
@@ -367,16 +371,37 @@ def body_frame_segments(
     still = np.clip(1.0 - v / STANDING_SPEED_MPS, 0.0, 1.0)
     sway_u = still * SWAY_AMPLITUDE_M * np.sin(two_pi * SWAY_HZ * t)
     sway_w = still * 0.5 * SWAY_AMPLITUDE_M * np.sin(two_pi * SWAY_HZ * 0.7 * t + 1.0)
-    breath = still * BREATH_AMPLITUDE_M * np.sin(two_pi * BREATH_HZ * t)
 
-    joints = _joints(
-        h, phi, rv, rv_w, legs, pel_u + sway_u, pel_w + sway_w, pel_z, alpha_p, alpha_t
-    )
-    out = np.empty((len(phi), N_SEGMENTS, 3))
+    return _joints(h, phi, rv, rv_w, legs, pel_u + sway_u, pel_w + sway_w, pel_z, alpha_p, alpha_t)
+
+
+def body_frame_segments(
+    phase: np.ndarray, speed_mps: np.ndarray, t_s: np.ndarray, height_m: float
+) -> np.ndarray:
+    """Segment centres in the body frame ``(u, w, z)`` (z above the floor).
+
+    Parameters
+    ----------
+    phase, speed_mps, t_s, height_m
+        As :func:`body_frame_joints`.
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape ``(F, N_SEGMENTS, 3)``, m, in the order of :data:`SEGMENT_NAMES`: the midpoints
+        of :data:`SEGMENT_ENDS` (the torso's moved by the breathing chest wall).
+    """
+    joints = body_frame_joints(phase, speed_mps, t_s, height_m)
+    out = np.empty((len(joints["pelvis"]), N_SEGMENTS, 3))
     for k, name in enumerate(SEGMENT_NAMES):
         a, b = SEGMENT_ENDS[name]
         out[:, k] = 0.5 * (joints[a] + joints[b])
-    out[:, SEGMENT_NAMES.index("torso"), 0] += breath  # the chest wall
+    v = np.asarray(speed_mps, dtype=np.float64)
+    still = np.clip(1.0 - v / STANDING_SPEED_MPS, 0.0, 1.0)
+    # the chest wall moves with the breath (forward)
+    out[:, SEGMENT_NAMES.index("torso"), 0] += (
+        still * BREATH_AMPLITUDE_M * np.sin(2 * math.pi * BREATH_HZ * np.asarray(t_s))
+    )
     return out
 
 
