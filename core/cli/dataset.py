@@ -23,8 +23,9 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--person-model",
         default="point",
-        help="person scattering model: point (the paper's, default) or extended (torso, arms, "
-        "legs, micro-Doppler); the trajectories and seeds stay those of the point set",
+        help="person scattering model: point (the paper's, default), blob (5 scatterers: "
+        "torso, arms, legs; 'extended' is its former name) or walking (17 segments driven by "
+        "Boulic's gait model); the trajectories and seeds stay those of the point set",
     )
     p.set_defaults(func=run)
 
@@ -48,12 +49,14 @@ def run(args: argparse.Namespace) -> int:
     if args.jobs is not None and not 1 <= args.jobs <= MAX_JOBS:
         raise InputError(f"--jobs must be in [1, {MAX_JOBS}], got {args.jobs}")
     check_output_path(args.out, what="data set")
-    from core.scene.scene import PERSON_MODELS
+    from core.scene.scene import PERSON_MODELS, person_model_kind
 
-    if args.person_model not in PERSON_MODELS:
+    try:
+        person_model_kind(args.person_model)
+    except InputError:
         raise InputError(
             f"--person-model must be one of {list(PERSON_MODELS)}, got {args.person_model!r}"
-        )
+        ) from None
     ds = paper_dataset(
         args.seed,
         args.trajectories,

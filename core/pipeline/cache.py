@@ -235,7 +235,8 @@ def paper_dataset(
 
     Each trajectory is simulated with its scene's own seed, so ``simulate_scene(scene)`` of any
     of the scenes reproduces its frames of the data set bit for bit. ``person_model``
-    (``"point"`` or ``"extended"``) changes only the person's scattering model.
+    (``"point"``, ``"blob"``/``"extended"`` or ``"walking"``) changes only the person's scattering
+    model.
     """
     scenes = paper_scenes(seed, n_trajectories, person_model=person_model)
     return build_dataset(
