@@ -102,15 +102,6 @@ def plan(
     from core.simulation.levels import fidelity_level
 
     fidelity_level(fidelity)  # InputError for an unknown level
-    if fidelity == "measurement" and consumer != "study":
-        walkers = [i for i, q in enumerate(scene.persons) if q.kind == "walking"]
-        if walkers:
-            # the measurement level's statistical model is fitted to point scatterers; the
-            # walking body's statistics are not fitted yet (issue 13)
-            raise InputError(
-                f"fidelity 'measurement' has no model of the walking body yet (persons "
-                f"{walkers}); use fidelity 'exact' or 'fast', or person model 'point' or 'blob'"
-            )
     if consumer not in CONSUMERS:
         raise InputError(f"consumer must be one of {list(CONSUMERS)}, got {consumer!r}")
     keep = keep_rd_maps or consumer == "gui"

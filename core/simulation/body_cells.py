@@ -25,7 +25,7 @@ from core.config import RadarConfig
 
 #: Merge cell size in (range bins, Doppler bins, azimuth beam widths 2/M), fitted against the
 #: exact level (docs/people.md).
-MERGE_CELLS = (2.0, 2.0, 1.0)
+MERGE_CELLS = (3.0, 2.0, 1.0)
 
 
 class MergedReflectors(NamedTuple):

@@ -240,8 +240,12 @@ def test_bad_person_input_names_the_field(person, match) -> None:
         Scene.from_dict(d)
 
 
-def test_measurement_level_refuses_the_walking_body() -> None:
+def test_measurement_level_simulates_the_walking_body() -> None:
+    # the measurement level merges the segments that share a cell (core.simulation.body_cells)
+    from core.pipeline import simulate_scene
+
     s = Scene.from_dict(scene_dict())
-    with pytest.raises(InputError, match="fidelity 'measurement' has no model of the walking"):
-        plan(s, fidelity="measurement")
-    plan(Scene.from_dict(scene_dict(model="blob")), fidelity="measurement")
+    run = simulate_scene(s, fidelity="measurement")
+    n_person = [int(np.sum(c.source == 0)) for c in run.clouds]
+    assert sum(n_person) > 0
+    assert max(n_person) < 17  # fewer points than segments: merged cells
