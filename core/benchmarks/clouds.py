@@ -194,7 +194,7 @@ def fit_merge_cells(models: tuple[str, ...], n_trajectories: int, jobs: int | No
 
     exact = {m: points(paper_dataset(0, n_trajectories, jobs=jobs, person_model=m)) for m in models}
     chosen = body_cells.MERGE_CELLS
-    rows = []
+    rows: list[dict] = []
     try:
         for cells in FIT_GRID:
             body_cells.MERGE_CELLS = cells
@@ -222,7 +222,7 @@ def fit_merge_cells(models: tuple[str, ...], n_trajectories: int, jobs: int | No
             )
     finally:
         body_cells.MERGE_CELLS = chosen
-    best = min(rows, key=lambda r: r["rms_log_ratio"])
+    best = min(rows, key=lambda r: float(r["rms_log_ratio"]))
     return {
         "exact_points": {m: v.round(3).tolist() for m, v in exact.items()},
         "grid": rows,
