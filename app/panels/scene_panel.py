@@ -9,7 +9,7 @@ from PySide6 import QtCore, QtWidgets
 
 from app.models import SceneModel
 from core.errors import InputError
-from core.scene.scene import PERSON_MODELS, person_model_kind
+from core.scene.scene import DEFAULT_PERSON_MODEL, PERSON_MODELS, person_model_kind
 from core.scene.walking import DEFAULT_HEIGHT_M, HEIGHT_RANGE_M
 
 CLASS_NAMES = {
@@ -276,11 +276,17 @@ class ScenePanel(QtWidgets.QWidget):
 
     def _add_class_person(self) -> None:
         cls = self.class_combo.currentData() or "c"
-        person = {"trajectory": {"class": cls, "seed": random.randrange(2**31 - 1)}}
+        person = {
+            "model": DEFAULT_PERSON_MODEL,
+            "trajectory": {"class": cls, "seed": random.randrange(2**31 - 1)},
+        }
         self._try(self.model.add_person, person)
 
     def _add_waypoint_person(self) -> None:
-        person = {"trajectory": {"waypoints": [[-1.0, 3.0, 1.2], [1.0, 6.0, 1.2]]}}
+        person = {
+            "model": DEFAULT_PERSON_MODEL,
+            "trajectory": {"waypoints": [[-1.0, 3.0, 1.2], [1.0, 6.0, 1.2]]},
+        }
         self._try(self.model.add_person, person)
 
     def _remove_person(self) -> None:

@@ -62,6 +62,10 @@ PERSON_KEYS = ("trajectory", "rcs_dbsm", "model", "height_m", "gait_phase")
 #: name, still read (and written back as given, so old files and results stay identical).
 PERSON_MODELS = ("point", "blob", "walking")
 PERSON_MODEL_ALIASES = {"extended": "blob"}
+#: The person model ``radartune dataset`` and the app's new persons use unless told otherwise
+#: (docs/decisions/scene-07-default-person-model.md). A person without ``"model"`` in a scene
+#: file stays ``"point"``, so existing scene files keep their meaning.
+DEFAULT_PERSON_MODEL = "walking"
 
 
 def person_model_kind(name: str) -> str:
