@@ -69,9 +69,8 @@ import numpy as np
 
 #: Height of the radar above the floor (m): the segments' z is their height minus this.
 RADAR_HEIGHT_M = 1.0
-#: Default body height (m) and the accepted range.
+#: Default body height (m); the accepted range is core.limits.PERSON_HEIGHT_RANGE_M.
 DEFAULT_HEIGHT_M = 1.75
-HEIGHT_RANGE_M = (1.0, 2.2)
 #: Highest relative velocity RV = v / H_t of the walking model (above it people run).
 MAX_RELATIVE_VELOCITY = 2.5
 #: Reference relative velocity: amplitudes quoted at RV = 1.5 (about 1.4 m/s for 1.75 m).
