@@ -9,8 +9,9 @@ from PySide6 import QtCore, QtWidgets
 
 from app.models import SceneModel
 from core.errors import InputError
+from core.limits import PERSON_HEIGHT_RANGE_M
 from core.scene.scene import DEFAULT_PERSON_MODEL, PERSON_MODELS, person_model_kind
-from core.scene.walking import DEFAULT_HEIGHT_M, HEIGHT_RANGE_M
+from core.scene.walking import DEFAULT_HEIGHT_M
 
 CLASS_NAMES = {
     "a": "a — straight line (along x or y)",
@@ -196,7 +197,7 @@ class ScenePanel(QtWidgets.QWidget):
             "point: the paper's one scatterer; blob: 5 scatterers with micro-Doppler; "
             "walking: 17 segments driven by Boulic's gait model (docs/scenes.md)"
         )
-        self.height = _dspin(*HEIGHT_RANGE_M, 2, "m", "personHeight")
+        self.height = _dspin(*PERSON_HEIGHT_RANGE_M, 2, "m", "personHeight")
         self.height.setToolTip("body height of the walking model")
         model_row.addWidget(self.person_model, 1)
         model_row.addWidget(self.height, 1)

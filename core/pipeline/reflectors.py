@@ -159,15 +159,15 @@ class Reflectors:
                             i, idx[rows], xy[rows, i], v[rows, i], rcs[rows, i]
                         )
                     continue
-                for row in rows:
-                    f = idx[row]
+                for at_row in rows:
+                    fr = int(idx[at_row])
                     bp, bv, frac = body_scatterers(
-                        xy[row, i], v[row, i], self.headings[i][f], self.truth_t_s[f]
+                        xy[at_row, i], v[at_row, i], self.headings[i][fr], self.truth_t_s[fr]
                     )
-                    d_pos[row, sl, :2] = bp
-                    d_vel[row, sl, :2] = bv
+                    d_pos[at_row, sl, :2] = bp
+                    d_vel[at_row, sl, :2] = bv
                     # σ_part = σ · share (linear power)
-                    d_rcs[row, sl] = rcs[row, i] + 10 * np.log10(frac)
+                    d_rcs[at_row, sl] = rcs[at_row, i] + 10 * np.log10(frac)
             n_body = mask.sum(axis=1)
             body_pos, body_vel = d_pos[mask], d_vel[mask]
             body_rcs, body_src = d_rcs[mask], d_src[mask]
@@ -205,7 +205,7 @@ class Reflectors:
         frame_of = np.repeat(np.arange(n_f), per_frame)
         slot = np.arange(n) - start[frame_of]  # position within the frame
         first = n_point[frame_of]
-        if body_pos is not None and len(body_pos):
+        if body_pos is not None and body_src is not None and len(body_pos):
             at = np.flatnonzero((slot >= first) & (slot < first + n_body[frame_of]))
             position[at] = body_pos
             velocity[at] = body_vel

@@ -24,6 +24,7 @@ from core.limits import (
     MAX_SCATTERER_FRAMES,
     MAX_SIMULATED_SAMPLES,
     MAX_STATIC_REFLECTORS,
+    PERSON_HEIGHT_RANGE_M,
 )
 from core.scene.aoi import AOI
 from core.scene.body import N_BODY_SCATTERERS
@@ -39,7 +40,6 @@ from core.scene.trajectory import (
 )
 from core.scene.walking import (
     DEFAULT_HEIGHT_M,
-    HEIGHT_RANGE_M,
     MAX_RELATIVE_VELOCITY,
     N_SEGMENTS,
     max_walking_speed_mps,
@@ -134,7 +134,7 @@ class Person:
     def __post_init__(self) -> None:
         kind = person_model_kind(self.model)
         if self.height_m is not None:
-            _number(self.height_m, "height_m", *HEIGHT_RANGE_M)
+            _number(self.height_m, "height_m", *PERSON_HEIGHT_RANGE_M)
         if self.gait_phase is not None:
             _number(self.gait_phase, "gait_phase", 0.0, 1.0)
         if kind == "walking":
@@ -537,7 +537,7 @@ def _parse_scene(data: Any, base_dir: Path) -> Scene:
             raise InputError(f"{where}.{exc.message}") from None
         height = p.get("height_m")
         if height is not None:
-            height = _number(height, f"{where}.height_m", *HEIGHT_RANGE_M)
+            height = _number(height, f"{where}.height_m", *PERSON_HEIGHT_RANGE_M)
         phase = p.get("gait_phase")
         if phase is not None:
             phase = _number(phase, f"{where}.gait_phase", 0.0, 1.0)

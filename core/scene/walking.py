@@ -63,14 +63,14 @@ world ``x, y`` from the trajectory and the heading ``h = atan2(vx, vy)``:
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 
 #: Height of the radar above the floor (m): the segments' z is their height minus this.
 RADAR_HEIGHT_M = 1.0
-#: Default body height (m) and the accepted range.
+#: Default body height (m); the accepted range is core.limits.PERSON_HEIGHT_RANGE_M.
 DEFAULT_HEIGHT_M = 1.75
-HEIGHT_RANGE_M = (1.0, 2.2)
 #: Highest relative velocity RV = v / H_t of the walking model (above it people run).
 MAX_RELATIVE_VELOCITY = 2.5
 #: Reference relative velocity: amplitudes quoted at RV = 1.5 (about 1.4 m/s for 1.75 m).
@@ -175,7 +175,7 @@ def default_gait_phase(seed: int) -> float:
     return float(np.random.default_rng(np.random.SeedSequence([int(seed), 13])).random())
 
 
-def _hermite(p0, p1, m0, m1, s):
+def _hermite(p0: Any, p1: Any, m0: Any, m1: Any, s: np.ndarray) -> np.ndarray:
     """Cubic Hermite ``p(s)`` on ``s`` in [0, 1] with end slopes ``m0, m1`` (per unit s)."""
     s2, s3 = s * s, s * s * s
     return (
@@ -186,7 +186,9 @@ def _hermite(p0, p1, m0, m1, s):
     )
 
 
-def _stance_geometry(stance_len, rho_max, hip_fwd, height_m):
+def _stance_geometry(
+    stance_len: np.ndarray, rho_max: np.ndarray, hip_fwd: np.ndarray, height_m: float
+) -> tuple[np.ndarray, np.ndarray]:
     """Where the stance is placed and how low the pelvis must go for the leg to reach it.
 
     The foot is flat from heel strike (ankle ``x0`` ahead of the pelvis centre) and rolls over
@@ -211,7 +213,16 @@ def _stance_geometry(stance_len, rho_max, hip_fwd, height_m):
     return x0 + hip_fwd, z
 
 
-def _ankle_path(psi, v, dc, beta, rho_max, x0, rv_w, height_m):
+def _ankle_path(
+    psi: np.ndarray,
+    v: np.ndarray,
+    dc: np.ndarray,
+    beta: np.ndarray,
+    rho_max: np.ndarray,
+    x0: np.ndarray,
+    rv_w: np.ndarray,
+    height_m: float,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Ankle ``(u, z)`` and the ankle->toe vector of one leg in the body frame's (u, z) plane.
 
     ``psi``: the leg's phase in cycles, ``[0, 1)`` (0 = its heel strike); ``x0``: the ankle at
@@ -256,7 +267,7 @@ def _ankle_path(psi, v, dc, beta, rho_max, x0, rv_w, height_m):
     return ank_u, ank_z, foot_u, foot_z
 
 
-def _knee(hip, ankle, height_m):
+def _knee(hip: np.ndarray, ankle: np.ndarray, height_m: float) -> tuple[np.ndarray, np.ndarray]:
     """Two-link inverse kinematics in 3-D, the knee forward.
 
     ``hip``, ``ankle``: ``(F, 3)`` in the body frame. Returns the knee and the reachable ankle
@@ -426,7 +437,18 @@ SEGMENT_ENDS = {
 }
 
 
-def _joints(h, phi, rv, rv_w, legs, pel_u, pel_w, pel_z, alpha_p, alpha_t):
+def _joints(
+    h: float,
+    phi: np.ndarray,
+    rv: np.ndarray,
+    rv_w: np.ndarray,
+    legs: dict[str, tuple[np.ndarray, ...]],
+    pel_u: np.ndarray,
+    pel_w: np.ndarray,
+    pel_z: np.ndarray,
+    alpha_p: np.ndarray,
+    alpha_t: np.ndarray,
+) -> dict[str, np.ndarray]:
     """Joint positions ``name -> (F, 3)`` in the body frame (u, w, z)."""
     two_pi = 2 * math.pi
     hw, sw_half = 0.5 * HIP_WIDTH * h, 0.5 * SHOULDER_WIDTH * h

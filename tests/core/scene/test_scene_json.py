@@ -130,7 +130,7 @@ def modified(**changes):
         (modified(static_reflectors__0__x_m=0.0, static_reflectors__0__y_m=0.0), "range 0"),
         (modified(static_reflectors__0__y_m=30.0), "maximum range"),
         (modified(persons__2__trajectory__initial_position_m=[0.0, 4.0]), "within 0.0"),
-        (modified(persons__0__model="blob"), "persons[0].model"),
+        (modified(persons__0__model="stick-figure"), "persons[0].model"),
     ],
 )
 def test_bad_scene_names_the_field(tmp_path: Path, data, expected: str) -> None:

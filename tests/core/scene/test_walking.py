@@ -159,6 +159,14 @@ def test_body_heading_follows_the_trajectory_through_a_turn() -> None:
         # torsion (4 deg * RV = 5.3 deg) and the frame's turn
         want = np.array([-math.cos(heading[f]), math.sin(heading[f])])
         assert math.degrees(math.acos(np.clip(left @ want, -1, 1))) < 8.0
+    # on the circle the head's velocity (trajectory + turn of the body) is the derivative of its
+    # positions from frame to frame (central differences over 2 frames, 0.16 s)
+    k = NAMES.index("head")
+    head = np.array([sc.position_m[sc.source == 0][k] for sc in frames])
+    head_v = np.array([sc.velocity_mps[sc.source == 0][k] for sc in frames])
+    dt = refl.truth_t_s[1] - refl.truth_t_s[0]
+    num = (head[2:] - head[:-2]) / (2 * dt)
+    assert np.percentile(np.abs(num - head_v[1:-1]), 95) < 0.1
 
 
 def test_segment_powers_add_up_to_the_eq5_draw() -> None:
