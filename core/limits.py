@@ -39,10 +39,12 @@ MAX_FRAMES = 10_000
 #: Most person-frames (persons x frames) one scene may simulate: bounds the total work.
 MAX_PERSON_FRAMES = 20_000
 #: Most scatterer-frames one scene may simulate: frames x (persons' scatterers — 1 a point
-#: person, one per body part an extended one — + static reflectors + expected clutter points).
+#: person, 5 a blob, 17 a walking body — + static reflectors + expected clutter points).
 #: The exact simulator needs ~0.05-0.2 ms a scatterer-frame on top of ~3.4 ms a frame, so a scene
 #: at this limit runs in well under a minute.
 MAX_SCATTERER_FRAMES = 100_000
+#: Body heights of the walking person model, m.
+PERSON_HEIGHT_RANGE_M = (1.0, 2.2)
 #: Most static reflectors in one scene.
 MAX_STATIC_REFLECTORS = 1_000
 #: Most samples in one frame's radar cube (virtual channels x loops x ADC samples; the paper's
@@ -79,6 +81,7 @@ LIMITS: dict[str, tuple[object, str]] = {
     "MAX_FRAMES": (MAX_FRAMES, "frames of one trajectory"),
     "MAX_PERSON_FRAMES": (MAX_PERSON_FRAMES, "persons x frames of one scene"),
     "MAX_SCATTERER_FRAMES": (MAX_SCATTERER_FRAMES, "frames x scatterers of one scene"),
+    "PERSON_HEIGHT_RANGE_M": (PERSON_HEIGHT_RANGE_M, "persons[i].height_m (walking model), m"),
     "MAX_STATIC_REFLECTORS": (MAX_STATIC_REFLECTORS, "static reflectors in one scene"),
     "MAX_CUBE_SAMPLES": (MAX_CUBE_SAMPLES, "virtual channels x loops x samples of one frame"),
     "MAX_SIMULATED_SAMPLES": (MAX_SIMULATED_SAMPLES, "frames x cube samples of one scene"),

@@ -9,6 +9,9 @@ from PySide6 import QtCore, QtWidgets
 
 from app.models import SceneModel
 from core.errors import InputError
+from core.limits import PERSON_HEIGHT_RANGE_M
+from core.scene.scene import DEFAULT_PERSON_MODEL, PERSON_MODELS, person_model_kind
+from core.scene.walking import DEFAULT_HEIGHT_M
 
 CLASS_NAMES = {
     "a": "a — straight line (along x or y)",
@@ -185,6 +188,20 @@ class ScenePanel(QtWidgets.QWidget):
         rcs_row.addWidget(self.fixed_rcs)
         rcs_row.addWidget(self.rcs, 1)
         pl.addLayout(rcs_row)
+        model_row = QtWidgets.QHBoxLayout()
+        model_row.addWidget(QtWidgets.QLabel("model"))
+        self.person_model = QtWidgets.QComboBox()
+        self.person_model.setObjectName("personModel")
+        self.person_model.addItems(list(PERSON_MODELS))
+        self.person_model.setToolTip(
+            "point: the paper's one scatterer; blob: 5 scatterers with micro-Doppler; "
+            "walking: 17 segments driven by Boulic's gait model (docs/scenes.md)"
+        )
+        self.height = _dspin(*PERSON_HEIGHT_RANGE_M, 2, "m", "personHeight")
+        self.height.setToolTip("body height of the walking model")
+        model_row.addWidget(self.person_model, 1)
+        model_row.addWidget(self.height, 1)
+        pl.addLayout(model_row)
         outer.addWidget(persons)
 
         # ---- static reflectors ----------------------------------------------------------------
@@ -220,6 +237,8 @@ class ScenePanel(QtWidgets.QWidget):
         self.draw_button.toggled.connect(self.draw_mode_changed)
         self.fixed_rcs.toggled.connect(self._on_rcs)
         self.rcs.valueChanged.connect(self._on_rcs)
+        self.person_model.currentIndexChanged.connect(self._on_person_model)
+        self.height.valueChanged.connect(self._on_person_model)
         self.reflectors.edited.connect(self._on_reflectors)
         self.add_refl.clicked.connect(self._add_reflector)
         self.del_refl.clicked.connect(self._delete_reflector)
@@ -258,11 +277,17 @@ class ScenePanel(QtWidgets.QWidget):
 
     def _add_class_person(self) -> None:
         cls = self.class_combo.currentData() or "c"
-        person = {"trajectory": {"class": cls, "seed": random.randrange(2**31 - 1)}}
+        person = {
+            "model": DEFAULT_PERSON_MODEL,
+            "trajectory": {"class": cls, "seed": random.randrange(2**31 - 1)},
+        }
         self._try(self.model.add_person, person)
 
     def _add_waypoint_person(self) -> None:
-        person = {"trajectory": {"waypoints": [[-1.0, 3.0, 1.2], [1.0, 6.0, 1.2]]}}
+        person = {
+            "model": DEFAULT_PERSON_MODEL,
+            "trajectory": {"waypoints": [[-1.0, 3.0, 1.2], [1.0, 6.0, 1.2]]},
+        }
         self._try(self.model.add_person, person)
 
     def _remove_person(self) -> None:
@@ -351,6 +376,20 @@ class ScenePanel(QtWidgets.QWidget):
             person.pop("rcs_dbsm", None)
         self._try(self.model.set_person, i, person)
 
+    def _on_person_model(self, *_args) -> None:
+        i, person = self._current()
+        kind = self.person_model.currentText()
+        if kind == "point":
+            person.pop("model", None)
+        elif person_model_kind(person.get("model", "point")) != kind:
+            person["model"] = kind
+        if kind == "walking":
+            person["height_m"] = round(self.height.value(), 2)
+        else:
+            person.pop("height_m", None)
+            person.pop("gait_phase", None)
+        self._try(self.model.set_person, i, person)
+
     def _on_reflectors(self) -> None:
         try:
             rows = self.reflectors.rows()
@@ -386,6 +425,8 @@ class ScenePanel(QtWidgets.QWidget):
             self.person_seed,
             self.fixed_rcs,
             self.rcs,
+            self.person_model,
+            self.height,
             *self.class_params.values(),
         ]
         for w in widgets:
@@ -431,6 +472,13 @@ class ScenePanel(QtWidgets.QWidget):
             self.fixed_rcs.setChecked("rcs_dbsm" in person)
             self.rcs.setValue(float(person.get("rcs_dbsm", -8.0)))
             self.rcs.setEnabled("rcs_dbsm" in person)
+            try:
+                kind = person_model_kind(person.get("model", "point"))
+            except InputError:
+                kind = "point"
+            self.person_model.setCurrentIndex(list(PERSON_MODELS).index(kind))
+            self.height.setValue(float(person.get("height_m", DEFAULT_HEIGHT_M)))
+            self.height.setEnabled(kind == "walking")
             self.reflectors.set_rows(
                 [
                     [r["x_m"], r["y_m"], r.get("rcs_dbsm", 10.0)]

@@ -14,6 +14,12 @@ in the same run, single-threaded, interleaved in blocks (10 exact frames, 1 plai
 that both see the same load, and the ratio is reported (the machine is shared and noisy).
 If ``core.pipeline.paper_dataset`` is importable, generating the 35-trajectory data set
 (uncached, one process) is timed too.
+
+The walking-body case (:func:`walking_case`): the same class-a walk with the paper's clutter
+(0.02 m^-2), once with the walking body (17 segments at their heights, elevation processed) and
+once with the point person, the frames built by the pipeline's reflector stage; the exact
+chain runs both interleaved in blocks (frames/s and their ratio in the same run), and the fast
+level runs the walking frames in one batch (its frames/s against the exact chain's).
 """
 
 from __future__ import annotations
@@ -239,9 +245,108 @@ def run(quick: bool = False) -> dict:
         "plain_points_per_frame": plain_points,
         "exact_person_detected_fraction": person_found,
     }
+    result["walking_body"] = walking_case(quick)
     result["stages_ms"] = _stage_profile(radar, settings, antenna, frames[: 50 if quick else 300])
     result["dataset"] = _time_dataset(quick)
     return result
+
+
+def walking_case(quick: bool = False) -> dict:
+    """The exact chain on a walking body and on the point person, and the fast level.
+
+    Returns frames/s (wall clock and CPU) of the exact chain for both persons, their ratio,
+    the fast level's frames/s on the walking frames and its speed-up over the exact chain,
+    the reflector stage's ms per frame and the mean scatterers and points per frame.
+    """
+    from core.pipeline.plan import plan, processing_settings
+    from core.pipeline.reflectors import Reflectors
+    from core.scene import Scene
+    from core.simulation import AntennaGain, simulate_frame
+    from core.simulation.fast import simulate_frames_fast
+
+    def scene(model: str) -> Scene:
+        return Scene.from_dict(
+            {
+                "schema_version": 1,
+                "seed": 11,
+                "clutter_density_per_m2": CLUTTER_DENSITY_PER_M2,
+                "persons": [
+                    {
+                        "model": model,
+                        "trajectory": {"class": "a", "seed": 5, "speed_mps": 1.3},
+                    }
+                ],
+            }
+        )
+
+    built = {}
+    for model in ("walking", "point"):
+        sc = scene(model)
+        antenna = AntennaGain.draw(sc.radar, np.random.default_rng(7))
+        settings = processing_settings(sc)
+        t0 = time.perf_counter()
+        refl = Reflectors.build(sc, plan(sc), sc.seed, antenna, settings)
+        frames, _ = refl.frames()
+        built[model] = (sc.radar, antenna, settings, frames, time.perf_counter() - t0)
+    radar, antenna, settings, walk, t_refl = built["walking"]
+    point = built["point"][3]
+    n = min(len(walk), len(point))
+    reps = 1 if quick else max(1, 600 // n)
+    # warm up both paths (planar and with elevation) and the fast level
+    for fr in (walk[0], point[0]):
+        simulate_frame(radar, fr, np.random.default_rng(0), antenna=antenna, settings=settings)
+    simulate_frames_fast(
+        radar, walk[:2], [np.random.default_rng(0)] * 2, antenna=antenna, settings=settings
+    )
+    rng_w, rng_p = np.random.default_rng(1), np.random.default_rng(1)
+    block = 10
+    spent = {"walking": [0.0, 0.0, 0], "point": [0.0, 0.0, 0]}
+    pts = {"walking": [], "point": []}
+    for _ in range(reps):
+        for b in range(0, n, block):
+            for name, frames, rng in (("walking", walk, rng_w), ("point", point, rng_p)):
+                t, c, out = _time_frames(
+                    lambda f, rng=rng: simulate_frame(
+                        radar, f, rng, antenna=antenna, settings=settings
+                    ),
+                    frames[b : b + block],
+                )
+                spent[name][0] += t
+                spent[name][1] += c
+                spent[name][2] += len(out)
+                pts[name] += [int(np.sum(o.point_cloud.source == 0)) for o in out]
+    rngs = [np.random.default_rng(100 + i) for i in range(n)]
+    t0, c0 = time.perf_counter(), time.process_time()
+    for _ in range(reps):
+        simulate_frames_fast(radar, walk[:n], rngs, antenna=antenna, settings=settings)
+    t_fast, c_fast = time.perf_counter() - t0, time.process_time() - c0
+    fps = {k: v[2] / v[0] for k, v in spent.items()}
+    fps_cpu = {k: v[2] / v[1] for k, v in spent.items()}
+    fast_fps = reps * n / t_fast
+    return {
+        "frames": spent["walking"][2],
+        "frames_per_trajectory": n,
+        "scatterers_per_frame_walking": float(np.mean([len(f) for f in walk[:n]])),
+        "scatterers_per_frame_point": float(np.mean([len(f) for f in point[:n]])),
+        "person_points_per_frame_walking": float(np.mean(pts["walking"])),
+        "person_points_per_frame_point": float(np.mean(pts["point"])),
+        "reflectors_ms_per_frame_walking": 1e3 * t_refl / len(walk),
+        "exact_fps_walking": fps["walking"],
+        "exact_fps_point": fps["point"],
+        "exact_point_over_walking": fps["point"] / fps["walking"],
+        "exact_fps_cpu_walking": fps_cpu["walking"],
+        "exact_fps_cpu_point": fps_cpu["point"],
+        "exact_point_over_walking_cpu": fps_cpu["point"] / fps_cpu["walking"],
+        "fast_fps_walking": fast_fps,
+        "fast_fps_cpu_walking": reps * n / c_fast,
+        "fast_over_exact_walking": fast_fps / fps["walking"],
+        "fast_over_exact_walking_cpu": (reps * n / c_fast) / fps_cpu["walking"],
+        "goal": {
+            "exact_fps_walking": 150.0,
+            "exact_point_over_walking": 2.0,
+            "fast_over_exact": 10,
+        },
+    }
 
 
 def _stage_profile(radar: RadarConfig, settings: ProcessingSettings, antenna, frames) -> dict:
@@ -328,6 +433,19 @@ def summary(result: dict) -> str:
         f"plain {result['plain_points_per_frame']:.2f}; person detected in "
         f"{100 * result['exact_person_detected_fraction']:.0f} % of frames",
     ]
+    wb = result.get("walking_body")
+    if wb:
+        lines.append(
+            f"  walking body ({wb['scatterers_per_frame_walking']:.1f} scatterers/frame, "
+            f"{wb['person_points_per_frame_walking']:.1f} person points/frame; point person "
+            f"{wb['person_points_per_frame_point']:.2f}): exact {wb['exact_fps_walking']:.0f} "
+            f"frames/s, point person {wb['exact_fps_point']:.0f} frames/s in the same run "
+            f"({wb['exact_point_over_walking']:.2f}x; CPU "
+            f"{wb['exact_point_over_walking_cpu']:.2f}x; goal >= 150 frames/s, <= 2x); fast "
+            f"{wb['fast_fps_walking']:.0f} frames/s = {wb['fast_over_exact_walking']:.1f}x exact "
+            f"(CPU {wb['fast_over_exact_walking_cpu']:.1f}x; goal >= 10x); reflectors "
+            f"{wb['reflectors_ms_per_frame_walking']:.3f} ms/frame"
+        )
     stages = result.get("stages_ms")
     if stages:
         lines.append(

@@ -19,8 +19,9 @@ from core.files import write_json_atomic
 BENCHMARKS = ("sim", "track", "tune", "fidelity", "dataset", "false_alarms", "cvca", "import")
 #: benchmark name -> module in core.benchmarks, where the name is a Python keyword
 MODULES = {"import": "import_"}
-#: not part of ``all``: hours of studies (16 x 1000 trials)
-LONG = ("cvca_seeds",)
+#: not part of ``all``: hours of studies (16 x 1000 trials); person clouds (a calibration, not
+#: a speed figure)
+LONG = ("cvca_seeds", "clouds")
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
@@ -37,7 +38,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--render-only",
         action="store_true",
-        help="fidelity: re-write its tables and plot from <out-dir>/fidelity.json, no run",
+        help="fidelity, clouds: re-write the tables and plots from <out-dir>/<name>.json, no run",
     )
     for model in ("cv", "ca"):
         p.add_argument(
@@ -82,18 +83,21 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _render_only(args: argparse.Namespace) -> int:
-    """``--render-only``: the fidelity report re-rendered from a stored result."""
+    """``--render-only``: the fidelity or clouds report re-rendered from a stored result."""
     import json
 
     from core.errors import InputError
 
-    if args.name != "fidelity":
-        raise InputError(f"--render-only is for fidelity only, not {args.name!r}")
-    from core.benchmarks.fidelity_report import render, summary
+    if args.name not in ("fidelity", "clouds"):
+        raise InputError(f"--render-only is for fidelity and clouds only, not {args.name!r}")
+    if args.name == "fidelity":
+        from core.benchmarks.fidelity_report import render, summary
+    else:
+        from core.benchmarks.clouds import render, summary  # type: ignore[assignment]
 
-    path = Path(args.out_dir) / f"fidelity{'-quick' if args.quick else ''}.json"
+    path = Path(args.out_dir) / f"{args.name}{'-quick' if args.quick else ''}.json"
     if not path.exists():
-        raise InputError("no such file (run `radartune bench fidelity` first)", str(path))
+        raise InputError(f"no such file (run `radartune bench {args.name}` first)", str(path))
     try:
         result = json.loads(path.read_text())
     except (json.JSONDecodeError, UnicodeDecodeError) as exc:
@@ -101,7 +105,7 @@ def _render_only(args: argparse.Namespace) -> int:
     try:
         written = render(result, quick=args.quick)
     except (KeyError, TypeError, ValueError, IndexError) as exc:
-        raise InputError(f"not a fidelity result: {exc!r}", str(path)) from None
+        raise InputError(f"not a {args.name} result: {exc!r}", str(path)) from None
     print(summary(result))
     for out in written:
         print(f"written: {out}")

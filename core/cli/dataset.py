@@ -22,9 +22,11 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--no-cache", action="store_true", help="neither read nor write the cache")
     p.add_argument(
         "--person-model",
-        default="point",
-        help="person scattering model: point (the paper's, default) or extended (torso, arms, "
-        "legs, micro-Doppler); the trajectories and seeds stay those of the point set",
+        default=None,
+        help="person scattering model: walking (default: 17 segments driven by Boulic's gait "
+        "model), point (the paper's: the paper-faithful set) or blob (5 scatterers: torso, "
+        "arms, legs; 'extended' is its former name); the trajectories and seeds are the same "
+        "for every model (docs/person-models.md)",
     )
     p.add_argument(
         "--persons",
@@ -57,12 +59,17 @@ def run(args: argparse.Namespace) -> int:
     if args.jobs is not None and not 1 <= args.jobs <= MAX_JOBS:
         raise InputError(f"--jobs must be in [1, {MAX_JOBS}], got {args.jobs}")
     check_output_path(args.out, what="data set")
-    from core.scene.scene import PERSON_MODELS
+    from core.scene.scene import DEFAULT_PERSON_MODEL, PERSON_MODELS, person_model_kind
 
-    if args.person_model not in PERSON_MODELS:
+    if args.person_model is None:
+        args.person_model = DEFAULT_PERSON_MODEL
+
+    try:
+        person_model_kind(args.person_model)
+    except InputError:
         raise InputError(
             f"--person-model must be one of {list(PERSON_MODELS)}, got {args.person_model!r}"
-        )
+        ) from None
     ds = paper_dataset(
         args.seed,
         args.trajectories,

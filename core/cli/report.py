@@ -20,7 +20,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--person-model",
         default=None,
-        help="person model of a paper:SEED generalisation set: point (default) or extended",
+        help="person model of a paper:SEED generalisation set: point (default), blob "
+        "(former name extended) or walking",
     )
     p.set_defaults(func=run)
 

@@ -53,7 +53,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--person-model",
         default=None,
-        help="person model of the paper data set: point (default) or extended; same "
+        help="person model of the paper data set: point (default), blob (former name "
+        "extended) or walking; same "
         "trajectories and seeds (docs/report/extended-person.md)",
     )
     p.add_argument(

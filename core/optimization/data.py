@@ -19,9 +19,9 @@ def resolve_dataset(
 
     ``None`` or ``"paper"``: the paper's data set of seed 0; ``"paper:SEED"``: of another seed
     (35 trajectories, 7 per class); ``"paper:SEED:MODEL"``: with the person model ``MODEL``
-    (``point`` or ``extended``; same trajectories and seeds); anything else: a path to a
-    data-set file. ``person_model``, if given, applies to the ``paper`` forms without a model
-    (and must agree with one given in the string).
+    (``point``, ``blob`` (former name ``extended``) or ``walking``; same trajectories and
+    seeds); anything else: a path to a data-set file. ``person_model``, if given, applies to
+    the ``paper`` forms without a model (and must agree with one given in the string).
     """
     if dataset in (None, "", "paper") or str(dataset).startswith("paper:"):
         seed = 0
@@ -44,13 +44,15 @@ def resolve_dataset(
                 )
             model = parts[2]
         from core.pipeline import paper_dataset_file
-        from core.scene.scene import PERSON_MODELS
+        from core.scene.scene import PERSON_MODELS, person_model_kind
 
-        if model not in PERSON_MODELS:
+        try:
+            person_model_kind(model)
+        except InputError:
             raise InputError(
                 f"data set {dataset!r}: person model must be one of {list(PERSON_MODELS)}, "
                 f"got {model!r}"
-            )
+            ) from None
         return str(paper_dataset_file(seed, n_trajectories, person_model=model))
     if person_model not in (None, "point"):
         raise InputError(

@@ -236,8 +236,8 @@ def paper_dataset(
 
     Each trajectory is simulated with its scene's own seed, so ``simulate_scene(scene)`` of any
     of the scenes reproduces its frames of the data set bit for bit. ``person_model``
-    (``"point"`` or ``"extended"``) changes only the person's scattering model; ``n_persons``
-    puts that many persons in every scene (:func:`core.scene.paper_scenes`).
+    (``"point"``, ``"blob"``/``"extended"`` or ``"walking"``) changes only the person's scattering
+    model; ``n_persons`` puts that many persons in every scene (:func:`core.scene.paper_scenes`).
     """
     scenes = paper_scenes(seed, n_trajectories, person_model=person_model, n_persons=n_persons)
     return build_dataset(

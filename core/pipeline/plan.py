@@ -108,7 +108,17 @@ def plan(
     study = consumer == "study"
     has_clutter = scene.clutter_density_per_m2 > 0
     drawn_rcs = [i for i, p in enumerate(scene.persons) if p.rcs_dbsm is None]
-    extended = [i for i, p in enumerate(scene.persons) if p.model == "extended"]
+    extended = [i for i, p in enumerate(scene.persons) if p.kind != "point"]
+    walking = [i for i, p in enumerate(scene.persons) if p.kind == "walking"]
+    blob = [i for i in extended if i not in walking]
+    body_why = " and ".join(
+        (
+            [f"extended model (torso, arms, legs, micro-Doppler) for person(s) {blob}"]
+            if blob
+            else []
+        )
+        + ([f"walking body (17 segments, Boulic gait) for person(s) {walking}"] if walking else [])
+    )
     needs_el = scene.radar.has_elevation and not scene.is_planar
 
     def stage(name, needs, produces, run, why_run, why_skip):
@@ -138,7 +148,7 @@ def plan(
         ),
         stage(
             "body_model", ("truth_xy", "person_rcs"), ("body_scatterers",), extended,
-            f"extended model (torso, arms, legs, micro-Doppler) for person(s) {extended}",
+            body_why,
             "point-scatterer persons (the paper's model)",
         ),
         stage(

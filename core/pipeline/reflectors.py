@@ -13,7 +13,16 @@ from core.config import ProcessingSettings
 from core.pipeline.plan import Plan, plan, processing_settings
 from core.pipeline.streams import stage_rng
 from core.scene import Scene, draw_clutter
-from core.scene.body import body_scatterers, walking_headings
+from core.scene.body import N_BODY_SCATTERERS, body_scatterers, walking_headings
+from core.scene.scene import person_seed
+from core.scene.walking import (
+    N_SEGMENTS,
+    RCS_SHARES,
+    default_gait_phase,
+    gait_phase,
+    heading_rates,
+    walking_scatterers,
+)
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -28,8 +37,10 @@ class Reflectors:
     truth_xy_m: np.ndarray  # (F, n_persons, 2)
     truth_v_mps: np.ndarray  # (F, n_persons, 2)
     fixed_rcs: np.ndarray  # (n_persons,), NaN where drawn
-    extended: np.ndarray  # (n_persons,) bool: body model applies
+    extended: np.ndarray  # (n_persons,) bool: a body model (blob or walking) applies
+    walking: np.ndarray  # (n_persons,) bool: the walking body (else the blob) where extended
     headings: dict[int, np.ndarray]
+    gait: dict[int, tuple[np.ndarray, np.ndarray, float]]  # walking: (phase, turn rate, height)
     run_rcs: bool
     run_clutter: bool
     run_static: bool
@@ -39,9 +50,27 @@ class Reflectors:
     def build(cls, scene: Scene, p: Plan, seed: int, antenna, settings) -> Reflectors:
         """The builder of a scene's frames under plan ``p`` (``seed``: every stream's seed)."""
         t_s, xy, v = scene.truth()
-        extended = np.array([q.model == "extended" for q in scene.persons], dtype=bool)
+        extended = np.array([q.kind != "point" for q in scene.persons], dtype=bool)
         if not p.runs("body_model"):
             extended[:] = False
+        walking = extended & np.array([q.kind == "walking" for q in scene.persons], dtype=bool)
+        headings = {
+            i: walking_headings(q.trajectory.velocity_mps)
+            for i, q in enumerate(scene.persons)
+            if extended[i]
+        }
+        gait = {}
+        for i in np.flatnonzero(walking):
+            q = scene.persons[i]
+            n = q.trajectory.n_frames
+            phase0 = q.gait_phase
+            if phase0 is None:
+                phase0 = default_gait_phase(person_seed(scene.seed, int(i)))
+            gait[int(i)] = (
+                gait_phase(t_s[:n], q.trajectory.speed_mps, q.body_height_m, phase0),
+                heading_rates(t_s[:n], headings[i]),
+                q.body_height_m,
+            )
         fixed_rcs = np.array([np.nan if q.rcs_dbsm is None else q.rcs_dbsm for q in scene.persons])
         return cls(
             scene=scene,
@@ -53,11 +82,9 @@ class Reflectors:
             truth_v_mps=v,
             fixed_rcs=fixed_rcs,
             extended=extended,
-            headings={
-                i: walking_headings(q.trajectory.velocity_mps)
-                for i, q in enumerate(scene.persons)
-                if extended[i]
-            },
+            walking=walking,
+            headings=headings,
+            gait=gait,
             run_rcs=p.runs("person_rcs"),
             run_clutter=p.runs("clutter"),
             run_static=p.runs("static_reflectors"),
@@ -107,21 +134,43 @@ class Reflectors:
         active = ~np.isnan(xy[:, :, 0])  # (F, n_p)
         point = active & ~self.extended[None, :]
         n_point = point.sum(axis=1)
-        # extended persons: the body model per frame and person (frame order, person order)
-        body_pos, body_vel, body_rcs, body_src = [], [], [], []
+        # body persons (blob, walking): their scatterers per frame and person (frame order,
+        # person order), laid out densely (F, slots) and taken where the person is active
+        body = np.flatnonzero(self.extended)
+        n_slots = [N_SEGMENTS if self.walking[i] else N_BODY_SCATTERERS for i in body]
+        first_slot = np.concatenate([[0], np.cumsum(n_slots)]).astype(np.int64)
         n_body = np.zeros(n_f, dtype=np.int64)
-        if self.extended.any():
-            for row, f in enumerate(idx):
-                for i in np.flatnonzero(active[row] & self.extended):
+        body_pos = body_vel = body_rcs = body_src = None
+        if len(body):
+            width = int(first_slot[-1])
+            d_pos = np.zeros((n_f, width, 3))
+            d_vel = np.zeros((n_f, width, 3))
+            d_rcs = np.zeros((n_f, width))
+            d_src = np.empty((n_f, width), dtype=np.int32)
+            mask = np.zeros((n_f, width), dtype=bool)
+            for j, i in enumerate(body):
+                sl = slice(first_slot[j], first_slot[j + 1])
+                d_src[:, sl] = i
+                rows = np.flatnonzero(active[:, i])
+                mask[rows, sl] = True
+                if self.walking[i]:
+                    if len(rows):
+                        d_pos[rows, sl], d_vel[rows, sl], d_rcs[rows, sl] = self._walking_rows(
+                            i, idx[rows], xy[rows, i], v[rows, i], rcs[rows, i]
+                        )
+                    continue
+                for at_row in rows:
+                    fr = int(idx[at_row])
                     bp, bv, frac = body_scatterers(
-                        xy[row, i], v[row, i], self.headings[i][f], self.truth_t_s[f]
+                        xy[at_row, i], v[at_row, i], self.headings[i][fr], self.truth_t_s[fr]
                     )
-                    body_pos.append(bp)
-                    body_vel.append(bv)
+                    d_pos[at_row, sl, :2] = bp
+                    d_vel[at_row, sl, :2] = bv
                     # σ_part = σ · share (linear power)
-                    body_rcs.append(rcs[row, i] + 10 * np.log10(frac))
-                    body_src.append(np.full(len(bp), i, dtype=np.int32))
-                    n_body[row] += len(bp)
+                    d_rcs[at_row, sl] = rcs[at_row, i] + 10 * np.log10(frac)
+            n_body = mask.sum(axis=1)
+            body_pos, body_vel = d_pos[mask], d_vel[mask]
+            body_rcs, body_src = d_rcs[mask], d_src[mask]
         n_clutter = np.zeros(n_f, dtype=np.int64)
         c_pos, c_vr, c_snr = [], [], []
         if self.run_clutter:
@@ -156,12 +205,12 @@ class Reflectors:
         frame_of = np.repeat(np.arange(n_f), per_frame)
         slot = np.arange(n) - start[frame_of]  # position within the frame
         first = n_point[frame_of]
-        if body_pos:
+        if body_pos is not None and body_src is not None and len(body_pos):
             at = np.flatnonzero((slot >= first) & (slot < first + n_body[frame_of]))
-            position[at, :2] = np.concatenate(body_pos)
-            velocity[at, :2] = np.concatenate(body_vel)
-            rcs_all[at] = np.concatenate(body_rcs)
-            source[at] = np.concatenate(body_src)
+            position[at] = body_pos
+            velocity[at] = body_vel
+            rcs_all[at] = body_rcs
+            source[at] = body_src
         first = first + n_body[frame_of]
         if n_clutter.any():
             at = np.flatnonzero((slot >= first) & (slot < first + n_clutter[frame_of]))
@@ -187,6 +236,25 @@ class Reflectors:
             # an invalid reflector: the frame's validating constructor names the field
             out.append(_checked_scatterers(sim, *part) if whole_ok else _scatterers(sim, *part))
         return out, n_clutter
+
+    def _walking_rows(self, i, frames, xy, v, rcs):
+        """The walking body of person ``i`` in ``frames`` (vectorised over the frames).
+
+        Returns positions and velocities ``(n, N_SEGMENTS, 3)`` and RCS ``(n, N_SEGMENTS)``
+        (dBsm).
+        """
+        phase, turn, height = self.gait[int(i)]
+        pos, vel = walking_scatterers(
+            xy,
+            v,
+            self.headings[i][frames],
+            turn[frames],
+            phase[frames],
+            self.truth_t_s[frames],
+            height,
+        )
+        # σ_segment = σ · share (linear power): the shares sum to 1, so the powers add up to σ
+        return pos, vel, rcs[:, None] + 10 * np.log10(RCS_SHARES)[None, :]
 
     @staticmethod
     def _constants(scene: Scene, fixed_rcs, run_static: bool) -> _FrameConstants:

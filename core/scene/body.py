@@ -1,4 +1,4 @@
-"""Extended person model (optional): torso, arms and legs with micro-Doppler, in the z = 0 plane.
+"""Blob person model ("blob", formerly "extended"): torso, arms and legs with micro-Doppler, z = 0.
 
 The paper models a person as one point scatterer (the default). The extended model spreads the
 person's RCS over five scatterers that move with the walking person and swing along the walking

@@ -24,6 +24,7 @@ from core.limits import (
     MAX_SCATTERER_FRAMES,
     MAX_SIMULATED_SAMPLES,
     MAX_STATIC_REFLECTORS,
+    PERSON_HEIGHT_RANGE_M,
 )
 from core.scene.aoi import AOI
 from core.scene.body import N_BODY_SCATTERERS
@@ -37,6 +38,12 @@ from core.scene.trajectory import (
     waypoint_duration_s,
     waypoint_trajectory,
 )
+from core.scene.walking import (
+    DEFAULT_HEIGHT_M,
+    MAX_RELATIVE_VELOCITY,
+    N_SEGMENTS,
+    max_walking_speed_mps,
+)
 
 SCHEMA_VERSION = 1
 PAPER_CLUTTER_DENSITY_PER_M2 = 0.02
@@ -49,8 +56,35 @@ SCENE_KEYS = (
     "static_reflectors",
     "persons",
 )
-PERSON_KEYS = ("trajectory", "rcs_dbsm", "model")
-PERSON_MODELS = ("point", "extended")
+PERSON_KEYS = ("trajectory", "rcs_dbsm", "model", "height_m", "gait_phase")
+#: Person models: the paper's point, the 5-scatterer blob (:mod:`core.scene.body`) and the
+#: walking body of segments (:mod:`core.scene.walking`). ``"extended"`` is the blob's former
+#: name, still read (and written back as given, so old files and results stay identical).
+PERSON_MODELS = ("point", "blob", "walking")
+PERSON_MODEL_ALIASES = {"extended": "blob"}
+#: The person model ``radartune dataset`` and the app's new persons use unless told otherwise
+#: (docs/decisions/scene-07-default-person-model.md). A person without ``"model"`` in a scene
+#: file stays ``"point"``, so existing scene files keep their meaning.
+DEFAULT_PERSON_MODEL = "walking"
+
+
+def person_model_kind(name: str) -> str:
+    """The model a person-model name stands for (``"extended"`` -> ``"blob"``).
+
+    :class:`InputError` for an unknown name.
+    """
+    kind = PERSON_MODEL_ALIASES.get(name, name) if isinstance(name, str) else name
+    if kind not in PERSON_MODELS:
+        raise InputError(f"model must be one of {list(PERSON_MODELS)}, got {name!r}")
+    return kind
+
+
+def scatterers_per_person(name: str) -> int:
+    """Scatterers a person of model ``name`` contributes to a frame."""
+    kind = person_model_kind(name)
+    return {"point": 1, "blob": N_BODY_SCATTERERS, "walking": N_SEGMENTS}[kind]
+
+
 REFLECTOR_KEYS = ("x_m", "y_m", "z_m", "rcs_dbsm")
 RCS_RANGE_DBSM = (-60.0, 60.0)
 WAYPOINT_SPEED_RANGE_MPS = (0.05, 3.0)
@@ -78,22 +112,50 @@ class StaticReflector:
 
 @dataclass(frozen=True, slots=True, kw_only=True)
 class Person:
-    """One walking person: a point scatterer on the trajectory at z = 0.
+    """One walking person on a trajectory.
 
     ``rcs_dbsm`` fixes the RCS; ``None`` draws it from eq. (5), N(−8, 16) dBsm, every frame.
-    ``model``: ``"point"`` (the paper's, default) or ``"extended"`` (torso, arms and legs with
-    micro-Doppler, :mod:`core.scene.body`; the RCS is split over the body scatterers).
+    ``model``: ``"point"`` (the paper's, default: one scatterer at z = 0), ``"blob"`` (torso,
+    arms and legs as 5 scatterers in the z = 0 plane, :mod:`core.scene.body`; ``"extended"`` is
+    its former name) or ``"walking"`` (17 articulated segments at their heights driven by
+    Boulic's gait model, :mod:`core.scene.walking`); the RCS is split over the scatterers.
+    ``height_m`` (walking model: body height, default 1.75 m) and ``gait_phase`` (walking model:
+    phase of the gait cycle at the first frame in cycles, default drawn from the scene seed).
     ``spec`` is the trajectory's JSON description (kept so that the scene saves as written).
     """
 
     trajectory: Trajectory
     rcs_dbsm: float | None = None
     model: str = "point"
+    height_m: float | None = None
+    gait_phase: float | None = None
     spec: Mapping[str, Any] = field(default_factory=dict, compare=False)
 
     def __post_init__(self) -> None:
-        if self.model not in PERSON_MODELS:
-            raise InputError(f"model must be one of {list(PERSON_MODELS)}, got {self.model!r}")
+        kind = person_model_kind(self.model)
+        if self.height_m is not None:
+            _number(self.height_m, "height_m", *PERSON_HEIGHT_RANGE_M)
+        if self.gait_phase is not None:
+            _number(self.gait_phase, "gait_phase", 0.0, 1.0)
+        if kind == "walking":
+            v_max = max_walking_speed_mps(self.body_height_m)
+            fastest = float(self.trajectory.speed_mps.max(initial=0.0))
+            if fastest > v_max:
+                raise InputError(
+                    f"trajectory speed {fastest:.3g} m/s exceeds the walking model's "
+                    f"{v_max:.3g} m/s for height_m={self.body_height_m} (RV = v / H_t <= "
+                    f"{MAX_RELATIVE_VELOCITY}); use a slower trajectory or model 'point'/'blob'"
+                )
+
+    @property
+    def kind(self) -> str:
+        """The person model (``"point"``, ``"blob"`` or ``"walking"``; aliases resolved)."""
+        return person_model_kind(self.model)
+
+    @property
+    def body_height_m(self) -> float:
+        """Body height of the walking model (m)."""
+        return DEFAULT_HEIGHT_M if self.height_m is None else float(self.height_m)
 
     def to_dict(self) -> dict:
         d: dict[str, Any] = {"trajectory": dict(self.spec)}
@@ -101,6 +163,10 @@ class Person:
             d["rcs_dbsm"] = self.rcs_dbsm
         if self.model != "point":
             d["model"] = self.model
+        if self.height_m is not None:
+            d["height_m"] = self.height_m
+        if self.gait_phase is not None:
+            d["gait_phase"] = self.gait_phase
         return d
 
 
@@ -142,8 +208,11 @@ class Scene:
 
     @property
     def is_planar(self) -> bool:
-        """True when every reflector has z = 0 (persons are always at z = 0)."""
-        return all(r.z_m == 0.0 for r in self.static_reflectors)
+        """True when every reflector has z = 0 (point and blob persons are at z = 0; walking
+        bodies have their segments at their heights)."""
+        return all(r.z_m == 0.0 for r in self.static_reflectors) and not any(
+            p.kind == "walking" for p in self.persons
+        )
 
     @property
     def trajectory_class(self) -> str:
@@ -464,11 +533,28 @@ def _parse_scene(data: Any, base_dir: Path) -> Scene:
         if rcs is not None:
             rcs = _number(rcs, f"{where}.rcs_dbsm", *RCS_RANGE_DBSM)
         model = p.get("model", "point")
-        if model not in PERSON_MODELS:
-            raise InputError(f"{where}.model must be one of {list(PERSON_MODELS)}, got {model!r}")
-        persons.append(
-            Person(trajectory=traj, rcs_dbsm=rcs, model=model, spec=dict(p["trajectory"]))
-        )
+        try:
+            person_model_kind(model)
+        except InputError as exc:
+            raise InputError(f"{where}.{exc.message}") from None
+        height = p.get("height_m")
+        if height is not None:
+            height = _number(height, f"{where}.height_m", *PERSON_HEIGHT_RANGE_M)
+        phase = p.get("gait_phase")
+        if phase is not None:
+            phase = _number(phase, f"{where}.gait_phase", 0.0, 1.0)
+        try:
+            person = Person(
+                trajectory=traj,
+                rcs_dbsm=rcs,
+                model=model,
+                height_m=height,
+                gait_phase=phase,
+                spec=dict(p["trajectory"]),
+            )
+        except InputError as exc:
+            raise InputError(f"{where}: {exc.message}") from None
+        persons.append(person)
     n_frames = max((p.trajectory.n_frames for p in persons), default=1)
     if len(persons) * n_frames > MAX_PERSON_FRAMES:
         raise InputError(
@@ -476,7 +562,7 @@ def _parse_scene(data: Any, base_dir: Path) -> Scene:
             f"{MAX_PERSON_FRAMES} of one scene's work"
         )
     scatterers = (
-        sum(N_BODY_SCATTERERS if p.model == "extended" else 1 for p in persons)
+        sum(scatterers_per_person(p.model) for p in persons)
         + len(reflectors)
         + expected_clutter_count(aoi, density)
     )
@@ -542,9 +628,10 @@ def paper_scenes(
     from ``numpy.random.SeedSequence(seed).spawn(n_trajectories)`` (child ``k`` →
     two 32-bit words), so the set depends on ``seed`` only.
 
-    ``person_model`` (``"point"``, the paper's, or ``"extended"``) changes only the person's
-    scattering model (:class:`Person` ``model``): trajectories, scene seeds and everything else
-    are those of the point-model set of the same ``seed``.
+    ``person_model`` (``"point"``, the paper's, ``"blob"`` (or its former name
+    ``"extended"``) or ``"walking"``) changes only the person's scattering model
+    (:class:`Person` ``model``): trajectories, scene seeds and everything else are those of the
+    point-model set of the same ``seed``.
 
     ``n_persons`` > 1 (at most :data:`core.limits.MAX_PERSONS`) adds persons 1 … N−1 to every
     scene: person j walks a trajectory of class ``"abcde"[(k + j) % 5]`` drawn with the seed
@@ -554,8 +641,10 @@ def paper_scenes(
     """
     if n_trajectories < 1:
         raise InputError(f"n_trajectories must be >= 1, got {n_trajectories}")
-    if person_model not in PERSON_MODELS:
-        raise InputError(f"person_model must be one of {list(PERSON_MODELS)}, got {person_model!r}")
+    try:
+        person_model_kind(person_model)
+    except InputError as exc:
+        raise InputError(f"person_{exc.message}") from None
     if not (isinstance(n_persons, int) and 1 <= n_persons <= MAX_PERSONS):
         raise InputError(f"n_persons must be in [1, {MAX_PERSONS}], got {n_persons!r}")
     scenes = []

@@ -79,7 +79,9 @@ from core.processing.angle import log_parabolic_offset
 from core.processing.cfar import METHOD_CODE, effective_cells_or_none
 from core.processing.points import angle_twiddles, array_rows
 from core.processing.spectrum import window
+from core.simulation import body_cells
 from core.simulation.antenna import AntennaGain
+from core.simulation.body_cells import merge_person_cells
 from core.simulation.false_alarm_pool import chain_false_alarms
 from core.simulation.fast import FramesOutput
 from core.simulation.fast_model import cell_noise_power_v2, range_responses
@@ -421,7 +423,11 @@ def simulate_frames_measurement(
 
 
 def _run(radar, settings, antenna, states, start, pos, vel, rcs, source, elev, noise):
-    """The compiled kernel over frames ``start[f]:start[f+1]`` of the concatenated reflectors."""
+    """The compiled kernel over frames ``start[f]:start[f+1]`` of the concatenated reflectors
+    (a person's scatterers that share a cell merged first: :mod:`core.simulation.body_cells`)."""
+    start, pos, vel, rcs, source = merge_person_cells(
+        radar, start, pos, vel, rcs, source, body_cells.MERGE_CELLS
+    )
     _, const = _setup(radar, settings)
     fa = _false_alarm_pool(radar, settings) if noise else _NO_FALSE_ALARM_POOL
     g_db = antenna.gain_db(np.arctan2(pos[:, 0], pos[:, 1])) if len(pos) else np.zeros(0)

@@ -115,6 +115,7 @@ def test_scene_panel_both_ways(window, qtbot) -> None:
     # waypoints: a drawn person, its table, and clicks in the top view
     panel.add_wp_button.click()
     assert model.n_persons == 2 and model.selected_person == 1
+    assert model.document["persons"][1]["model"] == "walking"  # decision scene-07
     assert panel.stack.currentIndex() == 1 and panel.waypoints.rowCount() == 2
     panel.waypoints.item(1, 2).setText("0.8")
     wp = model.document["persons"][1]["trajectory"]["waypoints"]

@@ -182,3 +182,15 @@ def test_scatterer_frames() -> None:
     assert scene(static_reflectors=refl, persons=[profile(frames)]).n_frames == frames
     with pytest.raises(InputError, match=r"frames x scatterers = 101 x 1000"):
         scene(static_reflectors=refl, persons=[profile(frames + 1)])
+
+
+def test_person_height() -> None:
+    lo, hi = limits.PERSON_HEIGHT_RANGE_M
+    slow = {"class": "a", "seed": 1, "speed_mps": 1.0}
+    for h in (lo, hi):
+        walker = {"model": "walking", "height_m": h, "trajectory": slow}
+        assert scene(persons=[walker]).persons[0].height_m == h
+    for h in (lo - 0.01, hi + 0.01):
+        walker = {"model": "walking", "height_m": h, "trajectory": slow}
+        with pytest.raises(InputError, match=rf"persons\[0\]\.height_m must be in \[{lo}, {hi}\]"):
+            scene(persons=[walker])

@@ -334,3 +334,25 @@ def test_usage_errors_are_one_line(capsys, argv) -> None:
         main(argv)
     err = capsys.readouterr().err
     assert exc.value.code == 2 and len(err.splitlines()) == 1 and "--help" in err, err
+
+
+def test_person_model_bad_input_is_one_line(tmp_path, capsys) -> None:
+    code, _, err = run_cli(
+        capsys, "dataset", "--out", str(tmp_path / "d.npz"), "--person-model", "stick-figure"
+    )
+    assert_one_line(code, err, "--person-model must be one of", "walking")
+    walking = json.loads(json.dumps(SCENE))
+    walking["persons"][0]["model"] = "walking"
+    walking["persons"][0]["height_m"] = 0.0
+    scene = tmp_path / "walking.json"
+    scene.write_text(json.dumps(walking))
+    out = tmp_path / "w.npz"
+    code, _, err = run_cli(capsys, "simulate", "--scene", str(scene), "--out", str(out))
+    assert_one_line(code, err, "persons[0].height_m must be in [1.0, 2.2]")
+    walking["persons"][0]["height_m"] = 1.7
+    scene.write_text(json.dumps(walking))
+    code, _, err = run_cli(
+        capsys, "simulate", "--scene", str(scene), "--out", str(out), "--fidelity", "measurement"
+    )
+    # the measurement level simulates the walking body (core.simulation.body_cells)
+    assert code == 0 and out.exists(), err

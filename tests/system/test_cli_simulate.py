@@ -118,6 +118,10 @@ def test_dataset_command_writes_the_paper_subset(tmp_path: Path, monkeypatch, ca
     assert "elapsed" in captured.out and "dataset [" in captured.err  # progress bar
     ds = Dataset.load(out)
     assert list(ds.trajectory_class) == ["a"] and ds.seed == 3
+    # the default person model is the walking body (decision scene-07)
+    scene = ds.scene()
+    scene = scene[0] if isinstance(scene, list) else scene
+    assert scene["persons"][0]["model"] == "walking"
     assert len(list((tmp_path / "cache" / "datasets").glob("*.npz"))) == 1
 
 

@@ -32,11 +32,23 @@ def test_extended_paper_scenes_change_only_the_person_model() -> None:
     )
 
 
+def test_walking_and_blob_paper_scenes_keep_the_trajectories() -> None:
+    point = paper_scenes(0, 5)
+    for model in ("blob", "walking"):
+        other = paper_scenes(0, 5, person_model=model)
+        assert [p.persons[0].kind for p in other] == [model] * 5
+        for a, b in zip(point, other, strict=True):
+            assert a.seed == b.seed
+            np.testing.assert_array_equal(
+                a.persons[0].trajectory.position_m, b.persons[0].trajectory.position_m
+            )
+
+
 def test_bad_person_model_is_rejected() -> None:
     with pytest.raises(InputError, match="person_model"):
-        paper_scenes(0, 5, person_model="blob")
+        paper_scenes(0, 5, person_model="stick-figure")
     with pytest.raises(InputError, match="person model"):
-        resolve_dataset("paper:0:blob")
+        resolve_dataset("paper:0:stick-figure")
     with pytest.raises(InputError, match="paper:SEED"):
         resolve_dataset("paper:0:extended:x")
     with pytest.raises(InputError, match="--person-model"):

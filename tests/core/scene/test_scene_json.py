@@ -118,7 +118,7 @@ def modified(**changes):
         (modified(persons__0__trajectory__class="x"), "persons[0].trajectory.class"),
         (modified(clutter_density_per_m2=2.0), "clutter_density_per_m2"),
         (modified(colour="red"), "['colour']"),
-        (modified(persons__1__height_m=1.8), "persons[1]: unknown key(s) ['height_m']"),
+        (modified(persons__1__weight_kg=80), "persons[1]: unknown key(s) ['weight_kg']"),
         (modified(aoi__max_azimuth_deg=120), "aoi.max_azimuth_deg"),
         (modified(persons__2__rcs_dbsm="loud"), "persons[2].rcs_dbsm"),
         (modified(persons__0__trajectory__speed_mps=7), "persons[0].trajectory.speed_mps"),
@@ -130,7 +130,7 @@ def modified(**changes):
         (modified(static_reflectors__0__x_m=0.0, static_reflectors__0__y_m=0.0), "range 0"),
         (modified(static_reflectors__0__y_m=30.0), "maximum range"),
         (modified(persons__2__trajectory__initial_position_m=[0.0, 4.0]), "within 0.0"),
-        (modified(persons__0__model="blob"), "persons[0].model"),
+        (modified(persons__0__model="stick-figure"), "persons[0].model"),
     ],
 )
 def test_bad_scene_names_the_field(tmp_path: Path, data, expected: str) -> None:
