@@ -26,6 +26,8 @@ class FrameResult:
 
     ``rd_map_db``: shape ``(range bins, Doppler bins)``, zero velocity centred, or ``None``
     when the plan does not keep it. ``n_clutter``: clutter reflectors drawn in this frame.
+    ``ra_map_db``: ``(range bins, angle bins)`` range-azimuth map in dB, kept with the
+    range-Doppler map by the levels that have a Doppler cube, else ``None``.
     """
 
     index: int
@@ -36,6 +38,7 @@ class FrameResult:
     rd_map_db: np.ndarray | None
     detections: np.ndarray
     n_clutter: int
+    ra_map_db: np.ndarray | None = None
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -132,6 +135,7 @@ def iter_frames(
             rd_map_db=out.rd_map_db if p.keep_rd_maps else None,
             detections=out.detections,
             n_clutter=n_clutter,
+            ra_map_db=out.ra_map_db if p.keep_rd_maps else None,
         )
 
 
