@@ -210,8 +210,19 @@ class TopView(pg.PlotWidget):
         self.setTitle(
             "Top view · points: SNR 10–50 dB"
             if mode == "snr"
-            else "Top view · points: person / clutter / noise"
+            else "Top view · points: person / clutter / false alarm"
         )
+        # legend of the label colours (app.colours), shown while points are coloured by label
+        legend = self.getPlotItem().legend
+        if not hasattr(self, "_label_samples"):
+            self._label_samples = {
+                k: pg.ScatterPlotItem(brush=self._label_brushes[k], pen=None, size=8)
+                for k in ("person", "clutter", "false alarm")
+            }
+        for name, sample in self._label_samples.items():
+            legend.removeItem(sample)
+            if mode == "label":
+                legend.addItem(sample, f"point: {name}")
 
     def _point_brushes(
         self, frames: Sequence[FrameData]
