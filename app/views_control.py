@@ -34,9 +34,10 @@ class ViewsController(QtCore.QObject):
         self.tabs.addTab(self.elevation_view, "Elevation")
         self.views_dock = self._dock("Radar views", self.tabs)
         self.tracks_dock = self._dock("Tracks", self.track_table)
-        window.tabifyDockWidget(self.views_dock, self.tracks_dock)
-        self.views_dock.raise_()
-        window.resizeDocks([self.views_dock], [300], QtCore.Qt.Vertical)
+        # side by side under the central views: the track table beside the radar views
+        window.splitDockWidget(self.views_dock, self.tracks_dock, QtCore.Qt.Horizontal)
+        window.resizeDocks([self.views_dock], [250], QtCore.Qt.Vertical)
+        window.resizeDocks([self.views_dock, self.tracks_dock], [3, 2], QtCore.Qt.Horizontal)
         view_menu = next(
             (a.menu() for a in window.menuBar().actions() if a.text() == "&View"), None
         )

@@ -24,7 +24,6 @@ class ElevationView(pg.PlotWidget):
         self.setLabel("left", "height z", units="m")
         self.showGrid(x=True, y=True, alpha=0.2)
         self.addLegend(offset=(-5, 5))
-        self.setAspectLocked(True)
         self._brushes = np.empty(3, dtype=object)
         self._brushes[:] = [
             pg.mkBrush(*LABEL_COLOURS[k], 220) for k in ("person", "clutter", "false alarm")

@@ -1,5 +1,6 @@
-"""Range-azimuth heat map: ``FrameData.ra_map_db`` against sin(azimuth) and range, with the
-frame's detections on top. Items are created once; the map is drawn with fixed levels."""
+"""Range-azimuth heat map: ``FrameData.ra_map_db`` against range and sin(azimuth), with the
+frame's detections on top. Range runs along the horizontal axis (the views sit in a wide,
+low dock, and range has the most bins). Items are created once; levels are fixed per radar."""
 
 from __future__ import annotations
 
@@ -12,7 +13,7 @@ from core.config import RadarConfig
 
 LEVEL_SPAN_DB = 50.0
 #: azimuth ticks (degrees) drawn on the sin(azimuth) axis
-TICKS_DEG = (-90, -60, -45, -30, -15, 0, 15, 30, 45, 60, 90)
+TICKS_DEG = (-60, -30, 0, 30, 60)
 
 
 class RangeAzimuthView(pg.GraphicsLayoutWidget):
@@ -23,11 +24,11 @@ class RangeAzimuthView(pg.GraphicsLayoutWidget):
         super().__init__(parent)
         self.setObjectName("rangeAzimuthView")
         self.plot = self.addPlot(row=0, col=0)
-        self.plot.setLabel("bottom", "azimuth (axis uniform in sin az)", units="°")
-        self.plot.setLabel("left", "range", units="m")
+        self.plot.setLabel("bottom", "range", units="m")
+        self.plot.setLabel("left", "azimuth (°, axis uniform in sin az)")
         self.plot.setTitle("Range-azimuth map (dB, moving reflectors: clutter removed)")
         ticks = [(float(np.sin(np.deg2rad(d))), f"{d}") for d in TICKS_DEG]
-        self.plot.getAxis("bottom").setTicks([ticks])
+        self.plot.getAxis("left").setTicks([ticks])
         self.image = pg.ImageItem(axisOrder="row-major")
         self.plot.addItem(self.image)
         self.colorbar = pg.ColorBarItem(
@@ -51,15 +52,15 @@ class RangeAzimuthView(pg.GraphicsLayoutWidget):
         self._levels = None
         self._n_angle = 0
         self._max_range_m = float(max_range_m or radar.max_range_m)
-        self.plot.setXRange(-1.0, 1.0, padding=0.02)
-        self.plot.setYRange(0.0, self._max_range_m, padding=0.02)
-        self.message.setPos(0.0, self._max_range_m / 2)
+        self.plot.setYRange(-1.0, 1.0, padding=0.02)
+        self.plot.setXRange(0.0, self._max_range_m, padding=0.02)
+        self.message.setPos(self._max_range_m / 2, 0.0)
 
     def _set_rect(self, n_range: int, n_angle: int) -> None:
         dr = self._radar.range_resolution_m
         du = 2.0 / n_angle
-        # angle index i at u = 2 (i - N/2) / N; range bin k at k dR; the image spans bin edges
-        self.image.setRect(QtCore.QRectF(-1.0 - du / 2, -dr / 2, 2.0, n_range * dr))
+        # range bin k at k dR; angle index i at u = 2 (i - N/2) / N; the image spans bin edges
+        self.image.setRect(QtCore.QRectF(-dr / 2, -1.0 - du / 2, n_range * dr, 2.0))
         self._n_angle = n_angle
 
     def show_frame(self, frame: FrameData | None) -> None:
@@ -80,8 +81,9 @@ class RangeAzimuthView(pg.GraphicsLayoutWidget):
             floor = float(np.median(ra))
             self._levels = (floor - 3.0, floor - 3.0 + LEVEL_SPAN_DB)
             self.colorbar.setLevels(self._levels)
-        self.image.setImage(ra, autoLevels=False, levels=self._levels)
+        # image rows are the vertical axis: [angle index, range bin]
+        self.image.setImage(ra.T, autoLevels=False, levels=self._levels)
         if ra.shape[1] != self._n_angle:
             self._set_rect(*ra.shape)
         c = frame.cloud
-        self.points.setData(np.sin(c.azimuth_rad) * np.cos(c.elevation_rad), c.range_m)
+        self.points.setData(c.range_m, np.sin(c.azimuth_rad) * np.cos(c.elevation_rad))

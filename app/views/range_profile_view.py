@@ -37,7 +37,7 @@ class RangeProfileView(QtWidgets.QWidget):
         self.plot.setLabel("left", "power (dB)")
         self.plot.setTitle("Range profile with the CFAR threshold")
         self.plot.showGrid(x=True, y=True, alpha=0.2)
-        self.plot.addLegend(offset=(-5, 5))
+        self.plot.addLegend(offset=(5, 5))  # top left: below the minimum range, rarely data
         self.profile = self.plot.plot(pen=pg.mkPen((230, 230, 230), width=1.2), name="power")
         self.threshold = self.plot.plot(
             pen=pg.mkPen((255, 80, 80), width=1.5, style=QtCore.Qt.DashLine),
@@ -48,8 +48,7 @@ class RangeProfileView(QtWidgets.QWidget):
             size=9, symbol="o", pen=pg.mkPen((80, 255, 120), width=1.5), brush=None,
             name="detections",
         )  # fmt: skip
-        self.plot.addItem(self.detections)
-        self.plot.getPlotItem().legend.addItem(self.detections, "detections")
+        self.plot.addItem(self.detections)  # named: the legend lists it
         lay = QtWidgets.QVBoxLayout(self)
         lay.setContentsMargins(0, 0, 0, 0)
         lay.addLayout(bar)

@@ -39,7 +39,7 @@ def test_range_azimuth_peak_at_the_persons_range_bin_and_angle(tracked) -> None:
     window.playback.set_frame(k)
     v = window.views_control
     v.draw_all(k, frames[k], window.tracking_model.result)
-    img = v.ra_view.image.image
+    img = v.ra_view.image.image.T  # drawn [angle, range]
     f = frames[k]
     assert np.array_equal(img, f.ra_map_db)
     radar = scene.radar
