@@ -231,7 +231,7 @@ def frame_views(rd_map_db, truth_xy_m: np.ndarray, radar: RadarConfig, settings)
     if rd_map_db is None:
         return {"cfar_threshold_db": None, "person_doppler_db": None}
     from core.processing import two_stage_thresholds
-    from core.processing.range_gate import doppler_at_range
+    from core.processing.micro_doppler import micro_doppler
 
     rd = np.asarray(rd_map_db)
     # the map's power back from dB: P = 10^(dB/10)
@@ -240,7 +240,11 @@ def frame_views(rd_map_db, truth_xy_m: np.ndarray, radar: RadarConfig, settings)
         th_db = (10.0 * np.log10(th.combined)).astype(np.float32)
     # R = |(x, y)| (the persons walk on the floor: z = 0)
     ranges = np.hypot(truth_xy_m[:, 0], truth_xy_m[:, 1])
-    return {"cfar_threshold_db": th_db, "person_doppler_db": doppler_at_range(rd, ranges, radar)}
+    cuts = [
+        micro_doppler(rd[None], ranges[i : i + 1], radar).power_db[0] for i in range(len(ranges))
+    ]
+    person_db = np.array(cuts, dtype=np.float32).reshape(len(ranges), rd.shape[1])
+    return {"cfar_threshold_db": th_db, "person_doppler_db": person_db}
 
 
 # ---- tracking ---------------------------------------------------------------------------------
