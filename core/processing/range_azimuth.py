@@ -9,13 +9,16 @@ detected cell; the powers are summed over Doppler (non-coherently)::
     P[k, i] = sum_j | sum_p x_p[k, j] exp(-j 2 pi i' p / N_fft) |^2,   i' = i - N_fft / 2
 
 so a reflector at ``u = sin(az) cos(el)`` peaks at the centred angle index
-``i = N_fft / 2 + N_fft u / 2`` (the angle stage's ``u = 2 k / N_fft``).
+``i = N_fft / 2 + N_fft u / 2`` (the angle stage's ``u = 2 k / N_fft``). The sum is evaluated
+as the quadratic form ``a_i^T R_k conj(a_i)`` of the row's spatial covariance
+``R_k = sum_j x_kj x_kj^H`` (the same numbers as the FFTs, tested; about 4x faster).
 """
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
-import scipy.fft
 
 from core.config import RadarConfig
 from core.processing.angle import azimuth_row, tdm_compensate
@@ -72,9 +75,22 @@ def range_azimuth_map(
         # x_v <- x_v exp(-j 2 pi d k(v) / (Nc Ntx)), per Doppler bin d
         slot_phase = tdm_compensate(np.ones((n_d, n_v), dtype=np.complex128), d, radar)
         sel = sel * slot_phase[:, row_ch].T[:, None, :].astype(np.complex64)
-    padded = np.zeros((fft_size, n_r, n_d), dtype=np.complex64)
-    padded[row_pos] = sel
-    spec = scipy.fft.fft(padded, axis=0, overwrite_x=True)
-    power = (spec.real**2 + spec.imag**2).sum(axis=2)  # [angle, range]
-    # centre the angle axis: index i <-> k = i - N/2
-    return np.ascontiguousarray(np.fft.fftshift(power, axes=0).T, dtype=np.float32)
+    # the sum over Doppler of |A x|^2 is a quadratic form of the spatial covariance:
+    # R_k = sum_j x_kj x_kj^H  (row channels x row channels, per range bin)
+    xs = np.ascontiguousarray(sel.transpose(1, 0, 2))  # [range, channel, Doppler]
+    cov = np.matmul(xs, np.conj(xs.transpose(0, 2, 1)))
+    steer = _steering(fft_size, tuple(int(p) for p in row_pos))  # [angle, channel]
+    # P[k, i] = a_i^T R_k conj(a_i),  a_i[p] = exp(-j 2 pi (i - N/2) p / N)
+    b = np.matmul(steer[None], cov)  # [range, angle, channel]
+    power = np.einsum("kic,ic->ki", b, np.conj(steer)).real
+    return np.ascontiguousarray(power, dtype=np.float32)
+
+
+@functools.lru_cache(maxsize=16)
+def _steering(fft_size: int, positions: tuple[int, ...]) -> np.ndarray:
+    """Rows of the centred ``fft_size``-point DFT at the array positions: ``[angle, channel]``."""
+    i = np.arange(fft_size)[:, None] - fft_size // 2
+    p = np.asarray(positions)[None, :]
+    a = np.exp(-2j * np.pi * i * p / fft_size).astype(np.complex64)
+    a.flags.writeable = False
+    return a

@@ -71,3 +71,20 @@ def test_static_reflector_removed_and_power_is_parseval() -> None:
     x = c[ch] * ph[:, None, :]
     expected = 64 * np.sum(np.abs(x) ** 2, axis=(0, 2))
     np.testing.assert_allclose(moving.sum(axis=1), expected, rtol=1e-4, atol=1e-12)
+
+
+def test_equals_the_zero_padded_fft_summed_over_doppler() -> None:
+    # the definition, written out: FFT of the zero-padded row per (range, Doppler), |.|^2 summed
+    rng = np.random.default_rng(3)
+    shape = (RADAR.n_virtual, 40, RADAR.n_loops)
+    cube = (rng.standard_normal(shape) + 1j * rng.standard_normal(shape)).astype(np.complex64)
+    from core.processing.angle import azimuth_row, tdm_compensate
+
+    ch, pos = azimuth_row(RADAR)
+    d = np.arange(RADAR.n_loops) - RADAR.n_loops // 2
+    ph = tdm_compensate(np.ones((RADAR.n_loops, RADAR.n_virtual)), d, RADAR)[:, ch].T
+    row = np.zeros((64, 40, RADAR.n_loops), dtype=np.complex128)
+    row[pos] = cube[ch] * ph[:, None, :]
+    spec = np.fft.fftshift(np.fft.fft(row, axis=0), axes=0)
+    expected = (np.abs(spec) ** 2).sum(axis=2).T
+    np.testing.assert_allclose(range_azimuth_map(cube, RADAR), expected, rtol=2e-5)
