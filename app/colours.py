@@ -1,8 +1,8 @@
 """The app's colours in one place: per-identity (tracks, persons) and per-label (points).
 
-Every view that colours a track by its identity, a person by its index or a point by its label
-takes the colour from here, so that track 3 is the same colour in the top view, the track table
-and the ψ plot, and the legend matches the points.
+Every view that colours a track by its identity or a point by its label takes the colour from
+here, so that track 3 is the same colour in the top view and the track table, and the legend
+matches the points. Persons (ground truth) have their own palette, :mod:`app.person_colours`.
 """
 
 from __future__ import annotations

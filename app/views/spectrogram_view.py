@@ -9,8 +9,9 @@ import numpy as np
 import pyqtgraph as pg
 from PySide6 import QtCore
 
-from app.colours import hex_colour, identity_colour
+from app.colours import hex_colour
 from app.data import FrameData
+from app.person_colours import person_colour
 from core.config import RadarConfig
 
 LEVEL_SPAN_DB = 45.0
@@ -49,7 +50,7 @@ class MicroDopplerView(pg.GraphicsLayoutWidget):
         self._set_title()
 
     def _set_title(self) -> None:
-        c = hex_colour(identity_colour(self.person))
+        c = hex_colour(person_colour(self.person))
         self.plot.setTitle(
             f"Micro-Doppler at the range of <span style='color:{c}'>person {self.person}</span>"
             " (dB)"
