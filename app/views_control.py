@@ -14,6 +14,9 @@ from app.views.range_profile_view import RangeProfileView
 from app.views.spectrogram_view import MicroDopplerView
 from app.views.track_table import TrackTable
 
+#: below this available height (logical px) the two docks start closed
+SMALL_SCREEN_HEIGHT_PX = 700
+
 
 class ViewsController(QtCore.QObject):
     """Owns the radar views and the track table of a :class:`~app.window.MainWindow`."""
@@ -32,12 +35,22 @@ class ViewsController(QtCore.QObject):
         self.tabs.addTab(self.profile_view, "Range profile")
         self.tabs.addTab(self.spectrogram_view, "Micro-Doppler")
         self.tabs.addTab(self.elevation_view, "Elevation")
+        # small minimum heights: the window must still fit 1366x768 at 150 % (512 logical px)
+        for widget in (self.tabs, self.track_table, self.ra_view, self.profile_view,
+                       self.spectrogram_view, self.elevation_view):  # fmt: skip
+            widget.setMinimumSize(80, 40)
         self.views_dock = self._dock("Radar views", self.tabs)
         self.tracks_dock = self._dock("Tracks", self.track_table)
         # side by side under the central views: the track table beside the radar views
         window.splitDockWidget(self.views_dock, self.tracks_dock, QtCore.Qt.Horizontal)
         window.resizeDocks([self.views_dock], [250], QtCore.Qt.Vertical)
         window.resizeDocks([self.views_dock, self.tracks_dock], [3, 2], QtCore.Qt.Horizontal)
+        # a small logical screen (1366x768 at 150 %: 512 px) has no height to spare for them:
+        # they start closed there (View menu opens them)
+        screen = window.screen() or QtWidgets.QApplication.primaryScreen()
+        if screen is not None and screen.availableGeometry().height() < SMALL_SCREEN_HEIGHT_PX:
+            self.views_dock.hide()
+            self.tracks_dock.hide()
         view_menu = next(
             (a.menu() for a in window.menuBar().actions() if a.text() == "&View"), None
         )
@@ -55,8 +68,9 @@ class ViewsController(QtCore.QObject):
         dock = QtWidgets.QDockWidget(title, self._window)
         dock.setObjectName(f"dock{title.replace(' ', '')}")
         dock.setWidget(widget)
+        # not in window.docks: those are the panels' docks (scroll areas) the window arranges;
+        # the views stay in the bottom area, across the window's width
         self._window.addDockWidget(QtCore.Qt.BottomDockWidgetArea, dock)
-        self._window.docks[title] = dock
         return dock
 
     def _on_scene_info(self, info) -> None:
