@@ -25,8 +25,8 @@ class RangeAzimuthView(pg.GraphicsLayoutWidget):
         self.setObjectName("rangeAzimuthView")
         self.plot = self.addPlot(row=0, col=0)
         self.plot.setLabel("bottom", "range", units="m")
-        self.plot.setLabel("left", "azimuth (°, axis uniform in sin az)")
-        self.plot.setTitle("Range-azimuth map (dB, moving reflectors: clutter removed)")
+        self.plot.setLabel("left", "azimuth", units="°")
+        self.plot.setTitle("Range-azimuth map (dB; azimuth uniform in sin az; clutter removed)")
         ticks = [(float(np.sin(np.deg2rad(d))), f"{d}") for d in TICKS_DEG]
         self.plot.getAxis("left").setTicks([ticks])
         self.image = pg.ImageItem(axisOrder="row-major")
