@@ -33,6 +33,15 @@ class FrameData:
         centred, or ``None`` when maps were not kept.
     detections
         CFAR detections, shape ``(n_det, 2)`` int: range bin, Doppler bin index into the map.
+    ra_map_db
+        Range-azimuth map in dB, ``(n_range_bins, n_angle_bins)``, angle index centred
+        (``u = sin(az) = 2 (i - N/2) / N``), or ``None`` (levels without a Doppler cube).
+    cfar_threshold_db
+        The two-stage CFAR threshold of every cell of ``rd_map_db`` in dB (the larger of the
+        two stages'), NaN where the detector does not test; ``None`` without a map.
+    person_doppler_db
+        ``(n_persons, n_doppler_bins)`` dB: the map's Doppler spectrum at each person's range
+        (one column of that person's micro-Doppler spectrogram); NaN rows for absent persons.
     """
 
     index: int
@@ -41,6 +50,9 @@ class FrameData:
     truth_xy_m: np.ndarray
     rd_map_db: np.ndarray | None = None
     detections: np.ndarray = field(default_factory=lambda: np.zeros((0, 2), dtype=np.int64))
+    ra_map_db: np.ndarray | None = None
+    cfar_threshold_db: np.ndarray | None = None
+    person_doppler_db: np.ndarray | None = None
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -61,6 +73,17 @@ class TrackFrame:
         ``(n,)`` existence probability ψ in [0, 1].
     confirmed
         ``(n,)`` bool, True once the track is confirmed.
+    velocity_xy_mps
+        ``(n, 2)`` estimated velocity in m/s.
+    sigma_xy_m
+        ``(n, 2)`` standard deviations of the position estimate (√P_xx, √P_yy) in m.
+    birth_frame
+        ``(n,)`` int frame in which each track was born (age = frame − birth).
+    n_associated
+        ``(n,)`` int measurements in each track's gate this frame; −1 where the tracker does
+        not report it.
+    nis
+        ``(n,)`` normalised innovation squared of the last update; NaN where not reported.
     """
 
     track_id: np.ndarray
@@ -69,6 +92,11 @@ class TrackFrame:
     gate_shape_xy_m2: np.ndarray
     psi: np.ndarray
     confirmed: np.ndarray
+    velocity_xy_mps: np.ndarray | None = None
+    sigma_xy_m: np.ndarray | None = None
+    birth_frame: np.ndarray | None = None
+    n_associated: np.ndarray | None = None
+    nis: np.ndarray | None = None
 
     @classmethod
     def empty(cls) -> TrackFrame:

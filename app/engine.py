@@ -209,15 +209,42 @@ def simulate(scene, *, fidelity: str = "exact") -> Iterator[FrameData]:
     from core import pipeline
 
     the_plan = pipeline.plan(scene, fidelity=fidelity, consumer="gui")
+    settings = pipeline.processing_settings(scene)
     for fr in pipeline.iter_frames(scene, the_plan=the_plan):
+        truth = np.asarray(fr.truth_xy_m, dtype=float).reshape(-1, 2)
         yield FrameData(
             index=fr.index,
             t_s=fr.t_s,
             cloud=fr.point_cloud,
-            truth_xy_m=np.asarray(fr.truth_xy_m, dtype=float).reshape(-1, 2),
+            truth_xy_m=truth,
             rd_map_db=fr.rd_map_db,
             detections=np.asarray(fr.detections).reshape(-1, 2),
+            ra_map_db=fr.ra_map_db,
+            **frame_views(fr.rd_map_db, truth, scene.radar, settings),
         )
+
+
+def frame_views(rd_map_db, truth_xy_m: np.ndarray, radar: RadarConfig, settings) -> dict:
+    """What the range profile and the micro-Doppler views draw of one frame's map: the CFAR
+    threshold of every cell in dB (``cfar_threshold_db``) and the Doppler spectrum at each
+    person's range (``person_doppler_db``); both ``None`` without a map."""
+    if rd_map_db is None:
+        return {"cfar_threshold_db": None, "person_doppler_db": None}
+    from core.processing import two_stage_thresholds
+    from core.processing.micro_doppler import micro_doppler
+
+    rd = np.asarray(rd_map_db)
+    # the map's power back from dB: P = 10^(dB/10)
+    th = two_stage_thresholds(10.0 ** (rd.astype(np.float64) / 10.0), radar, settings)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        th_db = (10.0 * np.log10(th.combined)).astype(np.float32)
+    # R = |(x, y)| (the persons walk on the floor: z = 0)
+    ranges = np.hypot(truth_xy_m[:, 0], truth_xy_m[:, 1])
+    cuts = [
+        micro_doppler(rd[None], ranges[i : i + 1], radar).power_db[0] for i in range(len(ranges))
+    ]
+    person_db = np.array(cuts, dtype=np.float32).reshape(len(ranges), rd.shape[1])
+    return {"cfar_threshold_db": th_db, "person_doppler_db": person_db}
 
 
 # ---- tracking ---------------------------------------------------------------------------------
@@ -264,16 +291,7 @@ def track(
     for k, ft in enumerate(res.frames):
         xy = np.asarray(ft.state, dtype=float)[:, :2].reshape(-1, 2)
         confirmed = np.asarray(ft.confirmed, dtype=bool)
-        tfs.append(
-            TrackFrame(
-                track_id=np.asarray(ft.ids, dtype=np.int64),
-                xy_m=xy,
-                gate_center_xy_m=np.asarray(ft.gate_center_xy, dtype=float).reshape(-1, 2),
-                gate_shape_xy_m2=np.asarray(ft.gate_shape_xy, dtype=float).reshape(-1, 2, 2),
-                psi=np.asarray(ft.psi, dtype=float),
-                confirmed=confirmed,
-            )
-        )
+        tfs.append(track_frame(ft))
         conf_list.append(xy[confirmed])
         ids_l.append(np.asarray(ft.ids, dtype=np.int64))
         t_l.append(np.full(len(ft.ids), k, dtype=np.int64))
@@ -311,6 +329,35 @@ def track(
         trail_id=ids,
         params_key=key,
         elapsed_s=time.perf_counter() - t0,
+    )
+
+
+def track_frame(ft) -> TrackFrame:
+    """A core ``FrameTracks`` as the overlay and the track table draw it.
+
+    ``n_associated`` and ``nis`` are taken when the tracker reports them (attributes of the same
+    names, per track); otherwise −1 and NaN.
+    """
+    n = len(ft.ids)
+    state = np.asarray(ft.state, dtype=float).reshape(n, -1)
+    cov = np.asarray(ft.covariance, dtype=float).reshape(n, state.shape[1], state.shape[1])
+    n_assoc = getattr(ft, "n_associated", None)
+    nis = getattr(ft, "nis", None)
+    return TrackFrame(
+        track_id=np.asarray(ft.ids, dtype=np.int64),
+        xy_m=state[:, :2],
+        gate_center_xy_m=np.asarray(ft.gate_center_xy, dtype=float).reshape(-1, 2),
+        gate_shape_xy_m2=np.asarray(ft.gate_shape_xy, dtype=float).reshape(-1, 2, 2),
+        psi=np.asarray(ft.psi, dtype=float),
+        confirmed=np.asarray(ft.confirmed, dtype=bool),
+        velocity_xy_mps=state[:, 2:4],
+        # sigma_x = sqrt(P_xx), sigma_y = sqrt(P_yy)
+        sigma_xy_m=np.sqrt(np.maximum(cov[:, [0, 1], [0, 1]], 0.0)),
+        birth_frame=np.asarray(ft.birth_frame, dtype=np.int64),
+        n_associated=(
+            np.full(n, -1, dtype=np.int64) if n_assoc is None else np.asarray(n_assoc, np.int64)
+        ),
+        nis=np.full(n, np.nan) if nis is None else np.asarray(nis, dtype=float),
     )
 
 

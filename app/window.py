@@ -128,6 +128,13 @@ class MainWindow(QtWidgets.QMainWindow):
         self._build_view_bar()
         self._build_menus()
         self._build_status()
+        # ---- radar views, track table, record and export (issue 17; app/views_control.py,
+        # app/record.py): docks and File-menu entries of their own, drawn from redraw()
+        from app.record import RecordController
+        from app.views_control import ViewsController
+
+        self.views_control = ViewsController(self)
+        self.record = RecordController(self)
 
         # ---- wiring ----------------------------------------------------------------------------
         self.scene_control.info_changed.connect(self._on_scene_info)
@@ -394,6 +401,7 @@ class MainWindow(QtWidgets.QMainWindow):
         self.top_view.show_frame(index, frames, result)
         self.rd_view.show_frame(frame)
         self.psi_view.set_frame(index)
+        self.views_control.redraw(index, frame, result)  # radar views and track table
         self._show_metrics(index, result)
         self.n_draws += 1
         self._draw_times.append(time.perf_counter())

@@ -12,6 +12,7 @@ import numpy as np
 import pyqtgraph as pg
 from PySide6 import QtCore, QtGui
 
+from app.colours import IDENTITY_PALETTE, LABEL_COLOURS, identity_colour, identity_index, label_key
 from app.data import FrameData, TrackFrame, TrackingResult
 from app.geometry import aoi_polyline, ellipse_polyline, trails_polyline
 
@@ -19,8 +20,6 @@ SNR_MIN_DB = 10.0
 SNR_MAX_DB = 50.0
 N_SNR_COLOURS = 32
 N_PSI_LEVELS = 11
-
-LABEL_COLOURS = {"person": (255, 140, 0), "clutter": (60, 140, 255), "noise": (160, 160, 160)}
 
 
 def _snr_palette() -> list[QtGui.QBrush]:
@@ -58,13 +57,19 @@ class TopView(pg.PlotWidget):
         self._snr_array = np.empty(N_SNR_COLOURS, dtype=object)
         self._snr_array[:] = self._snr_brushes
         self._label_array = np.empty(3, dtype=object)
-        self._label_array[:] = [self._label_brushes[k] for k in ("person", "clutter", "noise")]
-        self._confirmed_brushes = _psi_palette((0, 220, 90))
-        self._tentative_brushes = _psi_palette((240, 220, 40))
+        self._label_array[:] = [
+            self._label_brushes[k] for k in ("person", "clutter", "false alarm")
+        ]
+        # per identity (app.colours), opacity by ψ: [identity palette index][ψ level]
+        self._identity_brushes = [_psi_palette(rgb) for rgb in IDENTITY_PALETTE]
 
         self.aoi = self.plot(pen=pg.mkPen((120, 120, 120), width=1, style=QtCore.Qt.DashLine))
         self.reflectors = pg.ScatterPlotItem(
-            symbol="s", size=10, brush=pg.mkBrush(150, 75, 0), pen=None, name="static reflector"
+            symbol="s",
+            size=10,
+            brush=pg.mkBrush(*LABEL_COLOURS["static"]),
+            pen=None,
+            name="static reflector",
         )
         self.addItem(self.reflectors)
         self.truth_path = self.plot(
@@ -73,6 +78,11 @@ class TopView(pg.PlotWidget):
         self.points = pg.ScatterPlotItem(size=6, pen=None, name="points")
         self.addItem(self.points)
         self.trails = self.plot(pen=pg.mkPen((0, 220, 90, 150), width=1.5), connect="finite")
+        # trails coloured per identity: one NaN-separated curve per palette colour
+        self.identity_trails = [
+            self.plot(pen=pg.mkPen((*rgb, 190), width=2), connect="finite")
+            for rgb in IDENTITY_PALETTE
+        ]
         self.gates_confirmed = self.plot(
             pen=pg.mkPen((0, 220, 90), width=1), connect="finite", name="gate (confirmed)"
         )
@@ -102,6 +112,8 @@ class TopView(pg.PlotWidget):
              self.tracks, self.reflectors, self.points, self.truth_now, self.estimate)
         ):  # fmt: skip
             item.setZValue(z)
+        for item in self.identity_trails:
+            item.setZValue(self.trails.zValue())
         self.waypoint_line = self.plot(
             pen=pg.mkPen((255, 0, 255), width=1, style=QtCore.Qt.DashLine), symbol=None
         )
@@ -198,8 +210,19 @@ class TopView(pg.PlotWidget):
         self.setTitle(
             "Top view · points: SNR 10–50 dB"
             if mode == "snr"
-            else "Top view · points: person / clutter / noise"
+            else "Top view · points: person / clutter / false alarm"
         )
+        # legend of the label colours (app.colours), shown while points are coloured by label
+        legend = self.getPlotItem().legend
+        if not hasattr(self, "_label_samples"):
+            self._label_samples = {
+                k: pg.ScatterPlotItem(brush=self._label_brushes[k], pen=None, size=8)
+                for k in ("person", "clutter", "false alarm")
+            }
+        for name, sample in self._label_samples.items():
+            legend.removeItem(sample)
+            if mode == "label":
+                legend.addItem(sample, f"point: {name}")
 
     def _point_brushes(
         self, frames: Sequence[FrameData]
@@ -220,8 +243,8 @@ class TopView(pg.PlotWidget):
         if self.colour_by == "snr":
             brushes = self._snr_array[key]
         else:
-            # source >= 0 person, -1 clutter, -2 noise  ->  palette index 0, 1, 2
-            brushes = self._label_array[np.clip(-key, 0, 2)]
+            # source >= 0 person, -1 clutter, -2 false alarm  ->  palette index 0, 1, 2
+            brushes = self._label_array[label_key(key)]
         return x, y, brushes
 
     def show_frame(
@@ -261,16 +284,16 @@ class TopView(pg.PlotWidget):
             self.gates_confirmed.setData([], [])
             self.gates_tentative.setData([], [])
             self.trails.setData([], [])
+            for item in self.identity_trails:
+                item.setData([], [])
             self.estimate.setData([], [])
             for label in self._labels:
                 label.hide()
             return
         psi = np.nan_to_num(tf.psi, nan=1.0)  # fast stage: ψ not known yet, drawn opaque
         level = np.clip(np.round(psi * (N_PSI_LEVELS - 1)), 0, N_PSI_LEVELS - 1).astype(int)
-        brushes = [
-            (self._confirmed_brushes if c else self._tentative_brushes)[k]
-            for k, c in zip(level, tf.confirmed)
-        ]
+        colour = identity_index(tf.track_id)
+        brushes = [self._identity_brushes[c][k] for c, k in zip(colour, level)]
         symbols = ["o" if c else "t" for c in tf.confirmed]
         self.tracks.setData(x=tf.xy_m[:, 0], y=tf.xy_m[:, 1], brush=brushes, symbol=symbols)
         conf = tf.confirmed
@@ -280,15 +303,17 @@ class TopView(pg.PlotWidget):
         e = ellipse_polyline(c[~conf], g[~conf], 1.0)
         self.gates_tentative.setData(e[:, 0], e[:, 1], connect="finite")
         if tracking is not None:
-            t = trails_polyline(
-                tracking.trail_id,
-                tracking.trail_t_index,
-                tracking.trail_xy_m,
-                index,
-                self.trail_length,
-                tf.track_id[tf.confirmed],
-            )
-            self.trails.setData(t[:, 0], t[:, 1], connect="finite")
+            live = tf.track_id[tf.confirmed]
+            for c, item in enumerate(self.identity_trails):
+                t = trails_polyline(
+                    tracking.trail_id,
+                    tracking.trail_t_index,
+                    tracking.trail_xy_m,
+                    index,
+                    self.trail_length,
+                    live[identity_index(live) == c],
+                )
+                item.setData(t[:, 0], t[:, 1], connect="finite")
             est = tracking.estimate_xy_m[index]
             if np.isfinite(est).all():
                 self.estimate.setData([est[0]], [est[1]])
@@ -300,6 +325,7 @@ class TopView(pg.PlotWidget):
             self._labels.append(label)
         for k, label in enumerate(self._labels):
             if k < n:
+                label.setColor(identity_colour(int(tf.track_id[k])))
                 label.setText(f"{tf.track_id[k]} ψ={tf.psi[k]:.2f}")
                 label.setPos(float(tf.xy_m[k, 0]) + 0.1, float(tf.xy_m[k, 1]) + 0.1)
                 label.show()

@@ -27,6 +27,8 @@ class FrameResult:
 
     ``rd_map_db``: shape ``(range bins, Doppler bins)``, zero velocity centred, or ``None``
     when the plan does not keep it. ``n_clutter``: clutter reflectors drawn in this frame.
+    ``ra_map_db``: ``(range bins, angle bins)`` range-azimuth map in dB, kept with the
+    range-Doppler map by the levels that have a Doppler cube, else ``None``.
     """
 
     index: int
@@ -37,6 +39,7 @@ class FrameResult:
     rd_map_db: np.ndarray | None
     detections: np.ndarray
     n_clutter: int
+    ra_map_db: np.ndarray | None = None
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -166,6 +169,7 @@ def frame_inputs(
             antenna=antenna,
             rng=stage_rng(seed, "noise", f),
             n_clutter=n_clutter,
+            ra_map_db=out.ra_map_db if p.keep_rd_maps else None,
         )
 
 

@@ -8,14 +8,17 @@ from core.processing.cfar import (
     CagoCfar,
     CasoCfar,
     Cfar,
+    CfarThresholds,
     Detections,
     expected_false_alarms_per_frame,
     make_cfar,
     two_stage_cfar,
     two_stage_pfa,
+    two_stage_thresholds,
 )
 from core.processing.cfar_thresholds import pfa_ca, pfa_cago, pfa_caso, threshold_factor
 from core.processing.points import build_point_cloud, label_sources, refine_bins
+from core.processing.range_azimuth import azimuth_sines, range_azimuth_map
 from core.processing.spectrum import (
     doppler_fft,
     range_doppler_map,
@@ -30,8 +33,10 @@ __all__ = [
     "CagoCfar",
     "CasoCfar",
     "Cfar",
+    "CfarThresholds",
     "Detections",
     "expected_false_alarms_per_frame",
+    "azimuth_sines",
     "build_point_cloud",
     "doppler_fft",
     "estimate_angles",
@@ -40,6 +45,7 @@ __all__ = [
     "pfa_ca",
     "pfa_cago",
     "pfa_caso",
+    "range_azimuth_map",
     "range_doppler_map",
     "range_fft",
     "refine_bins",
@@ -48,6 +54,7 @@ __all__ = [
     "threshold_factor",
     "two_stage_cfar",
     "two_stage_pfa",
+    "two_stage_thresholds",
     "window",
     "window_loss_db",
 ]

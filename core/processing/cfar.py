@@ -116,6 +116,22 @@ class _SidedCfar:
             Per-cell noise estimate ``mu_hat`` (mean power of one cell), NaN where no training
             window fits.
         """
+        threshold, mu = self.threshold(power, axis)
+        p = np.moveaxis(np.asarray(power, dtype=np.float64), axis, 0)
+        with np.errstate(invalid="ignore"):
+            mask = p > np.moveaxis(threshold, axis, 0)
+        return np.moveaxis(mask, 0, axis), mu
+
+    def threshold(self, power: np.ndarray, axis: int = 0) -> tuple[np.ndarray, np.ndarray]:
+        """The threshold ``alpha * mu_hat`` each cell of ``power`` is compared with along
+        ``axis`` (a cell is detected when its power exceeds it).
+
+        Returns
+        -------
+        threshold, noise : numpy.ndarray of float64
+            Same shape as ``power``: the threshold and the noise estimate ``mu_hat``; NaN where
+            no training window fits.
+        """
         p = np.moveaxis(np.asarray(power, dtype=np.float64), axis, 0)
         n = self.n_train
         left, right, ok_l, ok_r = _side_sums(p, n, self.n_guard, self.cyclic)
@@ -127,9 +143,8 @@ class _SidedCfar:
         mu = np.where(only_l, left / n, mu)
         mu = np.where(only_r, right / n, mu)
         alpha = np.where(both, self.alpha(), self.alpha_one_side())
-        with np.errstate(invalid="ignore"):
-            mask = p > alpha * mu
-        return np.moveaxis(mask, 0, axis), np.moveaxis(mu, 0, axis)
+        # T = alpha * mu_hat
+        return np.moveaxis(alpha * mu, 0, axis), np.moveaxis(mu, 0, axis)
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -246,6 +261,26 @@ def _cfar_plan(radar: RadarConfig, settings: ProcessingSettings, n_r: int, n_d: 
     if inside.size == 0:
         return None
     lo, hi = int(inside[0]), int(inside[-1])
+    range_cfar, doppler_cfar, profile = _stage_detectors(radar, settings, n_d, L)
+    # the range stage needs training cells beyond the limits: run it on a margin around them
+    margin = settings.range_cfar.n_train + settings.range_cfar.n_guard
+    a, b = max(0, lo - margin), min(n_r, hi + 1 + margin)
+    return TwoStageCfarArgs(
+        profile=profile,
+        lo=lo,
+        hi=hi,
+        a=a,
+        b=b,
+        range_stage=cfar_stage_args(range_cfar),
+        doppler_stage=cfar_stage_args(doppler_cfar),
+        peak_grouping=settings.peak_grouping,
+    )
+
+
+def _stage_detectors(
+    radar: RadarConfig, settings: ProcessingSettings, n_d: int, L: int
+) -> tuple[_SidedCfar, _SidedCfar, np.ndarray]:
+    """The two stages' detectors and the whitening profile ``(n_d,)`` (read-only)."""
     rc, dc = settings.range_cfar, settings.doppler_cfar
     ne_r = ne_d = None
     profile = np.ones(n_d)
@@ -258,19 +293,68 @@ def _cfar_plan(radar: RadarConfig, settings: ProcessingSettings, n_r: int, n_d: 
                 clutter_removal_noise_profile(settings.doppler_window, n_d), dtype=np.float64
             )
     profile.flags.writeable = False
-    # the range stage needs training cells beyond the limits: run it on a margin around them
-    margin = rc.n_train + rc.n_guard
-    a, b = max(0, lo - margin), min(n_r, hi + 1 + margin)
-    return TwoStageCfarArgs(
-        profile=profile,
-        lo=lo,
-        hi=hi,
-        a=a,
-        b=b,
-        range_stage=cfar_stage_args(make_cfar(rc, L, ne_r)),
-        doppler_stage=cfar_stage_args(make_cfar(dc, L, ne_d)),
-        peak_grouping=settings.peak_grouping,
-    )
+    return make_cfar(rc, L, ne_r), make_cfar(dc, L, ne_d), profile
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class CfarThresholds:
+    """The thresholds of :func:`two_stage_cfar`, per cell of a range-Doppler map.
+
+    Both arrays have the map's shape ``[range bin, Doppler bin]``, in the map's units (V²),
+    NaN where the stage does not test the cell (outside the range limits; Doppler bins emptied
+    by clutter removal). A cell is detected when its power exceeds both (and, with peak
+    grouping, it is a local maximum): :attr:`combined`.
+    """
+
+    range_stage: np.ndarray
+    doppler_stage: np.ndarray
+
+    @property
+    def combined(self) -> np.ndarray:
+        """The larger of the two stages' thresholds (NaN where either is NaN)."""
+        return np.maximum(self.range_stage, self.doppler_stage)
+
+
+def two_stage_thresholds(
+    rd_map: np.ndarray,
+    radar: RadarConfig,
+    settings: ProcessingSettings = DEFAULT_PROCESSING,
+    *,
+    n_channels: int | None = None,
+) -> CfarThresholds:
+    """The threshold every cell of ``rd_map`` meets in each stage of :func:`two_stage_cfar`.
+
+    The same detectors, whitening and range limits as the detection (the range profile with
+    its CFAR threshold is drawn from this); the arithmetic of :meth:`CaCfar.threshold` and its
+    siblings, which the compiled detection is tested equal to.
+
+    Parameters
+    ----------
+    rd_map
+        ``[range bin, Doppler bin]`` power (V²), as for :func:`two_stage_cfar`.
+    n_channels
+        Number of summed channels ``L`` (default: ``radar.n_virtual``).
+    """
+    rd = np.asarray(rd_map, dtype=np.float64)
+    L = radar.n_virtual if n_channels is None else n_channels
+    n_r, n_d = rd.shape
+    out_r = np.full((n_r, n_d), np.nan)
+    out_d = np.full((n_r, n_d), np.nan)
+    plan = _cfar_plan(radar, settings, n_r, n_d, L)
+    if plan is None:
+        return CfarThresholds(range_stage=out_r, doppler_stage=out_d)
+    range_cfar, doppler_cfar, profile = _stage_detectors(radar, settings, n_d, L)
+    lo, hi, a, b = plan.lo, plan.hi, plan.a, plan.b
+    dead = profile < 0.01
+    # whitened map: equal noise in every Doppler bin (dead bins carry 0)
+    sub = np.where(dead[None, :], 0.0, rd[a:b] / np.where(dead, 1.0, profile)[None, :])
+    t_r, _ = range_cfar.threshold(sub, axis=0)
+    t_d, _ = doppler_cfar.threshold(sub[lo - a : hi - a + 1], axis=1)
+    # back to the map's units: T_map = T_whitened * profile
+    scale = np.where(dead, np.nan, profile)[None, :]
+    out_r[lo : hi + 1] = t_r[lo - a : hi - a + 1] * scale
+    out_d[lo : hi + 1] = t_d * scale
+    return CfarThresholds(range_stage=out_r, doppler_stage=out_d)
 
 
 #: The compiled kernels' code of each CFAR estimator.

@@ -11,6 +11,7 @@ from core.config import DEFAULT_PROCESSING, ProcessingSettings, RadarConfig
 from core.pointcloud import PointCloud
 from core.processing import (
     doppler_fft,
+    range_azimuth_map,
     range_doppler_map,
     two_stage_cfar,
 )
@@ -36,11 +37,16 @@ class FrameOutput:
         non-coherent sum (V²), zero velocity centred; None unless ``keep_rd_map=True``.
     detections
         ``(n_det, 2)`` int: range bin, Doppler index into ``rd_map_db``.
+    ra_map_db
+        ``[range bin, angle index]`` float32 range-azimuth map in dB
+        (:func:`core.processing.range_azimuth.range_azimuth_map`, angle index centred), kept
+        with ``rd_map_db`` by the levels that have a Doppler cube (exact); None otherwise.
     """
 
     point_cloud: PointCloud
     rd_map_db: np.ndarray | None
     detections: np.ndarray
+    ra_map_db: np.ndarray | None = None
 
 
 def processed_range_bins(radar: RadarConfig, settings: ProcessingSettings) -> int:
@@ -208,11 +214,15 @@ def frame_from_spectrum(
             reflector_source=scatterers.source,
             t_mid_s=0.5 * radar.n_loops * radar.n_tx * radar.chirp_period_s,
         )
-    rd_db = None
+    rd_db = ra_db = None
     if keep_rd_map:
-        rd_db = (10 * np.log10(np.maximum(rd, np.finfo(np.float32).tiny))).astype(np.float32)
+        tiny = np.finfo(np.float32).tiny
+        rd_db = (10 * np.log10(np.maximum(rd, tiny))).astype(np.float32)
+        ra = range_azimuth_map(doppler_cube, radar, fft_size=settings.angle_fft_size)
+        ra_db = (10 * np.log10(np.maximum(ra, tiny))).astype(np.float32)
     return FrameOutput(
         point_cloud=pc,
         rd_map_db=rd_db,
         detections=np.column_stack((det.range_bin, det.doppler_index)).astype(np.int64),
+        ra_map_db=ra_db,
     )

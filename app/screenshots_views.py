@@ -1,0 +1,89 @@
+"""Screenshots of the radar views, the track table and the label legend for the user guide.
+
+    QT_QPA_PLATFORM=offscreen python -m app.screenshots_views --out docs/screenshots
+
+Runs the real window on a scene (default: the two-person scene, simulated through the radar
+chain and tracked with the default parameters) and grabs each view at one frame with
+``QWidget.grab()``. Settings go to a temporary file, never the user's.
+"""
+
+from __future__ import annotations
+
+import argparse
+import shutil
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import app  # noqa: F401  (thread settings before numpy)
+from app.engine import ROOT
+
+SHOTS = (
+    ("ra_view", "views_range_azimuth.png"),
+    ("profile_view", "views_range_profile.png"),
+    ("spectrogram_view", "views_micro_doppler.png"),
+    ("elevation_view", "views_elevation.png"),
+    ("track_table", "views_track_table.png"),
+)
+
+
+def _wait(qa, cond, timeout_s: float) -> bool:
+    end = time.monotonic() + timeout_s
+    while time.monotonic() < end:
+        qa.processEvents()
+        if cond():
+            return True
+        time.sleep(0.01)
+    return cond()
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog="python -m app.screenshots_views", description=__doc__)
+    parser.add_argument("--out", default="docs/screenshots", help="output folder")
+    parser.add_argument(
+        "--scene", default=str(ROOT / "resources" / "scenes" / "two_persons.json"), help="scene"
+    )
+    parser.add_argument("--frame", type=int, default=60, help="frame shown (0-based)")
+    args = parser.parse_args(argv)
+
+    import pyqtgraph as pg
+    from PySide6 import QtCore, QtWidgets
+
+    from app.window import MainWindow
+
+    qa = QtWidgets.QApplication.instance() or QtWidgets.QApplication(sys.argv[:1])
+    pg.setConfigOptions(imageAxisOrder="row-major")
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    tmp = Path(tempfile.mkdtemp(prefix="radartune-shots-"))
+    settings = QtCore.QSettings(str(tmp / "settings.ini"), QtCore.QSettings.IniFormat)
+    w = MainWindow(settings, restore=False, scene_path=args.scene)
+    w.resize(1600, 1000)
+    w.show()
+    if not _wait(qa, lambda: w.cache.complete, 600):
+        print("simulation did not finish", file=sys.stderr)
+        return 1
+    _wait(qa, lambda: w.tracking_model.result is not None and w.tracker.idle, 300)
+    w.playback.set_frame(min(args.frame, len(w.cache) - 1))
+    w.colour_combo.setCurrentIndex(w.colour_combo.findData("label"))
+    w.redraw()
+    index = w.playback.frame
+    w.views_control.draw_all(index, w.cache.frames[index], w.tracking_model.result)
+    written = []
+    for attr, name in SHOTS:
+        widget = getattr(w.views_control, attr)
+        widget.resize(900, 300)
+        qa.processEvents()
+        widget.grab().save(str(out / name))
+        written.append(name)
+    w.top_view.grab().save(str(out / "views_top_view_identities.png"))
+    written.append("views_top_view_identities.png")
+    w.shutdown()
+    shutil.rmtree(tmp, ignore_errors=True)
+    print("\n".join(str(out / s) for s in written))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
