@@ -128,6 +128,7 @@ def iter_frames(
             rd_map_db=out.rd_map_db if p.keep_rd_maps else None,
             detections=out.detections,
             n_clutter=fi.n_clutter,
+            ra_map_db=out.ra_map_db if p.keep_rd_maps else None,
         )
 
 
@@ -169,7 +170,6 @@ def frame_inputs(
             antenna=antenna,
             rng=stage_rng(seed, "noise", f),
             n_clutter=n_clutter,
-            ra_map_db=out.ra_map_db if p.keep_rd_maps else None,
         )
 
 
