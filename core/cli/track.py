@@ -1,4 +1,4 @@
-"""``radartune track``: run the IPDA tracker on a data set and print the paper's loss table."""
+"""``radartune track``: run the (J)IPDA tracker on a data set and print the paper's loss table."""
 
 from __future__ import annotations
 
@@ -21,11 +21,18 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--engine", choices=("numba", "numpy"), default="numba", help="default: %(default)s"
     )
+    p.add_argument(
+        "--association",
+        choices=("ipda", "jipda"),
+        help="data association: joint IPDA over tracks sharing measurements, or independent "
+        "IPDA per track (default: the parameters' 'association', jipda)",
+    )
     p.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
     import time
+    from dataclasses import replace
     from pathlib import Path
 
     from core.dataset import Dataset
@@ -43,6 +50,8 @@ def run(args: argparse.Namespace) -> int:
         if args.params
         else TrackerParams.default(args.model or "cv")
     )
+    if args.association:
+        params = replace(params, association=args.association)
     ds = Dataset.load(args.data)
     traj = None
     if args.trajectories:
@@ -63,7 +72,8 @@ def run(args: argparse.Namespace) -> int:
     ev = evaluate(ds, est)
     print(
         f"{args.data}: {len(est.trajectories)} trajectories, {len(est.frame_index)} frames, "
-        f"model {params.model}, tracked in {elapsed * 1e3:.1f} ms"
+        f"model {params.model}, association {params.association}, "
+        f"tracked in {elapsed * 1e3:.1f} ms"
     )
     print(ev.format_table())
     if args.out:

@@ -26,6 +26,7 @@ __all__ = [
     "synthetic_frames",
     "synthetic_dataset",
     "crossing_paths",
+    "circling_paths",
     "people_dataset",
     "PAPER_LIKE",
 ]
@@ -267,6 +268,38 @@ def crossing_paths(
     # pᵢ(t) = c + s τ uᵢ, vᵢ = s uᵢ
     pos = np.asarray(centre)[None, None, :] + speed_mps * tau[:, None, None] * u[None, :, :]
     vel = np.broadcast_to(speed_mps * u[None, :, :], pos.shape).copy()
+    return pos, vel
+
+
+def circling_paths(
+    n_people: int,
+    n_frames: int,
+    scene: SyntheticScene = PAPER_LIKE,
+    *,
+    centre: tuple[float, float] = (0.0, 5.0),
+    speed_mps: float = 1.0,
+) -> tuple[np.ndarray, np.ndarray]:
+    """n people walking circles round one centre, every second one the other way: a room in
+    which they keep crossing.
+
+    Person i walks radius Rᵢ = 1.2 + 0.4·(i mod 3) m, starting at the angle 2πi/n, direction
+    sᵢ = (−1)ⁱ: φᵢ(t) = 2πi/n + sᵢ·(v/Rᵢ)·t, pᵢ(t) = c + Rᵢ[cos φᵢ, sin φᵢ].
+
+    Returns
+    -------
+    positions, velocities
+        (F, n, 2) in m and m/s.
+    """
+    t = np.arange(n_frames) * scene.frame_period_s
+    pos = np.zeros((n_frames, n_people, 2))
+    vel = np.zeros((n_frames, n_people, 2))
+    for i in range(n_people):
+        radius = 1.2 + 0.4 * (i % 3)
+        omega = (-1.0) ** i * speed_mps / radius
+        phi = 2.0 * math.pi * i / n_people + omega * t
+        pos[:, i] = np.asarray(centre) + radius * np.column_stack((np.cos(phi), np.sin(phi)))
+        # v = R ω [−sin φ, cos φ]
+        vel[:, i] = radius * omega * np.column_stack((-np.sin(phi), np.cos(phi)))
     return pos, vel
 
 
