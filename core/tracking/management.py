@@ -90,6 +90,7 @@ def merge(
             if position_gate_distance2(pos[a], pos_cov[a], pos[b], pos_cov[b]) > gamma2:
                 continue
             if confirmed is not None and confirmed[a] and confirmed[b]:
+                assert state is not None and state_cov is not None
                 v_a, v_b = state[a][2:4], state[b][2:4]
                 c_a, c_b = state_cov[a][2:4, 2:4], state_cov[b][2:4, 2:4]
                 if position_gate_distance2(v_a, c_a, v_b, c_b) > VELOCITY_MERGE_D2:
