@@ -1,7 +1,11 @@
 """The IPDA tracker's compiled kernel: every ``@njit`` function of the tracker, in one file.
 
 :func:`track_kernel` tracks every selected trajectory of a data set in one call, with the
-helpers it calls (prediction, PDA update, Cholesky solves, gating, track health, compaction).
+helpers it calls (prediction, PDA update, Cholesky solves, gating, track health, compaction, the
+JIPDA clusters and joint-event enumeration). Per frame it predicts and gates every track first
+(pass 1, kept per track), then associates and updates (pass 2): each track alone (IPDA), or with
+``joint`` the clusters of tracks sharing a validated measurement jointly (JIPDA,
+:mod:`core.tracking.jipda`; a cluster of one, or one above ``max_joint_events``, takes IPDA).
 Its arguments are four groups of arrays, :class:`KernelFrames`, :class:`KernelConstants`,
 :class:`KernelOutputs` and :class:`~core.tracking.results.TrackRecord`; the Python side that
 fills them and calls it is :mod:`core.tracking.kernel`.
@@ -703,7 +707,7 @@ def track_kernel(frames_, c_, out_, check, record, rec_):
                         if dd > gamma2:
                             continue
                         if joint and conf[a] and conf[b]:
-                            # confirmed pairs (JIPDA): also Δvᵀ (P_v,a + P_v,b)⁻¹ Δv ≤ 2 ln 2
+                            # confirmed pairs (JIPDA): also Δvᵀ (P_v,a + P_v,b)⁻¹ Δv ≤ 2 ln 10
                             dx = X[a, 2] - X[b, 2]
                             dy = X[a, 3] - X[b, 3]
                             c00 = P[a, 2, 2] + P[b, 2, 2]

@@ -10,8 +10,8 @@ import math
 import numpy as np
 
 #: Threshold on Δvᵀ (P_v,a + P_v,b)⁻¹ Δv for merging two confirmed tracks (JIPDA tracker):
-#: χ²₂⁻¹(0.5) = 2 ln 2, the velocities agree within their median uncertainty ellipse.
-VELOCITY_MERGE_D2 = 2.0 * math.log(2.0)
+#: χ²₂⁻¹(0.9) = 2 ln 10, the velocities agree within their 90 % uncertainty ellipse.
+VELOCITY_MERGE_D2 = 2.0 * math.log(10.0)
 
 __all__ = [
     "VELOCITY_MERGE_D2",

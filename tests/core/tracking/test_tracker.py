@@ -64,7 +64,7 @@ def test_non_finite_measurements_are_an_input_error(bad):
 
 
 def test_merge_of_confirmed_tracks_needs_agreeing_velocities():
-    """JIPDA's merge: two confirmed tracks at one position merge only when Δvᵀ(ΣP_v)⁻¹Δv ≤ 2 ln 2;
+    """JIPDA's merge: two confirmed tracks at one position merge only when Δvᵀ(ΣP_v)⁻¹Δv ≤ 2 ln 10;
     a tentative track merges on position alone."""
     from core.tracking.management import VELOCITY_MERGE_D2, merge
 
