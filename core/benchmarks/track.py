@@ -16,6 +16,7 @@ of a pass is also given scaled to 5 687 frames.
 from __future__ import annotations
 
 import time
+from dataclasses import replace
 
 import numpy as np
 
@@ -234,7 +235,8 @@ def run(quick: bool = False) -> dict:
         "models": {},
     }
     for model in ("cv", "ca"):
-        p = TrackerParams.default(model)
+        # the plain reference implements independent IPDA: compare like with like
+        p = replace(TrackerParams.default(model), association="ipda")
         t0 = time.perf_counter()
         fast = track_dataset(ds, p)  # first call: loads (or compiles) the kernel
         first = time.perf_counter() - t0
@@ -278,7 +280,91 @@ def run(quick: bool = False) -> dict:
             "mean_live_tracks": float(fast.n_tracks.mean()),
             **gui,
         }
+    out["jipda"] = jipda_bench(ds, quick)
     return out
+
+
+#: People in the cost-against-people measurement.
+PEOPLE = (1, 2, 4, 8)
+#: Frames of the multi-person scenes (people circling and crossing, paper clutter).
+PEOPLE_FRAMES = 1000
+
+
+def jipda_bench(ds, quick: bool = False) -> dict:
+    """JIPDA against IPDA in the same run: on the single-person data set (CPU time of a pass,
+    best of repeats, ratio) and on scenes of 1, 2, 4 and 8 people circling and crossing in a
+    room for 1 000 frames with the paper's clutter (frames/s). Writes the cost plot to
+    docs/tracking/jipda_cost.png (``bench/results/jipda_cost-quick.png`` when quick)."""
+    from core.evaluation import evaluate
+    from core.tracking import TrackerParams, track_dataset
+    from core.tracking.synthetic import circling_paths, people_dataset
+
+    repeats = 3 if quick else 15
+    single: dict = {}
+    for model in ("cv", "ca"):
+        row = {}
+        for assoc in ("ipda", "jipda"):
+            p = replace(TrackerParams.default(model), association=assoc)
+            est = track_dataset(ds, p)
+            _, cpu = _best_of(lambda p=p: track_dataset(ds, p), repeats)
+            row[f"{assoc}_cpu_ms_per_pass"] = 1e3 * cpu
+            row[f"{assoc}_loss_total_x1e3"] = 1e3 * evaluate(ds, est).loss_total
+        row["cpu_ratio_jipda_to_ipda"] = row["jipda_cpu_ms_per_pass"] / row["ipda_cpu_ms_per_pass"]
+        single[model] = row
+    n_frames = 200 if quick else PEOPLE_FRAMES
+    people: dict = {}
+    for n in PEOPLE:
+        pos, vel = circling_paths(n, n_frames)
+        scene_ds = people_dataset(pos, vel, seed=n)
+        row = {"points_per_frame": len(scene_ds.frame) / n_frames}
+        for assoc in ("ipda", "jipda"):
+            p = replace(TrackerParams.default("cv"), association=assoc)
+            est = track_dataset(scene_ds, p)
+            _, cpu = _best_of(lambda p=p, d=scene_ds: track_dataset(d, p), repeats)
+            row[f"{assoc}_frames_per_s"] = n_frames / cpu
+            row[f"{assoc}_us_per_frame"] = 1e6 * cpu / n_frames
+            row[f"{assoc}_mean_confirmed"] = float(est.n_confirmed.mean())
+        people[str(n)] = row
+    out = {
+        "single_person": single,
+        "people_scene": f"core.tracking.synthetic.circling_paths, {n_frames} frames, "
+        "2.1 clutter points a frame (PAPER_LIKE), CV defaults, CPU time best of repeats",
+        "people_frames": n_frames,
+        "people": people,
+    }
+    out["plot"] = str(_plot_people_cost(out, quick))
+    return out
+
+
+def _plot_people_cost(result: dict, quick: bool):
+    from pathlib import Path
+
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    path = Path("bench/results/jipda_cost-quick.png" if quick else "docs/tracking/jipda_cost.png")
+    path.parent.mkdir(parents=True, exist_ok=True)
+    ns = [int(n) for n in result["people"]]
+    fig, ax = plt.subplots(figsize=(6, 4))
+    for assoc, mk in (("ipda", "o-"), ("jipda", "s-")):
+        ys = [result["people"][str(n)][f"{assoc}_us_per_frame"] for n in ns]
+        ax.plot(ns, ys, mk, label=assoc.upper())
+    ax.axhline(50.0, color="r", ls=":", label="20 000 frames/s")
+    ax.set_xscale("log", base=2)
+    ax.set_xticks(ns, [str(n) for n in ns])
+    ax.set_xlabel("people in the scene (circling and crossing, paper clutter)")
+    ax.set_ylabel("CPU time per frame (µs), compiled kernel")
+    ax.set_title(f"tracker cost against the number of people ({result['people_frames']} frames)")
+    ax.grid(alpha=0.3)
+    ax.legend()
+    fig.tight_layout()
+    tmp = path.with_name(path.stem + ".tmp.png")
+    fig.savefig(tmp, dpi=110)
+    plt.close(fig)
+    tmp.replace(path)
+    return path
 
 
 def summary(result: dict) -> str:
@@ -312,4 +398,22 @@ def summary(result: dict) -> str:
             f"({r['gui_reference_cpu_ms']:6.0f}), {r['gui_speedup_cpu']:4.0f}x (CPU), "
             f"every track same: {r['gui_same_every_track']}"
         )
+    j = result.get("jipda")
+    if j:
+        lines.append("JIPDA against IPDA, same run (CPU ms a pass, loss x1e3):")
+        for model, r in j["single_person"].items():
+            lines.append(
+                f"{model:>5} IPDA {r['ipda_cpu_ms_per_pass']:6.2f} ms  JIPDA "
+                f"{r['jipda_cpu_ms_per_pass']:6.2f} ms  ratio {r['cpu_ratio_jipda_to_ipda']:4.2f}"
+                f"  loss {r['ipda_loss_total_x1e3']:.4f} / {r['jipda_loss_total_x1e3']:.4f}"
+            )
+        lines.append(f"people scenes ({j['people_scene']}):")
+        for n, r in j["people"].items():
+            lines.append(
+                f"{n:>5} people {r['points_per_frame']:5.1f} points/frame: IPDA "
+                f"{r['ipda_frames_per_s']:8.0f} frames/s, JIPDA {r['jipda_frames_per_s']:8.0f} "
+                f"frames/s ({r['jipda_us_per_frame']:6.1f} µs/frame), confirmed tracks "
+                f"{r['jipda_mean_confirmed']:.2f}"
+            )
+        lines.append(f"plot: {j['plot']}")
     return "\n".join(lines)

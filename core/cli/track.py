@@ -1,5 +1,5 @@
-"""``radartune track``: run the IPDA tracker on a data set and print the paper's loss table, GOSPA,
-the people-count error, identity switches and the metrics of every person."""
+"""``radartune track``: run the (J)IPDA tracker on a data set and print the paper's loss table,
+GOSPA, the people-count error, identity switches and the metrics of every person."""
 
 from __future__ import annotations
 
@@ -22,11 +22,18 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--engine", choices=("numba", "numpy"), default="numba", help="default: %(default)s"
     )
+    p.add_argument(
+        "--association",
+        choices=("ipda", "jipda"),
+        help="data association: joint IPDA over tracks sharing measurements, or independent "
+        "IPDA per track (default: the parameters' 'association', jipda)",
+    )
     p.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
     import time
+    from dataclasses import replace
     from pathlib import Path
 
     import numpy as np
@@ -47,6 +54,8 @@ def run(args: argparse.Namespace) -> int:
         if args.params
         else TrackerParams.default(args.model or "cv")
     )
+    if args.association:
+        params = replace(params, association=args.association)
     ds = Dataset.load(args.data)
     traj = None
     if args.trajectories:
@@ -90,7 +99,8 @@ def run(args: argparse.Namespace) -> int:
     ev = evaluate(ds, est)
     print(
         f"{args.data}: {len(est.trajectories)} trajectories, {len(est.frame_index)} frames, "
-        f"model {params.model}, tracked in {elapsed * 1e3:.1f} ms "
+        f"model {params.model}, association {params.association}, "
+        f"tracked in {elapsed * 1e3:.1f} ms "
         f"({elapsed / max(len(est.frame_index), 1) * 1e6:.1f} µs a frame; loading the compiled "
         f"tracker took {startup * 1e3:.0f} ms before)"
     )

@@ -7,6 +7,8 @@
 - :mod:`~core.tracking.ekf` — h(x), analytic Jacobian, prediction, Joseph form
 - :mod:`~core.tracking.gating` — S, Cholesky, Mahalanobis gate, gate volume
 - :mod:`~core.tracking.ipda` — existence, likelihood ratios, δ, ψ, β, PDA update
+- :mod:`~core.tracking.jipda` — joint IPDA: clusters of tracks sharing measurements, joint
+  events, marginal association probabilities and existence
 - :mod:`~core.tracking.initiation`, :mod:`~core.tracking.management` — birth, confirmation,
   deletion, merging, cap, estimate
 - :mod:`~core.tracking.inputs` — measurement frames validated once, derived constants

@@ -88,7 +88,7 @@ class TrackerConstants:
 
     ``F`` (d, d) transition, ``Q`` (d, d) process noise, ``R`` (3, 3) measurement noise, ``P0``
     (d, d) initial covariance, ``gamma`` the 3-D gate threshold, ``gamma2`` the 2-D merge
-    threshold, ``pdpg`` = P_D·P_G.
+    threshold (also of the JIPDA tracker's velocity test), ``pdpg`` = P_D·P_G.
     """
 
     F: np.ndarray

@@ -25,6 +25,7 @@ import functools
 import numpy as np
 
 from core.tracking.inputs import Frames, TrackerConstants, packed_frames
+from core.tracking.jipda import MAX_JOINT_EVENTS
 from core.tracking.kernel_jit import KernelConstants, KernelFrames, KernelOutputs, track_kernel
 from core.tracking.params import TrackerParams
 from core.tracking.results import FrameTracks, TrackerResult, TrackRecord
@@ -63,6 +64,8 @@ def kernel_constants(params: TrackerParams, frame_period_s: float) -> KernelCons
         confirm_threshold=float(params.confirm_threshold),
         delete_threshold=float(params.delete_threshold),
         max_tracks=int(params.max_tracks),
+        joint=params.association == "jipda",
+        max_joint_events=float(MAX_JOINT_EVENTS),
     )
 
 

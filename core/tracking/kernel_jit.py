@@ -1,7 +1,11 @@
 """The IPDA tracker's compiled kernel: every ``@njit`` function of the tracker, in one file.
 
 :func:`track_kernel` tracks every selected trajectory of a data set in one call, with the
-helpers it calls (prediction, PDA update, Cholesky solves, gating, track health, compaction).
+helpers it calls (prediction, PDA update, Cholesky solves, gating, track health, compaction, the
+JIPDA clusters and joint-event enumeration). Per frame it predicts and gates every track first
+(pass 1, kept per track), then associates and updates (pass 2): each track alone (IPDA), or with
+``joint`` the clusters of tracks sharing a validated measurement jointly (JIPDA,
+:mod:`core.tracking.jipda`; a cluster of one, or one above ``max_joint_events``, takes IPDA).
 Its arguments are four groups of arrays, :class:`KernelFrames`, :class:`KernelConstants`,
 :class:`KernelOutputs` and :class:`~core.tracking.results.TrackRecord`; the Python side that
 fills them and calls it is :mod:`core.tracking.kernel`.
@@ -24,6 +28,7 @@ from numba import njit
 from core import jit_guard  # noqa: F401  (before any kernel compiles: see core/jit_guard.py)
 from core.tracking.ekf import MIN_RANGE_M
 from core.tracking.ipda import LOG_2PI
+from core.tracking.management import VELOCITY_MERGE_D2
 from core.tracking.results import TrackRecord
 
 __all__ = ["KernelConstants", "KernelFrames", "KernelOutputs", "track_kernel"]
@@ -314,6 +319,89 @@ def _rank(nt, psi, ids, order):
 
 
 @njit(cache=True)
+def _find(lab, a):
+    """Root of track a in the union–find forest ``lab`` (the smallest index of its cluster)."""
+    while lab[a] != a:
+        a = lab[a]
+    return a
+
+
+@njit(cache=True)
+def _union(lab, a, b):
+    """Join the clusters of tracks a and b; the smaller root becomes the root."""
+    ra = _find(lab, a)
+    rb = _find(lab, b)
+    if ra < rb:
+        lab[rb] = ra
+    elif rb < ra:
+        lab[ra] = rb
+
+
+@njit(cache=True)
+def _joint_cluster(members, nk, MV, AW, IDX, PSP, pdpg, used, opt, LW0, LPS, MG, MG0):
+    """JIPDA marginals of the cluster's tracks ``members[:nk]`` into MG0[q] = β'_τ0 and
+    MG[q, i] = β'_τi (normalised), enumerating every joint event depth first, twice: first the
+    largest log p(ε), then the sums of p(ε)/max p. ``AW[τ, i]`` = log(P_D P_G Λ_τi)."""
+    for q in range(nk):
+        t = members[q]
+        pq = PSP[t]
+        # log w_τ0 = log(1 − P_D P_G ψ⁻_τ); log w_τi = log ψ⁻_τ + log(P_D P_G Λ_τi)
+        LW0[q] = math.log1p(-pdpg * pq)
+        LPS[q] = math.log(pq) if pq > 0.0 else -math.inf
+        MG0[q] = 0.0
+        for j in range(MV[t]):
+            MG[q, j] = 0.0
+    for j in range(used.shape[0]):
+        used[j] = False
+    top = -math.inf
+    total = 0.0
+    for sweep in range(2):
+        lvl = 0
+        opt[0] = -1
+        while lvl >= 0:
+            t = members[lvl]
+            k = opt[lvl]
+            if k >= 1:
+                used[IDX[t, k - 1]] = False
+            k += 1
+            while k >= 1 and k <= MV[t] and used[IDX[t, k - 1]]:
+                k += 1
+            if k > MV[t]:
+                opt[lvl] = -1
+                lvl -= 1
+                continue
+            opt[lvl] = k
+            if k >= 1:
+                used[IDX[t, k - 1]] = True
+            if lvl < nk - 1:
+                lvl += 1
+                opt[lvl] = -1
+                continue
+            # one joint event: log p(ε) = Σ_τ log w_τ,ε(τ)
+            lp = 0.0
+            for q in range(nk):
+                if opt[q] == 0:
+                    lp += LW0[q]
+                else:
+                    lp += LPS[q] + AW[members[q], opt[q] - 1]
+            if sweep == 0:
+                if lp > top:
+                    top = lp
+            else:
+                pe = math.exp(lp - top)
+                total += pe
+                for q in range(nk):
+                    if opt[q] == 0:
+                        MG0[q] += pe
+                    else:
+                        MG[q, opt[q] - 1] += pe
+    for q in range(nk):
+        MG0[q] /= total
+        for j in range(MV[members[q]]):
+            MG[q, j] /= total
+
+
+@njit(cache=True)
 def track_kernel(frames_, c_, out_, check, record, rec_):
     """Track the frames (:class:`KernelFrames`) with the constants (:class:`KernelConstants`)
     into the outputs (:class:`KernelOutputs`); with ``check`` count unhealthy tracks, with
@@ -333,6 +421,7 @@ def track_kernel(frames_, c_, out_, check, record, rec_):
     p_te, p11, p21 = c.p_te, c.p11, c.p21
     rho_given, nonparam = c.clutter_density, c.nonparametric
     confirm_th, delete_th, max_tracks = c.confirm_threshold, c.delete_threshold, c.max_tracks
+    joint, max_events = c.joint, c.max_joint_events
     est_xy, has, est_psi = out.estimate_xy, out.has_estimate, out.estimate_psi
     est_x, est_P, conf_xy = out.estimate_state, out.estimate_covariance, out.confirmed_xy
     n_conf, n_tr, n_bad = out.n_confirmed, out.n_tracks, out.n_unhealthy
@@ -360,12 +449,29 @@ def track_kernel(frames_, c_, out_, check, record, rec_):
     gc = np.zeros((n_rec, 2))
     gs = np.zeros((n_rec, 2, 2))
     gated_any = np.zeros(max_m + 1, dtype=np.bool_)
-    d2 = np.zeros(max_m + 1)
-    nu = np.zeros((max_m + 1, 3))
-    idx = np.zeros(max_m + 1, dtype=np.int64)
     beta = np.zeros(max_m + 1)
-    xp = np.zeros(n)
-    Pp = np.zeros((n, n))
+    # per track of a frame: prediction, gate and validated measurements (pass 1 → pass 2);
+    # a frame starts with at most max_tracks tracks (the cap ends every frame)
+    XP = np.zeros((max_tracks, n))
+    PPm = np.zeros((max_tracks, n, n))
+    HH = np.zeros((max_tracks, 3, n))
+    HPs = np.zeros((max_tracks, 3, n))
+    LL = np.zeros((max_tracks, 3, 3))
+    PSP = np.zeros(max_tracks)
+    MV = np.zeros(max_tracks, dtype=np.int64)
+    NU = np.zeros((max_tracks, max_m + 1, 3))
+    AW = np.zeros((max_tracks, max_m + 1))
+    IDX = np.zeros((max_tracks, max_m + 1), dtype=np.int64)
+    # clusters and joint events (JIPDA)
+    lab = np.zeros(max_tracks, dtype=np.int64)
+    owner = np.zeros(max_m + 1, dtype=np.int64)
+    members = np.zeros(max_tracks, dtype=np.int64)
+    used = np.zeros(max_m + 1, dtype=np.bool_)
+    opt = np.zeros(max_tracks, dtype=np.int64)
+    LW0 = np.zeros(max_tracks)
+    LPS = np.zeros(max_tracks)
+    MG = np.zeros((max_tracks, max_m + 1))
+    MG0 = np.zeros(max_tracks)
     tmp = np.zeros((n, n))
     A = np.zeros((n, n))
     K = np.zeros((n, 3))
@@ -374,7 +480,6 @@ def track_kernel(frames_, c_, out_, check, record, rec_):
     H = np.zeros((3, n))
     HP = np.zeros((3, n))
     S = np.zeros((3, 3))
-    L = np.zeros((3, 3))
     tmp2 = np.zeros((3, 3))
     zp = np.zeros(3)
     w = np.zeros(3)
@@ -392,16 +497,25 @@ def track_kernel(frames_, c_, out_, check, record, rec_):
             for j in range(m):
                 gated_any[j] = False
             n_old = nt
+            # pass 1: predict and gate every track; keep its prediction and its validated
+            # measurements (innovations, a = log(P_D P_G Λ), frame indices)
             for t in range(n_old):
+                xp = XP[t]
+                Pp = PPm[t]
+                Ht = HH[t]
+                HPt = HPs[t]
+                L = LL[t]
                 _predict(X[t], P[t], F, f_cols, f_nnz, Q, xp, Pp, tmp)
                 # ψ⁻ = p11 ψ + p21 (1 − ψ)
                 pp = p11 * psi[t] + p21 * (1.0 - psi[t])
                 pp = min(1.0, max(0.0, pp))
-                _measure(xp, zp, H)
-                _innov_cov(H, Pp, R, S, HP)
+                PSP[t] = pp
+                _measure(xp, zp, Ht)
+                _innov_cov(Ht, Pp, R, S, HPt)
                 if record:
                     _gate_xy(xp, S, gamma, gc[t], gs[t])
                 _chol3(S, L)
+                lab[t] = t
                 mval = 0
                 for j in range(m):
                     v[0] = z[za + j, 0] - zp[0]
@@ -410,25 +524,22 @@ def track_kernel(frames_, c_, out_, check, record, rec_):
                     _fwd3(L, v, w)
                     dd = w[0] * w[0] + w[1] * w[1] + w[2] * w[2]
                     if dd <= gamma:
+                        if joint and gated_any[j]:
+                            # union with the cluster of the measurement's first track
+                            _union(lab, owner[j], t)
+                        elif joint:
+                            owner[j] = t
                         gated_any[j] = True
-                        nu[mval, 0] = v[0]
-                        nu[mval, 1] = v[1]
-                        nu[mval, 2] = v[2]
-                        d2[mval] = dd
-                        idx[mval] = j
+                        NU[t, mval, 0] = v[0]
+                        NU[t, mval, 1] = v[1]
+                        NU[t, mval, 2] = v[2]
+                        AW[t, mval] = dd
+                        IDX[t, mval] = j
                         mval += 1
-                logdet = 2.0 * (math.log(L[0, 0]) + math.log(L[1, 1]) + math.log(L[2, 2]))
+                MV[t] = mval
                 if mval == 0:
-                    # ψ = (1 − P_D P_G) ψ⁻ / (1 − P_D P_G ψ⁻); state unchanged
-                    if pp <= 0.0:
-                        psi[t] = 0.0
-                    elif pp >= 1.0:
-                        psi[t] = 1.0
-                    else:
-                        psi[t] = (1.0 - pdpg) * pp / (1.0 - pdpg * pp)
-                    X[t, :] = xp
-                    P[t, :, :] = Pp
                     continue
+                logdet = 2.0 * (math.log(L[0, 0]) + math.log(L[1, 1]) + math.log(L[2, 2]))
                 if nonparam:
                     m_hat = mval - pdpg * pp
                     if m_hat <= 0.0:
@@ -440,30 +551,105 @@ def track_kernel(frames_, c_, out_, check, record, rec_):
                 # log Λᵢ = −½dᵢ² − ½ log det S − (3/2) log 2π − log(P_G ρ)
                 # aᵢ = log(P_D P_G) + log Λᵢ
                 c0 = -0.5 * logdet - 1.5 * LOG_2PI - (log_pg + math.log(rho)) + log_pdpg
-                top = a0
                 for j in range(mval):
-                    beta[j] = -0.5 * d2[j] + c0
-                    if beta[j] > top:
-                        top = beta[j]
-                ssum = math.exp(a0 - top)
-                for j in range(mval):
-                    ssum += math.exp(beta[j] - top)
-                lse = top + math.log(ssum)
-                b0 = math.exp(a0 - lse)
-                for j in range(mval):
-                    beta[j] = math.exp(beta[j] - lse)
-                omd = math.exp(lse)  # 1 − δ
-                if pp <= 0.0:
-                    psi[t] = 0.0
-                elif pp >= 1.0:
-                    psi[t] = 1.0
-                else:
-                    # ψ = (1 − δ) ψ⁻ / ((1 − ψ⁻) + (1 − δ) ψ⁻)
-                    ps = omd * pp / ((1.0 - pp) + omd * pp)
-                    psi[t] = min(1.0, max(0.0, ps))
-                _pda_update(
-                    X[t], P[t], xp, Pp, H, HP, R, L, nu, beta, b0, mval, K, A, C3, KT, tmp2, w, v
-                )
+                    AW[t, j] = -0.5 * AW[t, j] + c0
+            # pass 2: association and update, per track (IPDA) or per cluster (JIPDA)
+            for t in range(n_old):
+                lab[t] = _find(lab, t)
+            for r0 in range(n_old):
+                if lab[r0] != r0:
+                    continue
+                nk = 0
+                bound = 1.0
+                for t in range(r0, n_old):
+                    if lab[t] == r0:
+                        members[nk] = t
+                        nk += 1
+                        bound *= 1.0 + MV[t]
+                if nk > 1 and bound <= max_events:
+                    _joint_cluster(
+                        members, nk, MV, AW, IDX, PSP, pdpg, used, opt, LW0, LPS, MG, MG0
+                    )
+                for q in range(nk):
+                    t = members[q]
+                    mval = MV[t]
+                    pp = PSP[t]
+                    if mval == 0 and nk == 1 or mval == 0 and bound > max_events:
+                        # ψ = (1 − P_D P_G) ψ⁻ / (1 − P_D P_G ψ⁻); state unchanged
+                        if pp <= 0.0:
+                            psi[t] = 0.0
+                        elif pp >= 1.0:
+                            psi[t] = 1.0
+                        else:
+                            psi[t] = (1.0 - pdpg) * pp / (1.0 - pdpg * pp)
+                        X[t, :] = XP[t]
+                        P[t, :, :] = PPm[t]
+                        continue
+                    if nk == 1 or bound > max_events:
+                        # IPDA: 1 − δ = e^{a₀} + Σ e^{aᵢ} by log-sum-exp
+                        top = a0
+                        for j in range(mval):
+                            if AW[t, j] > top:
+                                top = AW[t, j]
+                        ssum = math.exp(a0 - top)
+                        for j in range(mval):
+                            ssum += math.exp(AW[t, j] - top)
+                        lse = top + math.log(ssum)
+                        b0 = math.exp(a0 - lse)
+                        for j in range(mval):
+                            beta[j] = math.exp(AW[t, j] - lse)
+                        omd = math.exp(lse)  # 1 − δ
+                        if pp <= 0.0:
+                            psi[t] = 0.0
+                        elif pp >= 1.0:
+                            psi[t] = 1.0
+                        else:
+                            # ψ = (1 − δ) ψ⁻ / ((1 − ψ⁻) + (1 − δ) ψ⁻)
+                            ps = omd * pp / ((1.0 - pp) + omd * pp)
+                            psi[t] = min(1.0, max(0.0, ps))
+                    else:
+                        # JIPDA: ψ_τ = Σ_i β'_τi + β'_τ0 q_τ
+                        # q_τ = (1 − P_D P_G) ψ⁻ / (1 − P_D P_G ψ⁻)
+                        qq = (1.0 - pdpg) * pp / (1.0 - pdpg * pp)
+                        ps = MG0[q] * qq
+                        for j in range(mval):
+                            ps += MG[q, j]
+                        if ps > 0.0:
+                            psi[t] = min(1.0, ps)
+                            # β_τ0 = β'_τ0 q_τ / ψ_τ, β_τi = β'_τi / ψ_τ
+                            b0 = MG0[q] * qq / ps
+                            for j in range(mval):
+                                beta[j] = MG[q, j] / ps
+                        else:
+                            psi[t] = 0.0
+                            b0 = 1.0
+                            for j in range(mval):
+                                beta[j] = 0.0
+                        if mval == 0:
+                            X[t, :] = XP[t]
+                            P[t, :, :] = PPm[t]
+                            continue
+                    _pda_update(
+                        X[t],
+                        P[t],
+                        XP[t],
+                        PPm[t],
+                        HH[t],
+                        HPs[t],
+                        R,
+                        LL[t],
+                        NU[t],
+                        beta,
+                        b0,
+                        mval,
+                        K,
+                        A,
+                        C3,
+                        KT,
+                        tmp2,
+                        w,
+                        v,
+                    )
             # initiation: measurements outside every gate start tentative tracks
             for j in range(m):
                 if not gated_any[j]:
@@ -519,8 +705,21 @@ def track_kernel(frames_, c_, out_, check, record, rec_):
                         dd = (c11 * dx * dx - 2.0 * c01 * dx * dy + c00 * dy * dy) / (
                             c00 * c11 - c01 * c01
                         )
-                        if dd <= gamma2:
-                            keep[b] = False
+                        if dd > gamma2:
+                            continue
+                        if joint and conf[a] and conf[b]:
+                            # confirmed pairs (JIPDA): also Δvᵀ (P_v,a + P_v,b)⁻¹ Δv ≤ 2 ln 10
+                            dx = X[a, 2] - X[b, 2]
+                            dy = X[a, 3] - X[b, 3]
+                            c00 = P[a, 2, 2] + P[b, 2, 2]
+                            c01 = P[a, 2, 3] + P[b, 2, 3]
+                            c11 = P[a, 3, 3] + P[b, 3, 3]
+                            dd = (c11 * dx * dx - 2.0 * c01 * dx * dy + c00 * dy * dy) / (
+                                c00 * c11 - c01 * c01
+                            )
+                            if dd > VELOCITY_MERGE_D2:
+                                continue
+                        keep[b] = False
                 if record:
                     _compact_rec(keep, nt, birth, gc, gs)
                 nt = _compact(keep, nt, X, P, psi, conf, ids)
@@ -603,6 +802,8 @@ class KernelConstants(NamedTuple):
     confirm_threshold: float
     delete_threshold: float
     max_tracks: int
+    joint: bool  # JIPDA over clusters of tracks sharing measurements (else IPDA per track)
+    max_joint_events: float  # clusters with a larger event bound Π(1 + m_τ) take IPDA
 
 
 class KernelOutputs(NamedTuple):

@@ -5,9 +5,23 @@ Tracks are ordered by age (birth order = id order). Ties in ψ always favour the
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
-__all__ = ["confirm", "survivors", "merge", "cap", "best_confirmed", "position_gate_distance2"]
+#: Threshold on Δvᵀ (P_v,a + P_v,b)⁻¹ Δv for merging two confirmed tracks (JIPDA tracker):
+#: χ²₂⁻¹(0.9) = 2 ln 10, the velocities agree within their 90 % uncertainty ellipse.
+VELOCITY_MERGE_D2 = 2.0 * math.log(10.0)
+
+__all__ = [
+    "VELOCITY_MERGE_D2",
+    "confirm",
+    "survivors",
+    "merge",
+    "cap",
+    "best_confirmed",
+    "position_gate_distance2",
+]
 
 
 def confirm(
@@ -26,7 +40,8 @@ def survivors(psi: np.ndarray, threshold: float) -> np.ndarray:
 def position_gate_distance2(
     pos_a: np.ndarray, cov_a: np.ndarray, pos_b: np.ndarray, cov_b: np.ndarray
 ) -> float:
-    """Squared distance of two positions (2,) with the combined position covariance (2, 2)."""
+    """Squared distance of two positions (or velocities) (2,) with the combined covariance
+    (2, 2)."""
     d = pos_a - pos_b
     C = cov_a + cov_b
     L = np.linalg.cholesky(C)
@@ -41,12 +56,27 @@ def _rank(psi: np.ndarray, ids: np.ndarray) -> np.ndarray:
 
 
 def merge(
-    pos: np.ndarray, pos_cov: np.ndarray, psi: np.ndarray, ids: np.ndarray, gamma2: float
+    pos: np.ndarray,
+    pos_cov: np.ndarray,
+    psi: np.ndarray,
+    ids: np.ndarray,
+    gamma2: float,
+    *,
+    confirmed: np.ndarray | None = None,
+    state: np.ndarray | None = None,
+    state_cov: np.ndarray | None = None,
 ) -> np.ndarray:
     """Merge tracks whose positions lie within each other's 2-D gate; keep the higher ψ.
 
     Greedy in ψ order: each kept track removes every lower-ranked track with
     ``Δpᵀ (P_a + P_b)⁻¹ Δp ≤ γ₂`` (γ₂ = χ²₂⁻¹(P_G)). pos (n, 2), pos_cov (n, 2, 2) → keep (n,).
+
+    With ``confirmed`` (n,) bool, ``state`` (n, d) and ``state_cov`` (n, d, d) (the JIPDA
+    tracker), two *confirmed* tracks are merged only when their velocities also agree:
+    ``Δvᵀ (P_v,a + P_v,b)⁻¹ Δv ≤`` :data:`VELOCITY_MERGE_D2` (velocity blocks of the
+    covariances), so two people crossing at an angle keep their tracks while two tracks
+    coalesced on one person (same velocity) still merge; a tentative track is merged on position
+    alone.
     """
     n = len(psi)
     keep = np.ones(n, dtype=bool)
@@ -55,10 +85,17 @@ def merge(
         if not keep[a]:
             continue
         for b in order[a_rank + 1 :]:
-            if keep[b] and position_gate_distance2(pos[a], pos_cov[a], pos[b], pos_cov[b]) <= (
-                gamma2
-            ):
-                keep[b] = False
+            if not keep[b]:
+                continue
+            if position_gate_distance2(pos[a], pos_cov[a], pos[b], pos_cov[b]) > gamma2:
+                continue
+            if confirmed is not None and confirmed[a] and confirmed[b]:
+                assert state is not None and state_cov is not None
+                v_a, v_b = state[a][2:4], state[b][2:4]
+                c_a, c_b = state_cov[a][2:4, 2:4], state_cov[b][2:4, 2:4]
+                if position_gate_distance2(v_a, c_a, v_b, c_b) > VELOCITY_MERGE_D2:
+                    continue
+            keep[b] = False
     return keep
 
 

@@ -14,6 +14,7 @@ from pathlib import Path
 from core.errors import InputError
 from core.files import read_json, write_json_atomic
 from core.limits import CLUTTER_DENSITY_RANGE, MAX_TRACKS, VARIANCE_RANGE
+from core.tracking.jipda import ASSOCIATIONS
 from core.tracking.space import MODELS, P0_NAMES, STATE_DIM, defaults, p0_names, parameter
 
 NONPARAMETRIC = "nonparametric"
@@ -55,6 +56,9 @@ class TrackerParams:
         (ρ̂ = m̂ / V estimated per track and frame).
     max_tracks
         Track cap; beyond it the tracks with the lowest ψ are removed.
+    association
+        ``"jipda"`` (joint IPDA over tracks whose gates share measurements, the default) or
+        ``"ipda"`` (independent IPDA per track); not optimised (docs/decisions/tracker-06).
     """
 
     model: str = "cv"
@@ -73,6 +77,7 @@ class TrackerParams:
     delete_threshold: float = 0.1
     clutter_density: float | str = 0.0073
     max_tracks: int = 20
+    association: str = "jipda"
 
     def __post_init__(self) -> None:
         if self.model not in MODELS:
@@ -133,6 +138,10 @@ class TrackerParams:
             raise InputError(
                 f"clutter_density must be in [{CLUTTER_DENSITY_RANGE[0]:g}, "
                 f"{CLUTTER_DENSITY_RANGE[1]:g}], got clutter_density={rho!r}"
+            )
+        if self.association not in ASSOCIATIONS:
+            raise InputError(
+                f"association must be one of {ASSOCIATIONS}, got association={self.association!r}"
             )
         if isinstance(self.max_tracks, bool) or not isinstance(self.max_tracks, int):
             raise InputError(f"max_tracks must be an integer, got max_tracks={self.max_tracks!r}")

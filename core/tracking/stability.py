@@ -24,13 +24,20 @@ from core.tracking.batch import dataset_frame_period_s
 from core.tracking.kernel import track_frames
 from core.tracking.params import TrackerParams
 from core.tracking.space import p0_names, search_space
-from core.tracking.synthetic import PAPER_LIKE, synthetic_dataset
+from core.tracking.synthetic import (
+    PAPER_LIKE,
+    circling_paths,
+    crossing_paths,
+    people_dataset,
+    synthetic_dataset,
+)
 
 __all__ = [
     "corner_names",
     "corner_params",
     "all_corners",
     "stability_scene",
+    "multi_person_scenes",
     "CornerReport",
     "sweep",
     "condition_number",
@@ -67,6 +74,19 @@ def stability_scene(n_frames: int = 300, seed: int = 0) -> Dataset:
     pos = centre + radius * np.column_stack((np.cos(phi), np.sin(phi)))
     vel = speed * np.column_stack((-np.sin(phi), np.cos(phi)))
     return synthetic_dataset(seed, paths=[(pos, vel)])
+
+
+def multi_person_scenes(n_frames: int = 300, seed: int = 0) -> dict[str, Dataset]:
+    """Paper-like scenes of several people whose tracks share measurements: two crossing at
+    90°, three crossing at 60° from each other, four circling a room (they keep crossing)."""
+    two = crossing_paths(2, n_frames, spread_rad=math.pi / 2)
+    three = crossing_paths(3, n_frames)
+    four = circling_paths(4, n_frames)
+    return {
+        "2 people crossing": people_dataset(*two, seed=seed),
+        "3 people crossing": people_dataset(*three, seed=seed + 1),
+        "4 people circling": people_dataset(*four, seed=seed + 2),
+    }
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)

@@ -25,6 +25,9 @@ __all__ = [
     "synthetic_trajectory",
     "synthetic_frames",
     "synthetic_dataset",
+    "crossing_paths",
+    "circling_paths",
+    "people_dataset",
     "PAPER_LIKE",
 ]
 
@@ -188,19 +191,29 @@ def synthetic_frames(
     rng: np.random.Generator,
     scene: SyntheticScene = PAPER_LIKE,
 ) -> list[PointCloud]:
-    """Point clouds of one person walking (F frames): noisy detections plus Poisson clutter."""
+    """Point clouds of people walking (F frames): noisy detections plus Poisson clutter.
+
+    ``truth_xy``, ``truth_v`` are (F, 2) for one person or (F, n, 2) for n people (m, m/s); each
+    person is detected independently with P_D (source = person index), persons in order, then
+    the clutter of the frame.
+    """
+    truth_xy = np.asarray(truth_xy, dtype=np.float64)
+    truth_v = np.asarray(truth_v, dtype=np.float64)
+    if truth_xy.ndim == 2:
+        truth_xy, truth_v = truth_xy[:, None, :], truth_v[:, None, :]
     clouds = []
-    for p, v in zip(truth_xy, truth_v):
+    for people_p, people_v in zip(truth_xy, truth_v):
         rows = []
         src = []
-        if rng.random() < scene.p_d:
-            r = math.hypot(p[0], p[1])
-            az = math.atan2(p[0], p[1])
-            # vr = (x·vx + y·vy)/r
-            vr = (p[0] * v[0] + p[1] * v[1]) / r if r > 0 else 0.0
-            n = rng.normal(0.0, scene.noise_std)
-            rows.append((max(r + n[0], 0.0), az + n[1], vr + n[2]))
-            src.append(0)
+        for i, (p, v) in enumerate(zip(people_p, people_v)):
+            if rng.random() < scene.p_d:
+                r = math.hypot(p[0], p[1])
+                az = math.atan2(p[0], p[1])
+                # vr = (x·vx + y·vy)/r
+                vr = (p[0] * v[0] + p[1] * v[1]) / r if r > 0 else 0.0
+                n = rng.normal(0.0, scene.noise_std)
+                rows.append((max(r + n[0], 0.0), az + n[1], vr + n[2]))
+                src.append(i)
         k = rng.poisson(scene.clutter_per_frame) if scene.clutter_per_frame > 0 else 0
         if k:
             c = np.column_stack(
@@ -227,6 +240,100 @@ def synthetic_frames(
             )
         )
     return clouds
+
+
+def crossing_paths(
+    n_people: int,
+    n_frames: int,
+    scene: SyntheticScene = PAPER_LIKE,
+    *,
+    centre: tuple[float, float] = (0.0, 5.0),
+    speed_mps: float = 1.2,
+    spread_rad: float = math.pi,
+) -> tuple[np.ndarray, np.ndarray]:
+    """n people walking straight lines that all cross at ``centre`` at the middle frame.
+
+    Person i heads at the angle θᵢ = i·spread/n (spread π: evenly spaced directions; two people
+    cross at 90°), starting half a walk before the crossing: pᵢ(t) = c + s·(t − F/2)·Δt·uᵢ.
+
+    Returns
+    -------
+    positions, velocities
+        (F, n, 2) in m and m/s.
+    """
+    dt = scene.frame_period_s
+    theta = np.arange(n_people) * spread_rad / n_people
+    u = np.column_stack((np.cos(theta), np.sin(theta)))  # (n, 2) headings
+    tau = (np.arange(n_frames) - n_frames / 2.0) * dt  # s relative to the crossing
+    # pᵢ(t) = c + s τ uᵢ, vᵢ = s uᵢ
+    pos = np.asarray(centre)[None, None, :] + speed_mps * tau[:, None, None] * u[None, :, :]
+    vel = np.broadcast_to(speed_mps * u[None, :, :], pos.shape).copy()
+    return pos, vel
+
+
+def circling_paths(
+    n_people: int,
+    n_frames: int,
+    scene: SyntheticScene = PAPER_LIKE,
+    *,
+    centre: tuple[float, float] = (0.0, 5.0),
+    speed_mps: float = 1.0,
+) -> tuple[np.ndarray, np.ndarray]:
+    """n people walking circles round one centre, every second one the other way: a room in
+    which they keep crossing.
+
+    Person i walks radius Rᵢ = 1.2 + 0.4·(i mod 3) m, starting at the angle 2πi/n, direction
+    sᵢ = (−1)ⁱ: φᵢ(t) = 2πi/n + sᵢ·(v/Rᵢ)·t, pᵢ(t) = c + Rᵢ[cos φᵢ, sin φᵢ].
+
+    Returns
+    -------
+    positions, velocities
+        (F, n, 2) in m and m/s.
+    """
+    t = np.arange(n_frames) * scene.frame_period_s
+    pos = np.zeros((n_frames, n_people, 2))
+    vel = np.zeros((n_frames, n_people, 2))
+    for i in range(n_people):
+        radius = 1.2 + 0.4 * (i % 3)
+        omega = (-1.0) ** i * speed_mps / radius
+        phi = 2.0 * math.pi * i / n_people + omega * t
+        pos[:, i] = np.asarray(centre) + radius * np.column_stack((np.cos(phi), np.sin(phi)))
+        # v = R ω [−sin φ, cos φ]
+        vel[:, i] = radius * omega * np.column_stack((-np.sin(phi), np.cos(phi)))
+    return pos, vel
+
+
+def people_dataset(
+    positions: np.ndarray,
+    velocities: np.ndarray,
+    seed: int = 0,
+    scene: SyntheticScene = PAPER_LIKE,
+) -> Dataset:
+    """A one-trajectory :class:`Dataset` of several people, (F, n, 2) truth each (m, m/s)."""
+    rng = np.random.default_rng(seed)
+    positions = np.asarray(positions, dtype=np.float64)
+    n_f = len(positions)
+    return Dataset.from_frames(
+        clouds=synthetic_frames(positions, velocities, rng, scene),
+        trajectory=np.zeros(n_f, dtype=np.int64),
+        truth_t_s=np.arange(n_f) * scene.frame_period_s,
+        truth_xy_m=positions,
+        truth_v_mps=np.asarray(velocities, dtype=np.float64),
+        trajectory_class=["drawn"],
+        scene_json=json.dumps(
+            {
+                "synthetic": True,
+                "seed": seed,
+                "persons": int(positions.shape[1]),
+                "clutter_per_frame": scene.clutter_per_frame,
+                "p_d": scene.p_d,
+                "noise_std": list(scene.noise_std),
+            }
+        ),
+        radar_json=json.dumps({"frame_period_s": scene.frame_period_s}),
+        fidelity="synthetic",
+        seed=seed,
+    )
 
 
 def synthetic_dataset(

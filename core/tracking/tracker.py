@@ -1,7 +1,9 @@
 """The IPDA multi-track tracker (SPEC §4), readable reference: it composes the role modules.
 
-Per frame: predict every track (motion model, existence eq. 9) → gate the measurements → IPDA
-update of every track with its validated measurements → initiate tentative tracks from the
+Per frame: predict every track (motion model, existence eq. 9) → gate the measurements →
+association and update: IPDA per track, or with ``association="jipda"`` joint IPDA over the
+clusters of tracks that share validated measurements (:mod:`core.tracking.jipda`; a lone track
+gets the IPDA update) → initiate tentative tracks from the
 measurements outside all gates → confirm → delete → merge → cap → single-person estimate.
 
 This path is plain numpy (one track at a time) and serves the GUI (every track per frame) and the
@@ -11,12 +13,13 @@ tests; :mod:`core.tracking.kernel` runs the same algorithm compiled for Optuna. 
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from core.errors import InputError
-from core.tracking import ekf, gating, initiation, ipda, management
+from core.tracking import ekf, gating, initiation, ipda, jipda, management
 from core.tracking.inputs import Frames, TrackerConstants, frame_slices
 from core.tracking.params import TrackerParams
 from core.tracking.results import FrameTracks, TrackerResult
@@ -46,6 +49,25 @@ def _gate_xy(x: np.ndarray, S: np.ndarray, gamma: float) -> tuple[np.ndarray, np
     return np.array([px, py]), gamma * (J @ S[:2, :2] @ J.T)
 
 
+@dataclass(slots=True)
+class _Gated:  # one track's prediction and validated measurements in one frame
+    x_pred: np.ndarray
+    P_pred: np.ndarray
+    H: np.ndarray
+    L: np.ndarray
+    psi_pred: float
+    nu: np.ndarray  # (m_τ, 3) innovations of the validated measurements
+    log_lr: np.ndarray  # (m_τ,) log Λ_τi
+    idx: np.ndarray  # (m_τ,) their indices in the frame
+
+
+def _ipda_update(t: _Track, g: _Gated, c: TrackerConstants) -> None:
+    """The independent IPDA update of one track (existence, then the PDA state update)."""
+    assoc = ipda.associate(g.log_lr, c.pdpg)
+    t.psi = ipda.update_existence(g.psi_pred, assoc, c.pdpg, len(g.nu))
+    t.x, t.P = ipda.pda_update(g.x_pred, g.P_pred, g.H, c.R, g.L, g.nu, assoc)
+
+
 def _step(
     tracks: list[_Track],
     z: np.ndarray,
@@ -56,6 +78,7 @@ def _step(
 ) -> tuple[list[_Track], int]:
     m = len(z)
     gated = np.zeros((len(tracks), m), dtype=bool)
+    gates: list[_Gated] = []
     for k, t in enumerate(tracks):
         # prediction: state, covariance, existence (eq. 9)
         x_pred, P_pred = ekf.predict(t.x, t.P, c.F, c.Q)
@@ -82,11 +105,35 @@ def _step(
         else:
             rho = float(params.clutter_density)
         log_lr = ipda.log_likelihood_ratios(d2, log_det_S, params.p_g, rho)
-        assoc = ipda.associate(log_lr, c.pdpg)
-        t.psi = ipda.update_existence(psi_pred, assoc, c.pdpg, n_val)
-        t.x, t.P = ipda.pda_update(x_pred, P_pred, H, c.R, L, nu, assoc)
+        gates.append(_Gated(x_pred, P_pred, H, L, psi_pred, nu, log_lr, np.flatnonzero(inside)))
         t.updated = True
         t.gate_center, t.gate_shape = _gate_xy(x_pred, S, c.gamma)
+    # association: each track alone (IPDA), or jointly within clusters of shared measurements
+    if params.association == "jipda" and len(tracks) > 1:
+        label = jipda.clusters(gated)
+    else:
+        label = np.arange(len(tracks))
+    for root in np.unique(label):
+        members = np.flatnonzero(label == root)
+        bound = jipda.event_bound(np.array([len(gates[k].nu) for k in members]))
+        if len(members) == 1 or bound > jipda.MAX_JOINT_EVENTS:
+            for k in members:
+                _ipda_update(tracks[k], gates[k], c)
+            continue
+        g = [gates[k] for k in members]
+        ja = jipda.joint_associate(
+            np.array([gk.psi_pred for gk in g]),
+            [gk.log_lr for gk in g],
+            [gk.idx for gk in g],
+            c.pdpg,
+        )
+        for i, k in enumerate(members):
+            gk, t = gates[k], tracks[k]
+            t.psi = float(ja.psi[i])
+            assoc = ipda.Association(
+                delta=math.nan, one_minus_delta=math.nan, beta0=float(ja.beta0[i]), beta=ja.beta[i]
+            )
+            t.x, t.P = ipda.pda_update(gk.x_pred, gk.P_pred, gk.H, c.R, gk.L, gk.nu, assoc)
     # initiation from the measurements outside every gate
     for j in np.flatnonzero(initiation.unassociated(gated)):
         x0 = initiation.initial_state(z[j], params.state_dim)
@@ -114,7 +161,19 @@ def _step(
         ids = np.array([t.id for t in tracks])
         pos = np.array([t.x[:2] for t in tracks])
         pos_cov = np.array([t.P[:2, :2] for t in tracks])
-        keep = management.merge(pos, pos_cov, psi, ids, c.gamma2)
+        if params.association == "jipda":
+            keep = management.merge(
+                pos,
+                pos_cov,
+                psi,
+                ids,
+                c.gamma2,
+                confirmed=np.array([t.confirmed for t in tracks]),
+                state=np.array([t.x for t in tracks]),
+                state_cov=np.array([t.P for t in tracks]),
+            )
+        else:
+            keep = management.merge(pos, pos_cov, psi, ids, c.gamma2)
         tracks = [t for t, k in zip(tracks, keep) if k]
     if len(tracks) > params.max_tracks:
         psi = np.array([t.psi for t in tracks])

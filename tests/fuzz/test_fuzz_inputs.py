@@ -395,6 +395,7 @@ PARAM_KEYS = [
     "delete_threshold",
     "clutter_density",
     "max_tracks",
+    "association",
     "p0_00",
     "p0_11",
     "p0_22",
@@ -409,7 +410,9 @@ PARAM_KEYS = [
 @given(
     doc=st.dictionaries(
         st.sampled_from(PARAM_KEYS),
-        st.one_of(numbers, st.sampled_from(["cv", "ca", "nonparametric"]), json_values),
+        st.one_of(
+            numbers, st.sampled_from(["cv", "ca", "nonparametric", "ipda", "jipda"]), json_values
+        ),
         max_size=6,
     )
 )

@@ -37,3 +37,24 @@ def test_stability_quick(capsys):
     assert main(["stability", "--quick", "--frames", "100"]) == 0
     out = capsys.readouterr().out
     assert "cv: 256 corners" in out and "stability: OK" in out
+    assert "4 people circling, ca: 128 corners" in out
+
+
+def test_track_association_option(tmp_path, capsys):
+    """--association overrides the parameters' association; the JSON records it; a bad value
+    exits 2."""
+    import pytest
+
+    data = synthetic_dataset(0, 1, classes="ab", n_frames=60).save(tmp_path / "d.npz")
+    for assoc in ("ipda", "jipda"):
+        out = tmp_path / f"{assoc}.json"
+        assert main(["track", "--data", str(data), "--association", assoc, "--out", str(out)]) == 0
+        assert f"association {assoc}" in capsys.readouterr().out
+        assert json.loads(out.read_text())["params"]["association"] == assoc
+    with pytest.raises(SystemExit) as exc:
+        main(["track", "--data", str(data), "--association", "jpda"])
+    assert exc.value.code == 2
+    bad = tmp_path / "bad.json"
+    bad.write_text(json.dumps({"association": "jpda"}))
+    assert main(["track", "--data", str(data), "--params", str(bad)]) == 2
+    assert "association must be one of" in capsys.readouterr().err

@@ -14,6 +14,10 @@ from core.tracking.tracker import run_tracker
 CASES = {
     "cv-default": TrackerParams.default("cv"),
     "ca-default": TrackerParams.default("ca"),
+    "cv-ipda": TrackerParams(association="ipda"),
+    "ca-nonparametric-ipda": TrackerParams(
+        model="ca", clutter_density="nonparametric", association="ipda"
+    ),
     "cv-nonparametric": TrackerParams(clutter_density="nonparametric"),
     "ca-nonparametric-p21": TrackerParams(
         model="ca", p0=(1, 1, 2, 2, 1, 1), p21=0.3, p11=0.9, clutter_density="nonparametric"

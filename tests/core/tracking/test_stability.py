@@ -165,3 +165,14 @@ def test_reference_tracker_on_a_sample_of_corners(model):
             for P in ft.covariance:
                 np.testing.assert_array_equal(P, P.T)
                 np.linalg.cholesky(P)  # raises unless positive definite
+
+
+@pytest.mark.parametrize("model", ["cv", "ca"])
+def test_multi_person_scenes_sample_of_corners(model):
+    """The crossing scenes (JIPDA clusters, joint events): no NaN, no non-PD covariance."""
+    from core.tracking.stability import multi_person_scenes
+
+    for name, ds in multi_person_scenes(150).items():
+        rep = sweep(model, all_corners(model, 24, seed=2), ds)
+        assert rep.ok, (name, rep.failures)
+        assert rep.nonfinite_outputs == 0 and rep.bad_track_frames == 0

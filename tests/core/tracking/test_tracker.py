@@ -61,3 +61,34 @@ def test_non_finite_measurements_are_an_input_error(bad):
 
     with pytest.raises(InputError, match="frame 0"):
         run_tracker(bad, TrackerParams())
+
+
+def test_merge_of_confirmed_tracks_needs_agreeing_velocities():
+    """JIPDA's merge: two confirmed tracks at one position merge only when Δvᵀ(ΣP_v)⁻¹Δv ≤ 2 ln 10;
+    a tentative track merges on position alone."""
+    from core.tracking.management import VELOCITY_MERGE_D2, merge
+
+    pos = np.zeros((2, 2))
+    cov = np.tile(np.eye(4) * 0.05, (2, 1, 1))  # combined velocity variance 0.1 per axis
+    psi, ids = np.array([0.99, 0.95]), np.array([0, 1])
+    dv = np.sqrt(VELOCITY_MERGE_D2 * 0.1)  # on the threshold along x
+    for dvx, confirmed, merged in [
+        (0.0, [True, True], True),
+        (0.99 * dv, [True, True], True),
+        (1.01 * dv, [True, True], False),
+        (5.0, [True, False], True),  # the tentative one goes
+    ]:
+        state = np.array([[0, 0, 1.0, 0], [0, 0, 1.0 + dvx, 0]])
+        keep = merge(
+            pos,
+            cov[:, :2, :2],
+            psi,
+            ids,
+            9.21,
+            confirmed=np.array(confirmed),
+            state=state,
+            state_cov=cov,
+        )
+        assert keep.tolist() == ([True, False] if merged else [True, True])
+    # without the JIPDA arguments: position alone, as the IPDA tracker always did
+    assert merge(pos, cov[:, :2, :2], psi, ids, 9.21).tolist() == [True, False]
