@@ -66,13 +66,14 @@ def test_study_on_two_person_set_gives_finite_losses(two, tmp_path, capsys) -> N
 
     ds = Dataset.load(two)
     losses = TrackerLosses(ds).losses(TrackerParams.default("cv").to_dict(), [0, 1, 2])
-    assert all(math.isfinite(v) and 0 < v <= 1.0 for v, _, _ in losses)
+    assert all(math.isfinite(s.loss) and 0 < s.loss <= 1.0 for s in losses)
+    assert all(math.isfinite(s.capped) and 0 <= s.capped <= 0.5**2 for s in losses)
     # the objective is the multi-person loss: the mean over both persons of eq. (13)
     from core.evaluation import evaluate as evaluate_run
     from core.tracking import track_dataset
 
     ev = evaluate_run(ds, track_dataset(ds, TrackerParams.default("cv"), with_tracks=True))
-    assert [v for v, _, _ in losses] == ev.loss.tolist()
+    assert [s.loss for s in losses] == ev.loss.tolist()
     result = evaluate(TrackerLosses(ds), TrackerParams.default("ca").to_dict())
     assert math.isfinite(result.value) and len(result.losses) == 3
     storage = f"sqlite:///{tmp_path / 's.db'}"
