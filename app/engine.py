@@ -13,6 +13,7 @@ import os
 import socket
 import subprocess
 import sys
+import tempfile
 import time
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
@@ -371,9 +372,11 @@ class StudyProcesses:
 
 
 def storage_url(storage: str) -> str:
-    from core.optimization import normalize_url
+    """The storage's canonical URL with a file path made absolute (relative to this process's
+    working folder), so that a helper process started elsewhere opens the same file."""
+    from core.optimization.storage import absolute_url
 
-    return normalize_url(storage)
+    return absolute_url(storage)
 
 
 def scene_dataset(frames: Sequence[FrameData], scene, path: Path) -> Path:
@@ -475,8 +478,14 @@ class Dashboard:
         )
         cmd = [sys.executable, "-m", "core.cli", "dashboard", "--storage", storage]
         cmd += ["--port", str(self.port), "--no-browser"]
+        # the storage is an absolute URL (serve_dashboard); the process runs in the temporary
+        # folder, never in the install folder, so nothing it may write lands in the checkout
         self._proc = subprocess.Popen(
-            cmd, cwd=str(ROOT), env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL
+            cmd,
+            cwd=tempfile.gettempdir(),
+            env=env,
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.DEVNULL,
         )
 
     def alive(self) -> bool:
