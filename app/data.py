@@ -197,6 +197,8 @@ class StudyProgress:
     #: best-so-far loss against wall-clock seconds since the first trial started
     curve_t_s: np.ndarray = field(default_factory=lambda: np.zeros(0))
     curve_best: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    #: why trials failed: (reason, number of trials), most frequent first
+    failures: tuple[tuple[str, int], ...] = ()
 
     @property
     def n_finished(self) -> int:

@@ -443,6 +443,7 @@ def study_progress(form):
     else:
         t, best_curve = np.zeros(0), np.zeros(0)
     return StudyProgress(
+        failures=failure_reasons(summaries),
         n_complete=states.count("COMPLETE"),
         n_pruned=states.count("PRUNED"),
         n_failed=states.count("FAIL"),
@@ -453,6 +454,17 @@ def study_progress(form):
         curve_t_s=t,
         curve_best=best_curve,
     )
+
+
+def failure_reasons(summaries, n_max: int = 5) -> tuple[tuple[str, int], ...]:
+    """The distinct reasons of the FAIL trials with how many trials each, most frequent first
+    (at most ``n_max``); a trial without a recorded reason counts as "no reason recorded"."""
+    counts: dict[str, int] = {}
+    for s in summaries:
+        if s.state == "FAIL":
+            reason = getattr(s, "error", "") or "no reason recorded (see the workers' log)"
+            counts[reason] = counts.get(reason, 0) + 1
+    return tuple(sorted(counts.items(), key=lambda kv: (-kv[1], kv[0]))[:n_max])
 
 
 def enqueue_trial(form, values: dict[str, float], model: str) -> None:

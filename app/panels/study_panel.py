@@ -78,6 +78,13 @@ class StudyPanel(QtWidgets.QWidget):
         self.counts = QtWidgets.QLabel()
         self.counts.setObjectName("studyCounts")
         outer.addWidget(self.counts)
+        self.failures = QtWidgets.QLabel()
+        self.failures.setObjectName("studyFailures")
+        self.failures.setWordWrap(True)
+        self.failures.setTextInteractionFlags(QtCore.Qt.TextSelectableByMouse)
+        self.failures.setStyleSheet("color: #c0392b;")
+        self.failures.hide()
+        outer.addWidget(self.failures)
 
         self.curve_plot = pg.PlotWidget()
         self.curve_plot.setObjectName("studyCurve")
@@ -157,6 +164,17 @@ class StudyPanel(QtWidgets.QWidget):
         self.stop_button.setEnabled(running)
         self.progress_bar.setMaximum(f.n_trials)
 
+    def show_failures(self, failures) -> None:
+        """Why trials failed, one line per distinct reason (hidden when none failed)."""
+        if not failures:
+            self.failures.hide()
+            self.failures.setText("")
+            return
+        lines = [f"{n} × {reason}" for reason, n in failures]
+        self.failures.setText("failed trials:\n" + "\n".join(lines))
+        self.failures.setToolTip("\n".join(lines))
+        self.failures.show()
+
     def show_progress(self, p: StudyProgress) -> None:
         self.progress_bar.setMaximum(max(self.model.form.n_trials, p.n_finished))
         self.progress_bar.setValue(p.n_finished)
@@ -165,6 +183,7 @@ class StudyPanel(QtWidgets.QWidget):
             f"complete {p.n_complete} · pruned {p.n_pruned} · failed {p.n_failed} · "
             f"running {p.n_running} · best loss {best}"
         )
+        self.show_failures(p.failures)
         if len(p.curve_t_s):
             ok = np.isfinite(p.curve_best) & (p.curve_best > 0)
             self.curve.setData(p.curve_t_s[ok], p.curve_best[ok])

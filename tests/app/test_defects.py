@@ -27,7 +27,7 @@ def test_dashboard_opens_the_guis_storage_by_absolute_path(tmp_path, monkeypatch
 
     monkeypatch.setattr(subprocess, "Popen", FakePopen)
     engine.serve_dashboard(StudyForm(storage="radartune-studies.db"))
-    (cmd, cwd), = calls
+    ((cmd, cwd),) = calls
     url = cmd[cmd.index("--storage") + 1]
     assert url == f"sqlite:///{gui_cwd / 'radartune-studies.db'}"
     assert Path(cwd).resolve() != engine.ROOT
@@ -39,3 +39,44 @@ def test_storage_url_is_absolute_for_the_study_service(tmp_path, monkeypatch) ->
     assert engine.storage_url("s.db") == f"sqlite:///{tmp_path / 's.db'}"
     assert engine.storage_url("runs/j.log") == f"journal:///{tmp_path / 'runs' / 'j.log'}"
     assert engine.storage_url("postgresql://u@h:5/d") == "postgresql+psycopg2://u@h:5/d"
+
+
+def test_study_failure_reasons_reach_the_panel(qtbot, tmp_path) -> None:
+    """Trials that failed show their reasons in the study panel, not only in a log file."""
+    import optuna
+    from optuna.trial import TrialState
+
+    from app.panels.study_panel import StudyPanel
+    from app.study import StudyModel
+    from app.study_service import progress_from_dict, progress_to_dict
+
+    storage = tmp_path / "s.db"
+    optuna.logging.set_verbosity(optuna.logging.ERROR)
+    study = optuna.create_study(storage=f"sqlite:///{storage}", study_name="radartune-cv")
+    reasons = ["FloatingPointError: trajectory 0: loss is nan"] * 3 + ["ValueError: bad"]
+    for reason in reasons:
+        trial = study.ask()
+        trial.set_user_attr("error", reason)
+        study.tell(trial, state=TrialState.FAIL)
+    study.tell(study.ask(), state=TrialState.FAIL)  # no reason recorded
+    study.tell(study.ask(), 2.0)
+
+    progress = engine.study_progress(StudyForm(storage=str(storage)))
+    assert progress.n_failed == 5 and progress.n_complete == 1
+    assert progress.failures[0] == ("FloatingPointError: trajectory 0: loss is nan", 3)
+    assert {r for r, _ in progress.failures[1:]} == {
+        "ValueError: bad",
+        "no reason recorded (see the workers' log)",
+    }
+    progress = progress_from_dict(progress_to_dict(progress))  # through the study service
+
+    model = StudyModel()
+    panel = StudyPanel(model)
+    qtbot.addWidget(panel)
+    panel.show()
+    assert panel.failures.isHidden()
+    model.set_progress(progress)
+    assert not panel.failures.isHidden()
+    text = panel.failures.text()
+    assert "3 × FloatingPointError: trajectory 0: loss is nan" in text
+    assert "1 × ValueError: bad" in text
