@@ -147,7 +147,8 @@ class MainWindow(QtWidgets.QMainWindow):
         self.radar_panel.load_cfg_requested.connect(self.scene_control.load_cfg_dialog)
         self.scene_panel.draw_mode_changed.connect(self.top_view.set_draw_mode)
         self.top_view.waypoint_added.connect(self.scene_panel.append_waypoint)
-        self.top_view.waypoints_moved.connect(self.scene_panel.set_waypoints)
+        self.top_view.waypoints_moved.connect(self._on_waypoints_dragged)
+        self.scene_model.selection_changed.connect(self._show_selected_waypoints)
         self.tracker_panel.apply_best_requested.connect(self.apply_best)
         self.study_panel.apply_best_requested.connect(self.apply_best)
         self.study_panel.start_requested.connect(self.start_study)
@@ -270,11 +271,20 @@ class MainWindow(QtWidgets.QMainWindow):
         )
         self.top_view.set_reflectors(info.reflectors_xy_m)
         self.top_view.set_truth_paths(info.truth_paths)
-        doc = self.scene_model.document
-        sel = self.scene_model.selected_person
-        traj = doc["persons"][sel]["trajectory"] if doc.get("persons") else {}
-        self.top_view.set_waypoints(traj.get("waypoints"))
+        self._show_selected_waypoints()
         self.rd_view.set_radar(info.radar)
+
+    def _show_selected_waypoints(self, *_args) -> None:
+        """The top view's handles: the selected person's waypoints (none for classes a–e)."""
+        persons = self.scene_model.document.get("persons") or []
+        sel = self.scene_model.selected_person
+        traj = persons[sel]["trajectory"] if 0 <= sel < len(persons) else {}
+        self.top_view.set_waypoints(traj.get("waypoints"))
+
+    def _on_waypoints_dragged(self, rows: list) -> None:
+        """A drag the scene refuses (e.g. outside the area of interest) puts the handles back."""
+        if not self.scene_panel.set_waypoints(rows):
+            self._show_selected_waypoints()
 
     # ---- tracker parameters ----
     def load_params_dialog(self) -> None:

@@ -80,3 +80,23 @@ def test_study_failure_reasons_reach_the_panel(qtbot, tmp_path) -> None:
     text = panel.failures.text()
     assert "3 × FloatingPointError: trajectory 0: loss is nan" in text
     assert "1 × ValueError: bad" in text
+
+
+def test_rejected_waypoint_drag_puts_the_handle_back(window, qtbot) -> None:
+    """A waypoint dropped outside the area of interest is refused; table, path and handle all
+    return to the last accepted position."""
+    window.scene_model.set_document(dict(engine.PAPER_SCENE_DOCUMENT))
+    window._scene_timer.stop()
+    window.scene_panel.add_wp_button.click()
+    qtbot.waitUntil(lambda: len(window.top_view._waypoint_items) == 2, timeout=5000)
+    wp = [list(r) for r in window.scene_model.document["persons"][1]["trajectory"]["waypoints"]]
+    item = window.top_view._waypoint_items[0]
+    item.setPos(40.0, 40.0)  # the area of interest ends at 10 m
+    item.sigPositionChangeFinished.emit(item)
+    assert window.errors, "the drag must be refused with a message"
+    assert window.scene_model.document["persons"][1]["trajectory"]["waypoints"] == wp
+    assert float(window.scene_panel.waypoints.item(0, 0).text()) == wp[0][0]
+    pos = window.top_view._waypoint_items[0].pos()
+    assert (pos.x(), pos.y()) == (wp[0][0], wp[0][1])
+    line_x, line_y = window.top_view.waypoint_line.getData()
+    assert (line_x[0], line_y[0]) == (wp[0][0], wp[0][1])
