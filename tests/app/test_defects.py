@@ -5,6 +5,8 @@ from __future__ import annotations
 import subprocess
 from pathlib import Path
 
+import pytest
+
 from app import engine
 from app.data import StudyForm
 
@@ -100,3 +102,35 @@ def test_rejected_waypoint_drag_puts_the_handle_back(window, qtbot) -> None:
     assert (pos.x(), pos.y()) == (wp[0][0], wp[0][1])
     line_x, line_y = window.top_view.waypoint_line.getData()
     assert (line_x[0], line_y[0]) == (wp[0][0], wp[0][1])
+
+
+@pytest.mark.parametrize("accept", [True, False])
+def test_short_range_cfg_offers_to_shrink_the_area_of_interest(window, monkeypatch, accept):
+    """high_velocity.cfg sees 7.49 m, the default area reaches 10 m: the user is asked; yes
+    shrinks the area to the radar's range (1 cm inside) and adopts the radar, no keeps both."""
+    from PySide6 import QtWidgets
+
+    window.scene_model.set_document(dict(engine.PAPER_SCENE_DOCUMENT))
+    window._scene_timer.stop()
+    asked = []
+
+    def question(*args, **_kw):
+        asked.append(args[2])
+        return QtWidgets.QMessageBox.Yes if accept else QtWidgets.QMessageBox.No
+
+    monkeypatch.setattr(QtWidgets.QMessageBox, "question", question)
+    cfg = engine.ROOT / "resources" / "radar" / "high_velocity.cfg"
+    radar = engine.read_ti_cfg(cfg)
+    assert radar.max_range_m < 10.0
+    window.load_cfg(cfg)
+    window._scene_timer.stop()
+    assert len(asked) == 1 and "7.49 m" in asked[0]
+    scene = window.scene_model.scene
+    if accept:
+        assert window.scene_model.document["aoi"]["max_range_m"] == 7.49
+        assert scene.radar == radar and window.radar_model.radar == radar
+        assert not window.errors
+    else:
+        assert window.scene_model.document["aoi"]["max_range_m"] == 10.0
+        assert scene.radar != radar and window.radar_model.radar == scene.radar
+        assert "exceeds the radar's maximum range" in window.errors[-1]
