@@ -10,7 +10,6 @@ updates its views) and re-simulated after a short debounce, so a burst of edits 
 from __future__ import annotations
 
 import math
-
 from pathlib import Path
 
 from PySide6 import QtCore, QtWidgets
