@@ -149,6 +149,10 @@ class ParamSpec:
     high: float
     log: bool
     label: str = ""
+    #: SI unit of the value ("" for probabilities), from core/tracking/space.py
+    unit: str = ""
+    #: ``symbol meaning`` without the unit (the slider's first line)
+    title: str = ""
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)

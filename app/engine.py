@@ -171,7 +171,15 @@ def param_specs(model: str) -> list[ParamSpec]:
     from core.tracking.space import search_space
 
     return [
-        ParamSpec(name=p.name, low=p.low, high=p.high, log=p.log, label=p.label)
+        ParamSpec(
+            name=p.name,
+            low=p.low,
+            high=p.high,
+            log=p.log,
+            label=p.label,
+            unit=p.unit,
+            title=f"{p.symbol} {p.meaning}",
+        )
         for p in search_space(model)
     ]
 

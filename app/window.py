@@ -172,6 +172,8 @@ class MainWindow(QtWidgets.QMainWindow):
 
         if restore:
             self.restore_settings()
+        else:
+            self.fit_screen()
         if load_scene:
             self.scene_control.load_initial(scene_path)
         freeze_heap()
@@ -239,6 +241,40 @@ class MainWindow(QtWidgets.QMainWindow):
         self.metrics_label.setObjectName("metricsLabel")
         self.statusBar().addPermanentWidget(self.metrics_label)
         self.statusBar().addPermanentWidget(self.retrack_label)
+
+    # ---- layout ----
+    def fit_screen(self, available: QtCore.QRect | None = None) -> None:
+        """First start: a window that fits the screen (1366×768 up, at 100 % or 150 %).
+
+        Below 1700 logical pixels of width the four panels share one tabbed dock on the right,
+        so that the top view keeps the width its locked aspect needs to show the whole area of
+        interest; the central splitter gives the top view about half of what is left.
+        """
+        if available is None:
+            screen = self.screen() or QtWidgets.QApplication.primaryScreen()
+            available = screen.availableGeometry()
+        width = min(1500, available.width())
+        height = min(950, available.height())
+        self.resize(width, height)
+        if width < 1700:
+            order = ("Scene", "Radar", "Tracker", "Study")
+            for title in order:
+                self.addDockWidget(QtCore.Qt.RightDockWidgetArea, self.docks[title])
+            for title in order[1:]:
+                self.tabifyDockWidget(self.docks[order[0]], self.docks[title])
+            self.docks["Scene"].raise_()
+            # wide enough for every panel's own minimum: no horizontal scroll bar in the dock
+            dock_w = max(self.panel_width(d) for d in self.docks.values())
+            self.resizeDocks([self.docks["Scene"]], [dock_w], QtCore.Qt.Horizontal)
+            centre = max(400, width - dock_w - 20)
+            self.central_splitter.setSizes([centre // 2, centre - centre // 2])
+
+    @staticmethod
+    def panel_width(dock: QtWidgets.QDockWidget) -> int:
+        """The width a dock needs to show its panel without a horizontal scroll bar."""
+        scroll = dock.widget()
+        bar_w = scroll.verticalScrollBar().sizeHint().width()
+        return max(300, scroll.widget().minimumSizeHint().width() + bar_w + 4)
 
     # ---- errors ----
     def show_error(self, message: str) -> None:
@@ -513,7 +549,7 @@ class MainWindow(QtWidgets.QMainWindow):
         if geometry is not None and not geometry.isEmpty():
             self.restoreGeometry(geometry)
         else:
-            self.resize(1500, 900)
+            self.fit_screen()
         state = s.value("window/state", type=QtCore.QByteArray)
         if state is not None and not state.isEmpty():
             self.restoreState(state)

@@ -92,7 +92,11 @@ class StudyPanel(QtWidgets.QWidget):
         self.curve_plot.setLabel("bottom", "wall-clock time", units="s")
         self.curve_plot.setLabel("left", "loss L_t [m²]")
         self.curve_plot.setLogMode(y=True)
-        self.curve_plot.getAxis("left").enableAutoSIPrefix(False)
+        left = self.curve_plot.getAxis("left")
+        left.enableAutoSIPrefix(False)
+        # labels on the decades only (the 2…9 minor ticks of a log axis ran into one another)
+        left.setStyle(maxTextLevel=0, autoExpandTextSpace=True)
+        left.setWidth(48)
         self.curve_plot.setMinimumHeight(140)
         self.curve = self.curve_plot.plot(
             pen=pg.mkPen((255, 140, 0), width=2), symbol="o", symbolSize=4, stepMode=None

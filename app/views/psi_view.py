@@ -20,7 +20,7 @@ class PsiView(pg.GraphicsLayoutWidget):
         self.psi_plot.setTitle("Existence probability ψ")
         self.psi_plot.setLabel("left", "ψ")
         self.psi_plot.setLabel("bottom", "time", units="s")
-        self.psi_plot.setYRange(0.0, 1.05, padding=0)
+        self.psi_plot.setYRange(-0.02, 1.08, padding=0)
         self.psi_plot.showGrid(y=True, alpha=0.2)
         self.psi_all = self.psi_plot.plot(pen=pg.mkPen((240, 220, 40, 120), width=1))
         self.psi_confirmed = self.psi_plot.plot(pen=pg.mkPen((0, 220, 90), width=2))
@@ -28,13 +28,15 @@ class PsiView(pg.GraphicsLayoutWidget):
             angle=0,
             pen=pg.mkPen((0, 220, 90), style=QtCore.Qt.DashLine),
             label="confirm {value:.2f}",
-            labelOpts={"position": 0.9, "color": (0, 220, 90), "anchors": [(1, 1), (1, 1)]},
+            # inside the plot at the left, below its line (between the two thresholds): clear of
+            # the axis, the title and the other label
+            labelOpts={"position": 0.02, "color": (0, 220, 90), "anchors": [(0, 0), (0, 0)]},
         )
         self.delete_line = pg.InfiniteLine(
             angle=0,
             pen=pg.mkPen((255, 80, 80), style=QtCore.Qt.DashLine),
             label="delete {value:.2f}",
-            labelOpts={"position": 0.9, "color": (255, 80, 80), "anchors": [(1, 0), (1, 0)]},
+            labelOpts={"position": 0.02, "color": (255, 80, 80), "anchors": [(0, 1), (0, 1)]},
         )
         self.psi_plot.addItem(self.confirm_line)
         self.psi_plot.addItem(self.delete_line)
@@ -45,7 +47,10 @@ class PsiView(pg.GraphicsLayoutWidget):
         self.metric_plot.setTitle("Running metrics")
         self.metric_plot.setLabel("bottom", "time", units="s")
         self.metric_plot.setLabel("left", "RMSE, OSPA", units="m")
-        self.metric_plot.addLegend(offset=(5, 5))
+        # one row in the top right corner, translucent: the curves start at the left
+        self.metric_plot.addLegend(
+            offset=(-5, 5), colCount=2, brush=pg.mkBrush(0, 0, 0, 120), labelTextSize="8pt"
+        )
         self.metric_plot.setXLink(self.psi_plot)
         self.rmse_curve = self.metric_plot.plot(pen=pg.mkPen((255, 140, 0), width=2), name="RMSE")
         self.ospa_curve = self.metric_plot.plot(pen=pg.mkPen((60, 140, 255), width=1), name="OSPA")

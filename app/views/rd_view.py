@@ -27,9 +27,14 @@ class RangeDopplerView(pg.GraphicsLayoutWidget):
         self.image = pg.ImageItem(axisOrder="row-major")
         self.plot.addItem(self.image)
         self.colorbar = pg.ColorBarItem(
-            values=(0.0, DEFAULT_LEVEL_SPAN_DB), colorMap=pg.colormap.get("viridis"), width=12
+            values=(0.0, DEFAULT_LEVEL_SPAN_DB),
+            colorMap=pg.colormap.get("viridis"),
+            width=12,
+            label="dB",
         )
-        self.colorbar.setImageItem(self.image, insert_in=self.plot)
+        # its own column of the layout (not inside the plot): its tick labels get their width
+        self.colorbar.setImageItem(self.image)
+        self.addItem(self.colorbar, row=0, col=1)
         self.detections = pg.ScatterPlotItem(
             size=9, symbol="s", pen=pg.mkPen("r", width=1.5), brush=None, pxMode=True
         )

@@ -52,7 +52,8 @@ class TopView(pg.PlotWidget):
         self.setLabel("left", "y", units="m")
         self.setTitle("Top view · points: SNR 10–50 dB")
         self.showGrid(x=True, y=True, alpha=0.2)
-        self.addLegend(offset=(5, 5))
+        # two columns, translucent: half the height over the plot
+        self.addLegend(offset=(5, 5), colCount=2, brush=pg.mkBrush(0, 0, 0, 140))
         self._snr_brushes = _snr_palette()
         self._label_brushes = {k: pg.mkBrush(*c, 220) for k, c in LABEL_COLOURS.items()}
         self._snr_array = np.empty(N_SNR_COLOURS, dtype=object)
