@@ -229,6 +229,20 @@ def simulate(scene, *, fidelity: str = "exact") -> Iterator[FrameData]:
         )
 
 
+def fidelity_levels() -> list[str]:
+    """Simulator levels, most faithful first (the keys of ``core.simulation.LEVELS``)."""
+    from core.simulation import LEVELS
+
+    return list(LEVELS)
+
+
+def processing_settings(scene) -> dict:
+    """The processing chain's settings for ``scene`` (windows, CFAR stages, ranges) as JSON."""
+    from core.pipeline import processing_settings as _settings
+
+    return _settings(scene).to_dict()
+
+
 # ---- tracking ---------------------------------------------------------------------------------
 def _truth0(frames: Sequence[FrameData]) -> np.ndarray:
     return np.array(
@@ -542,6 +556,8 @@ class Engine:
     default_extra = staticmethod(default_extra)
     make_params = staticmethod(make_params)
     simulate = staticmethod(simulate)
+    fidelity_levels = staticmethod(fidelity_levels)
+    processing_settings = staticmethod(processing_settings)
     track = staticmethod(track)
     read_ti_cfg = staticmethod(read_ti_cfg)
     scene_dataset = staticmethod(scene_dataset)

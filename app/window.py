@@ -23,6 +23,7 @@ from app.models import (
     TrackerParamsModel,
     TrackingModel,
 )
+from app.panels.processing_panel import ProcessingPanel
 from app.panels.radar_panel import RadarPanel
 from app.panels.scene_panel import ScenePanel
 from app.panels.study_panel import StudyPanel
@@ -104,6 +105,10 @@ class MainWindow(QtWidgets.QMainWindow):
         self._dock("Radar", self.radar_panel, QtCore.Qt.LeftDockWidgetArea)
         self._dock("Tracker", self.tracker_panel, QtCore.Qt.RightDockWidgetArea)
         self._dock("Study", self.study_panel, QtCore.Qt.RightDockWidgetArea)
+        # issue 17: fidelity level, processing settings and timing (app/panels/processing_panel)
+        self.processing_panel = ProcessingPanel(self.engine.fidelity_levels())
+        self._dock("Processing", self.processing_panel, QtCore.Qt.LeftDockWidgetArea)
+        self.tabifyDockWidget(self.docks["Radar"], self.docks["Processing"])
         self.tabifyDockWidget(self.docks["Scene"], self.docks["Radar"])
         self.tabifyDockWidget(self.docks["Tracker"], self.docks["Study"])
         self.docks["Scene"].raise_()
@@ -131,6 +136,7 @@ class MainWindow(QtWidgets.QMainWindow):
 
         # ---- wiring ----------------------------------------------------------------------------
         self.scene_control.info_changed.connect(self._on_scene_info)
+        self.processing_panel.fidelity_changed.connect(self.set_fidelity)
         self.scene_control.error.connect(self.show_error)
         self.scene_control.message.connect(lambda m: self.statusBar().showMessage(m, 5000))
         self.cache.reset.connect(self._on_cache_reset)
@@ -168,6 +174,9 @@ class MainWindow(QtWidgets.QMainWindow):
         self._draw_timer.start()
         self._dirty = True
         self._draw_times: deque[float] = deque(maxlen=60)
+        self._draw_costs_s: deque[float] = deque(maxlen=60)
+        self._track_ms_per_frame = float("nan")
+        self._t_timing_shown = 0.0
         self.n_draws = 0
 
         if restore:
@@ -257,7 +266,7 @@ class MainWindow(QtWidgets.QMainWindow):
         height = min(950, available.height())
         self.resize(width, height)
         if width < 1700:
-            order = ("Scene", "Radar", "Tracker", "Study")
+            order = tuple(self.docks)
             for title in order:
                 self.addDockWidget(QtCore.Qt.RightDockWidgetArea, self.docks[title])
             for title in order[1:]:
@@ -309,6 +318,17 @@ class MainWindow(QtWidgets.QMainWindow):
         self.top_view.set_truth_paths(info.truth_paths)
         self._show_selected_waypoints()
         self.rd_view.set_radar(info.radar)
+        if self.scene_model.scene is not None:
+            self.processing_panel.show_settings(
+                self.engine.processing_settings(self.scene_model.scene)
+            )
+
+    def set_fidelity(self, name: str) -> None:
+        """Simulate the scene again at another fidelity level (a key of the core registry)."""
+        if name != self.sim.fidelity:
+            self.sim.fidelity = name
+            self.processing_panel.set_fidelity(name)
+            self.scene_control.resimulate()
 
     def _show_selected_waypoints(self, *_args) -> None:
         """The top view's handles: the selected person's waypoints (none for classes a–e)."""
@@ -399,6 +419,7 @@ class MainWindow(QtWidgets.QMainWindow):
     def _on_tracked(self, elapsed_s: float) -> None:
         n = self.tracking_model.result.n_frames if self.tracking_model.result else len(self.cache)
         self.retrack_label.setText(f"re-track {n} frames: {elapsed_s * 1e3:.0f} ms")
+        self._track_ms_per_frame = elapsed_s * 1e3 / max(n, 1)
         self.tracker_panel.show_timing(elapsed_s, n)
 
     def _on_tracking_changed(self, result) -> None:
@@ -433,6 +454,7 @@ class MainWindow(QtWidgets.QMainWindow):
         self.redraw()
 
     def redraw(self) -> None:
+        t0 = time.perf_counter()
         frames = self.cache.frames
         index = self.playback.frame
         result = self.tracking_model.result
@@ -442,7 +464,9 @@ class MainWindow(QtWidgets.QMainWindow):
         self.psi_view.set_frame(index)
         self._show_metrics(index, result)
         self.n_draws += 1
-        self._draw_times.append(time.perf_counter())
+        now = time.perf_counter()
+        self._draw_times.append(now)
+        self._draw_costs_s.append(now - t0)
         self._update_fps()
 
     def _show_metrics(self, index: int, result) -> None:
@@ -465,6 +489,16 @@ class MainWindow(QtWidgets.QMainWindow):
             f" rendered {rendered:d} fps · simulated {self.sim.rate_fps:.1f} fps"
             + (" (done)" if self.cache.complete else "")
         )
+        if now - self._t_timing_shown >= 0.5:  # the timing panel twice a second
+            self._t_timing_shown = now
+            costs = sorted(self._draw_costs_s)
+            self.processing_panel.show_timing(
+                chain_ms=self.sim.ms_per_frame,
+                track_ms=self._track_ms_per_frame,
+                draw_ms=costs[len(costs) // 2] * 1e3 if costs else float("nan"),
+                sim_fps=self.sim.rate_fps,
+                draw_fps=rendered,
+            )
 
     # ---- study ----
     def start_study(self) -> None:

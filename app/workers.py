@@ -8,7 +8,9 @@ from __future__ import annotations
 
 import threading
 import time
+from collections import deque
 
+import numpy as np
 from PySide6 import QtCore
 
 from app.data import TrackingResult
@@ -43,16 +45,24 @@ class SimulationWorker(QtCore.QThread):
         self._scene = scene
         self.generation = generation
         self._stop = threading.Event()
+        self.fidelity = "exact"
+        #: seconds per simulated frame (radar chain: synthesis and processing), latest last
+        self.frame_times_s: deque[float] = deque(maxlen=50)
 
     def stop(self) -> None:
         self._stop.set()
 
     def run(self) -> None:  # worker thread
         try:
-            for frame in self._engine.simulate(self._scene):
+            frames = self._engine.simulate(self._scene, fidelity=self.fidelity)
+            t0 = time.perf_counter()
+            for frame in frames:
+                t1 = time.perf_counter()
+                self.frame_times_s.append(t1 - t0)  # synthesis + processing of one frame
                 if self._stop.is_set():
                     return
                 self.frame_ready.emit(self.generation, frame)
+                t0 = time.perf_counter()
             if not self._stop.is_set():
                 self.done.emit(self.generation)
         except Exception as exc:  # any failure becomes a message, never a crash
@@ -74,6 +84,8 @@ class SimulationController(QtCore.QObject):
         self._old: list[SimulationWorker] = []
         self._t_start = 0.0
         self.rate_fps = 0.0
+        #: simulator level of the next start (a key of core.simulation.LEVELS)
+        self.fidelity = "exact"
 
     def start(self, scene) -> None:
         """(Re)simulate ``scene``; a running simulation of an older scene is abandoned."""
@@ -81,6 +93,7 @@ class SimulationController(QtCore.QObject):
         info = self._engine.scene_info(scene)
         self._cache.clear(expected=info.n_frames, truth_paths=info.truth_paths)
         worker = SimulationWorker(self._engine, scene, self._cache.generation, self)
+        worker.fidelity = self.fidelity
         worker.frame_ready.connect(self._on_frame)
         worker.done.connect(self._on_done)
         worker.failed.connect(self._on_failed)
@@ -119,6 +132,16 @@ class SimulationController(QtCore.QObject):
     @property
     def running(self) -> bool:
         return self._worker is not None and self._worker.isRunning()
+
+    @property
+    def ms_per_frame(self) -> float:
+        """Median radar-chain time per frame of the current simulation (NaN before a frame;
+        the first frame, which may compile kernels, is left out once there are others)."""
+        w = self._worker or (self._old[-1] if self._old else None)
+        times = list(w.frame_times_s) if w is not None else []
+        if len(times) > 1:
+            times = times[1:]
+        return float(np.median(times)) * 1e3 if times else float("nan")
 
     def _on_frame(self, generation: int, frame) -> None:
         if generation != self._cache.generation:
