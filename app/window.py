@@ -38,7 +38,7 @@ from app.workers import SimulationController, TrackingController, freeze_heap
 from core.config import PAPER_RADAR
 from core.errors import InputError
 
-DRAW_INTERVAL_MS = 30  # GUI draw timer: at most ~33 redraws per second, stale frames dropped
+DRAW_INTERVAL_MS = 15  # GUI draw timer: at most ~66 redraws per second, stale frames dropped
 RETRACK_EVERY_N_FRAMES = 20  # while the simulation fills the cache
 
 

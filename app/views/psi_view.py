@@ -8,6 +8,7 @@ import pyqtgraph as pg
 from PySide6 import QtCore
 
 from app.data import TrackingResult
+from app.views.axis_cache import cache_axes
 
 
 class PsiView(pg.GraphicsLayoutWidget):
@@ -65,6 +66,7 @@ class PsiView(pg.GraphicsLayoutWidget):
         self._result: TrackingResult | None = None
         self._metric_text = ""
         self.n_draws = 0
+        cache_axes(self.psi_plot, self.metric_plot)
 
     def set_thresholds(self, confirm: float, delete: float) -> None:
         self.confirm_line.setValue(confirm)

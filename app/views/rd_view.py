@@ -7,6 +7,7 @@ import pyqtgraph as pg
 from PySide6 import QtCore
 
 from app.data import FrameData
+from app.views.axis_cache import cache_axes
 from core.config import RadarConfig
 
 #: Fixed colour levels in dB relative to the map's noise floor estimate are not used: the map is
@@ -44,6 +45,7 @@ class RangeDopplerView(pg.GraphicsLayoutWidget):
         self._radar: RadarConfig | None = None
         self._levels: tuple[float, float] | None = None
         self.n_draws = 0
+        cache_axes(self.plot, self.colorbar)
 
     def set_radar(self, radar: RadarConfig) -> None:
         """Axes from the radar: range bins → m, Doppler bins → m/s (zero velocity centred)."""

@@ -14,6 +14,7 @@ from PySide6 import QtCore, QtGui
 
 from app.data import FrameData, TrackFrame, TrackingResult
 from app.geometry import aoi_polyline, ellipse_polyline, trails_polyline
+from app.views.axis_cache import cache_axes
 
 SNR_MIN_DB = 10.0
 SNR_MAX_DB = 50.0
@@ -118,6 +119,7 @@ class TopView(pg.PlotWidget):
         self.last_n_points = 0
         self.last_n_tracks = 0
         self.set_aoi(0.5, 10.0, 60.0)
+        cache_axes(self.getPlotItem())
         # once the user pans or zooms, the view stays where they put it
         self.getPlotItem().vb.sigRangeChangedManually.connect(self._stop_auto_fit)
 

@@ -17,14 +17,15 @@ from pathlib import Path
 from core.files import write_json_atomic
 
 BENCHMARKS = ("sim", "track", "tune", "fidelity", "dataset", "false_alarms", "cvca")
-#: not part of ``all``: hours of studies (16 x 1000 trials)
-LONG = ("cvca_seeds",)
+#: not part of ``all``: hours of studies (16 x 1000 trials); the desktop app (needs Qt)
+LONG = ("cvca_seeds", "gui")
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "bench",
-        help="measure speed (and error against run time); cvca, cvca_seeds: CV against CA",
+        help="measure speed (and error against run time); cvca, cvca_seeds: CV against CA; "
+        "gui: the desktop app (offscreen and under Xvfb)",
     )
     p.add_argument("name", choices=(*BENCHMARKS, *LONG, "all"))
     p.add_argument(
