@@ -113,6 +113,9 @@ class TrackingResult:
         Identifies the parameter vector the run used (drop stale results).
     elapsed_s
         Wall-clock time of the tracker run plus preparation, in s.
+    engine
+        ``"numba"`` or ``"numpy"`` (the readable tracker, equal to round-off, while the
+        compiled kernel is still being compiled on a cold start).
     """
 
     frames: tuple[TrackFrame, ...]
@@ -130,6 +133,8 @@ class TrackingResult:
     trail_id: np.ndarray
     params_key: str = ""
     elapsed_s: float = 0.0
+    #: the tracker that ran: "numba" (compiled kernel) or "numpy" (readable, until compiled)
+    engine: str = "numba"
 
     @property
     def n_frames(self) -> int:

@@ -14,6 +14,7 @@ import socket
 import subprocess
 import sys
 import tempfile
+import threading
 import time
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
@@ -261,15 +262,42 @@ def _ospa_per_frame(frames: Sequence[FrameData], confirmed_xy: Sequence[np.ndarr
     return out
 
 
+#: set once the compiled tracker kernel is loaded or compiled (:func:`warm_up_tracker`)
+TRACKER_COMPILED = threading.Event()
+
+
+def warm_up_tracker() -> float:
+    """Load (or, on a cold cache, compile) the compiled tracker kernel on a two-frame problem;
+    run in a background thread at start. Until it returns, :func:`track` uses the readable numpy
+    tracker (the same result to round-off). Returns the seconds it took."""
+    from core.tracking import TrackerParams, run_tracker
+
+    t0 = time.perf_counter()
+    z = np.array([[3.0, 0.1, 0.5], [3.04, 0.1, 0.5]])
+    run_tracker((z, np.array([0, 1, 2])), TrackerParams(), 0.08, keep_tracks=True, engine="numba")
+    TRACKER_COMPILED.set()
+    return time.perf_counter() - t0
+
+
+def tracker_compiled() -> bool:
+    return TRACKER_COMPILED.is_set()
+
+
 def track(
-    frames: Sequence[FrameData], params, frame_period_s: float, *, key: str = ""
+    frames: Sequence[FrameData],
+    params,
+    frame_period_s: float,
+    *,
+    key: str = "",
+    engine: str = "numba",
 ) -> TrackingResult:
     """Re-track the cached point clouds with the compiled kernel, recording every track of every
     frame (ids, ψ, status, gates), and prepare everything the overlay draws, in one step.
 
     ``run_tracker(..., engine="numba")``: the readable tracker's result (equal to round-off) in
     milliseconds. The loss follows eqs. (12)–(13) against person 0 (the paper's single-person
-    scenes).
+    scenes). ``engine="numpy"``: the readable tracker (the GUI's choice until
+    :data:`TRACKER_COMPILED` is set, so that a cold start shows tracks while numba compiles).
     """
     from core.tracking import run_tracker
 
@@ -281,7 +309,7 @@ def track(
         else np.zeros((0, 3))
     )
     f_off = np.concatenate(([0], np.cumsum(counts))).astype(np.int64)
-    res = run_tracker((z, f_off), params, frame_period_s, keep_tracks=True, engine="numba")
+    res = run_tracker((z, f_off), params, frame_period_s, keep_tracks=True, engine=engine)
     tfs, conf_list = [], []
     ids_l, t_l, xy_l, psi_l, conf_l = [], [], [], [], []
     for k, ft in enumerate(res.frames):
@@ -334,6 +362,7 @@ def track(
         trail_id=ids,
         params_key=key,
         elapsed_s=time.perf_counter() - t0,
+        engine=engine,
     )
 
 
@@ -559,6 +588,8 @@ class Engine:
     fidelity_levels = staticmethod(fidelity_levels)
     processing_settings = staticmethod(processing_settings)
     track = staticmethod(track)
+    warm_up_tracker = staticmethod(warm_up_tracker)
+    tracker_compiled = staticmethod(tracker_compiled)
     read_ti_cfg = staticmethod(read_ti_cfg)
     scene_dataset = staticmethod(scene_dataset)
     start_study = staticmethod(start_study)

@@ -145,6 +145,9 @@ class MainWindow(QtWidgets.QMainWindow):
         self.sim.failed.connect(lambda m: self.show_error(f"simulation failed: {m}"))
         self.tracker.failed.connect(lambda m: self.show_error(f"tracking failed: {m}"))
         self.tracker.finished.connect(self._on_tracked)
+        self.tracker.compiled.connect(
+            lambda t: self.statusBar().showMessage(f"compiled tracker ready ({t:.1f} s)", 5000)
+        )
         self.tracking_model.changed.connect(self._on_tracking_changed)
         self.params_model.changed.connect(self._on_params_changed)
         self.playback.frame_changed.connect(self._mark_dirty)
@@ -244,7 +247,11 @@ class MainWindow(QtWidgets.QMainWindow):
             view_menu.addAction(dock.toggleViewAction())
 
     def _build_status(self) -> None:
-        self.retrack_label = QtWidgets.QLabel()
+        # until the first frame: what is happening (a first start compiles the radar chain)
+        self.retrack_label = QtWidgets.QLabel(
+            "re-track: waiting for the first simulated frame (the first start after an install "
+            "compiles the radar chain)"
+        )
         self.retrack_label.setObjectName("retrackLabel")
         self.metrics_label = QtWidgets.QLabel()
         self.metrics_label.setObjectName("metricsLabel")
@@ -418,7 +425,12 @@ class MainWindow(QtWidgets.QMainWindow):
 
     def _on_tracked(self, elapsed_s: float) -> None:
         n = self.tracking_model.result.n_frames if self.tracking_model.result else len(self.cache)
-        self.retrack_label.setText(f"re-track {n} frames: {elapsed_s * 1e3:.0f} ms")
+        result = self.tracking_model.result
+        numpy = result is not None and result.engine == "numpy"
+        self.retrack_label.setText(
+            f"re-track {n} frames: {elapsed_s * 1e3:.0f} ms"
+            + (" (readable numpy tracker while the compiled one compiles)" if numpy else "")
+        )
         self._track_ms_per_frame = elapsed_s * 1e3 / max(n, 1)
         self.tracker_panel.show_timing(elapsed_s, n)
 

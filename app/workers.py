@@ -165,6 +165,7 @@ class _Signals(QtCore.QObject):
     result = QtCore.Signal(int, object)
     failed = QtCore.Signal(int, str)
     done = QtCore.Signal(int)
+    compiled = QtCore.Signal()
 
 
 class _TrackJob(QtCore.QRunnable):
@@ -183,7 +184,10 @@ class _TrackJob(QtCore.QRunnable):
         engine, frames, params, frame_period_s, key = self._args
         try:
             if self._latest() == self._ticket:
-                result = engine.track(frames, params, frame_period_s, key=key)
+                # the readable numpy tracker until the compiled kernel is ready (cold start)
+                compiled = getattr(engine, "tracker_compiled", lambda: True)()
+                kw = {} if compiled else {"engine": "numpy"}
+                result = engine.track(frames, params, frame_period_s, key=key, **kw)
                 self._signals.result.emit(self._ticket, result)
         except Exception as exc:
             log_exception("re-tracking failed", exc)
@@ -201,6 +205,7 @@ class TrackingController(QtCore.QObject):
 
     failed = QtCore.Signal(str)
     finished = QtCore.Signal(float)  # elapsed s of the re-track (tracker + overlay preparation)
+    compiled = QtCore.Signal(float)  # the compiled tracker is ready (seconds it took)
 
     def __init__(
         self,
@@ -234,6 +239,31 @@ class TrackingController(QtCore.QObject):
         self.last_elapsed_s = float("nan")
         self.n_runs = 0
         params.changed.connect(self.request)
+        self.compile_s = float("nan")  # seconds the compiled tracker took to load or compile
+        self._start_warm_up()
+
+    def _start_warm_up(self) -> None:
+        """Load or compile the tracker kernel in a background thread (a cold start compiles for
+        minutes); when ready, re-track with it (the numpy tracker's overlay is shown meanwhile)."""
+        warm = getattr(self._engine, "warm_up_tracker", None)
+        if warm is None or self._engine.tracker_compiled():
+            return
+
+        def run() -> None:
+            try:
+                self.compile_s = warm()
+            except Exception as exc:  # the numpy tracker stays in use
+                log_exception("compiling the tracker kernel failed", exc)
+                return
+            self._signals.compiled.emit()
+
+        self._signals.compiled.connect(self._on_compiled)
+        threading.Thread(target=run, name="tracker-warm-up", daemon=True).start()
+
+    def _on_compiled(self) -> None:
+        self.compiled.emit(self.compile_s)
+        if self._cache.frames:
+            self.request()
 
     def request(self) -> None:
         self._timer.start()

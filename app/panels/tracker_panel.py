@@ -163,7 +163,7 @@ class TrackerPanel(QtWidgets.QWidget):
         buttons.addWidget(self.reset_button)
         buttons.addWidget(self.apply_best_button)
         outer.addLayout(buttons)
-        self.timing = QtWidgets.QLabel("re-track: –")
+        self.timing = QtWidgets.QLabel("re-track: waiting for the first simulated frames")
         self.timing.setObjectName("retrackTiming")
         outer.addWidget(self.timing)
         outer.addStretch(1)
