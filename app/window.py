@@ -158,6 +158,7 @@ class MainWindow(QtWidgets.QMainWindow):
         self.top_view.waypoint_added.connect(self.scene_panel.append_waypoint)
         self.top_view.waypoints_moved.connect(self._on_waypoints_dragged)
         self.scene_model.selection_changed.connect(self._show_selected_waypoints)
+        self.scene_model.selection_changed.connect(self.top_view.set_selected_person)
         self.tracker_panel.apply_best_requested.connect(self.apply_best)
         self.study_panel.apply_best_requested.connect(self.apply_best)
         self.study_panel.start_requested.connect(self.start_study)
@@ -324,6 +325,7 @@ class MainWindow(QtWidgets.QMainWindow):
         self.top_view.set_reflectors(info.reflectors_xy_m)
         self.top_view.set_truth_paths(info.truth_paths)
         self._show_selected_waypoints()
+        self.top_view.set_selected_person(self.scene_model.selected_person)
         self.rd_view.set_radar(info.radar)
         if self.scene_model.scene is not None:
             self.processing_panel.show_settings(
