@@ -93,6 +93,7 @@ class MainWindow(QtWidgets.QMainWindow):
         central.addWidget(right)
         central.setSizes([620, 480])
         self.central_splitter, self.right_splitter = central, right
+        self.compact = False
         self.setCentralWidget(central)
 
         # ---- panels in docks -----------------------------------------------------------------
@@ -265,7 +266,7 @@ class MainWindow(QtWidgets.QMainWindow):
 
         Below 1700 logical pixels of width the four panels share one tabbed dock on the right,
         so that the top view keeps the width its locked aspect needs to show the whole area of
-        interest; the central splitter gives the top view about half of what is left.
+        interest; the central splitter gives the top view 60 % of what is left.
         """
         if available is None:
             screen = self.screen() or QtWidgets.QApplication.primaryScreen()
@@ -284,7 +285,22 @@ class MainWindow(QtWidgets.QMainWindow):
             dock_w = max(self.panel_width(d) for d in self.docks.values())
             self.resizeDocks([self.docks["Scene"]], [dock_w], QtCore.Qt.Horizontal)
             centre = max(400, width - dock_w - 20)
-            self.central_splitter.setSizes([centre // 2, centre - centre // 2])
+            if centre < 700:  # e.g. 1366x768 at 150 %: the plots under the top view
+                self.set_compact(True)
+                h = max(300, height - 150)
+                self.central_splitter.setSizes([h * 3 // 5, h - h * 3 // 5])
+                self.right_splitter.setSizes([centre * 11 // 20, centre - centre * 11 // 20])
+            else:
+                # the top view 60 %: the area of interest is wider (±60°) than deep
+                self.central_splitter.setSizes([centre * 3 // 5, centre - centre * 3 // 5])
+
+    def set_compact(self, compact: bool) -> None:
+        """Compact layout for small screens: the top view above, range-Doppler and ψ side by
+        side below it (the normal layout: top view left, the two plots stacked right)."""
+        self.compact = bool(compact)
+        vertical, horizontal = QtCore.Qt.Vertical, QtCore.Qt.Horizontal
+        self.central_splitter.setOrientation(vertical if compact else horizontal)
+        self.right_splitter.setOrientation(horizontal if compact else vertical)
 
     @staticmethod
     def panel_width(dock: QtWidgets.QDockWidget) -> int:
@@ -416,6 +432,8 @@ class MainWindow(QtWidgets.QMainWindow):
         self._dirty = True
 
     def _on_frames_added(self, n: int) -> None:
+        if n == 1:  # the radar chain is compiled: now the tracker kernel (priority order)
+            self.tracker.start_warm_up()
         if n == 1 or n % RETRACK_EVERY_N_FRAMES == 0:
             self.tracker.request()
         if self.playback.frame >= n - 1:
@@ -576,6 +594,7 @@ class MainWindow(QtWidgets.QMainWindow):
         s.setValue("window/state", self.saveState())
         s.setValue("window/central_splitter", self.central_splitter.saveState())
         s.setValue("window/right_splitter", self.right_splitter.saveState())
+        s.setValue("window/compact", bool(self.compact))
         s.setValue("playback/speed", float(self.playback.speed))
         s.setValue("view/colour_by", str(self.top_view.colour_by))
         s.setValue("view/persistence", int(self.top_view.persistence))
@@ -601,6 +620,8 @@ class MainWindow(QtWidgets.QMainWindow):
         state = s.value("window/state", type=QtCore.QByteArray)
         if state is not None and not state.isEmpty():
             self.restoreState(state)
+        if s.value("window/compact", False, type=bool):
+            self.set_compact(True)
         for key, splitter in (
             ("window/central_splitter", self.central_splitter),
             ("window/right_splitter", self.right_splitter),

@@ -240,14 +240,17 @@ class TrackingController(QtCore.QObject):
         self.n_runs = 0
         params.changed.connect(self.request)
         self.compile_s = float("nan")  # seconds the compiled tracker took to load or compile
-        self._start_warm_up()
+        self._warming = False
 
-    def _start_warm_up(self) -> None:
+    def start_warm_up(self) -> None:
         """Load or compile the tracker kernel in a background thread (a cold start compiles for
-        minutes); when ready, re-track with it (the numpy tracker's overlay is shown meanwhile)."""
+        a minute or more); when ready, re-track with it (the numpy tracker's overlay is shown
+        meanwhile). The window calls this once the first frame is simulated: two compilations
+        at once share the GIL and delayed the first frame from 35 s to 171 s (app-06)."""
         warm = getattr(self._engine, "warm_up_tracker", None)
-        if warm is None or self._engine.tracker_compiled():
+        if self._warming or warm is None or self._engine.tracker_compiled():
             return
+        self._warming = True
 
         def run() -> None:
             try:

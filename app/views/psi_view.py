@@ -18,7 +18,7 @@ class PsiView(pg.GraphicsLayoutWidget):
         super().__init__(parent)
         self.setObjectName("psiView")
         self.psi_plot = self.addPlot(row=0, col=0)
-        self.psi_plot.setTitle("Existence probability ψ")
+        self.psi_plot.setTitle("existence probability ψ", size="9pt")
         self.psi_plot.setLabel("left", "ψ")
         self.psi_plot.setLabel("bottom", "time", units="s")
         self.psi_plot.setYRange(-0.02, 1.08, padding=0)
@@ -45,7 +45,7 @@ class PsiView(pg.GraphicsLayoutWidget):
         self.psi_plot.addItem(self.cursor)
 
         self.metric_plot = self.addPlot(row=1, col=0)
-        self.metric_plot.setTitle("Running metrics")
+        self.metric_plot.setTitle("running metrics", size="9pt")
         self.metric_plot.setLabel("bottom", "time", units="s")
         self.metric_plot.setLabel("left", "RMSE, OSPA", units="m")
         # one row in the top right corner, translucent: the curves start at the left

@@ -24,7 +24,9 @@ class RangeDopplerView(pg.GraphicsLayoutWidget):
         self.plot = self.addPlot(row=0, col=0)
         self.plot.setLabel("bottom", "radial velocity", units="m/s")
         self.plot.setLabel("left", "range", units="m")
-        self.plot.setTitle("Range-Doppler map (dB)")
+        # no title: its width was the plot's minimum width and pushed the colour bar out of a
+        # narrow view at 150 %; the axes and the colour bar's "dB" say what it is
+        self.setToolTip("range-Doppler map, dB (CFAR detections: red squares)")
         self.image = pg.ImageItem(axisOrder="row-major")
         self.plot.addItem(self.image)
         self.colorbar = pg.ColorBarItem(

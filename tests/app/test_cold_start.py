@@ -40,6 +40,7 @@ def test_numpy_tracker_until_compiled_then_the_kernel(qtbot, long_scene_frames) 
     ctl = TrackingController(eng, cache, TrackerParamsModel(eng), tracking)
     compiled = []
     ctl.compiled.connect(compiled.append)
+    ctl.start_warm_up()
     ctl.request()
     qtbot.waitUntil(lambda: tracking.result is not None and ctl.idle, timeout=120000)
     first = tracking.result
