@@ -264,35 +264,36 @@ class MainWindow(QtWidgets.QMainWindow):
     def fit_screen(self, available: QtCore.QRect | None = None) -> None:
         """First start: a window that fits the screen (1366×768 up, at 100 % or 150 %).
 
-        Below 1700 logical pixels of width the four panels share one tabbed dock on the right,
-        so that the top view keeps the width its locked aspect needs to show the whole area of
-        interest; the central splitter gives the top view 60 % of what is left.
+        The panels share one tabbed dock on the right, as wide as the widest panel, so that the
+        top view keeps the width its locked aspect needs to show the whole area of interest
+        (with docks on both sides a 1920-px window showed 29 m for the 10 m area); the central
+        splitter gives the top view 60 % of what is left, or, on a very small logical screen
+        (1366×768 at 150 %), the top view goes above the two plots.
         """
         if available is None:
             screen = self.screen() or QtWidgets.QApplication.primaryScreen()
             available = screen.availableGeometry()
-        width = min(1500, available.width())
-        height = min(950, available.height())
+        width = min(1800, available.width())
+        height = min(1000, available.height())
         self.resize(width, height)
-        if width < 1700:
-            order = tuple(self.docks)
-            for title in order:
-                self.addDockWidget(QtCore.Qt.RightDockWidgetArea, self.docks[title])
-            for title in order[1:]:
-                self.tabifyDockWidget(self.docks[order[0]], self.docks[title])
-            self.docks["Scene"].raise_()
-            # wide enough for every panel's own minimum: no horizontal scroll bar in the dock
-            dock_w = max(self.panel_width(d) for d in self.docks.values())
-            self.resizeDocks([self.docks["Scene"]], [dock_w], QtCore.Qt.Horizontal)
-            centre = max(400, width - dock_w - 20)
-            if centre < 700:  # e.g. 1366x768 at 150 %: the plots under the top view
-                self.set_compact(True)
-                h = max(300, height - 150)
-                self.central_splitter.setSizes([h * 3 // 5, h - h * 3 // 5])
-                self.right_splitter.setSizes([centre * 11 // 20, centre - centre * 11 // 20])
-            else:
-                # the top view 60 %: the area of interest is wider (±60°) than deep
-                self.central_splitter.setSizes([centre * 3 // 5, centre - centre * 3 // 5])
+        order = tuple(self.docks)
+        for title in order:
+            self.addDockWidget(QtCore.Qt.RightDockWidgetArea, self.docks[title])
+        for title in order[1:]:
+            self.tabifyDockWidget(self.docks[order[0]], self.docks[title])
+        self.docks["Scene"].raise_()
+        # wide enough for every panel's own minimum: no horizontal scroll bar in the dock
+        dock_w = max(self.panel_width(d) for d in self.docks.values())
+        self.resizeDocks([self.docks["Scene"]], [dock_w], QtCore.Qt.Horizontal)
+        centre = max(400, width - dock_w - 20)
+        if centre < 700:  # e.g. 1366x768 at 150 %: the plots under the top view
+            self.set_compact(True)
+            h = max(300, height - 150)
+            self.central_splitter.setSizes([h * 3 // 5, h - h * 3 // 5])
+            self.right_splitter.setSizes([centre * 11 // 20, centre - centre * 11 // 20])
+        else:
+            # the top view 60 %: the area of interest is wider (±60°) than deep
+            self.central_splitter.setSizes([centre * 3 // 5, centre - centre * 3 // 5])
 
     def set_compact(self, compact: bool) -> None:
         """Compact layout for small screens: the top view above, range-Doppler and ψ side by
