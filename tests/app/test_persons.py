@@ -40,3 +40,27 @@ def test_editor_adds_selects_removes_and_colours_persons(window) -> None:
     assert view._person_paths[MAX_PERSONS - 1].getData()[0] is None or (
         len(view._person_paths[MAX_PERSONS - 1].getData()[0]) == 0
     )
+
+
+def test_study_data_set_of_a_two_person_scene_gives_finite_losses(tmp_path) -> None:
+    """The GUI writes the scene on screen as the study's data set; on the shipped two-person
+    scene every trial failed with a NaN loss (issue 14). Person 0 is absent in some frames
+    (NaN truth); the data set keeps every person and the loss is finite."""
+    import json
+    import math
+
+    import numpy as np
+
+    from core.dataset import Dataset
+    from core.optimization import tracker_params_dict
+    from core.optimization.objective import TrackerLosses
+    from core.tracking.space import defaults
+
+    path = engine.ROOT / "resources" / "scenes" / "two_persons.json"
+    scene = engine.scene_from_document(json.loads(path.read_text()), path.parent)
+    frames = list(engine.simulate(scene))
+    ds = Dataset.load(engine.scene_dataset(frames, scene, tmp_path / "scene.npz"))
+    assert ds.truth_xy_m.shape == (len(frames), 2, 2)
+    assert np.isnan(ds.truth_xy_m).any()  # a person absent in some frames
+    ((value, _mse, n_c),) = TrackerLosses(ds).losses(tracker_params_dict(defaults("cv"), "cv"), [0])
+    assert math.isfinite(value) and value > 0 and n_c > 0

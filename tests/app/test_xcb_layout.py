@@ -28,9 +28,11 @@ def shown_window(qtbot, settings):
     qtbot.waitExposed(w)
     qtbot.waitUntil(lambda: w.cache.complete, timeout=300000)
     qtbot.waitUntil(
-        lambda: w.tracker.idle
-        and w.tracking_model.result is not None
-        and w.tracking_model.result.n_frames == len(w.cache),
+        lambda: (
+            w.tracker.idle
+            and w.tracking_model.result is not None
+            and w.tracking_model.result.n_frames == len(w.cache)
+        ),
         timeout=300000,
     )
     w.redraw()
