@@ -94,9 +94,7 @@ class StudyPanel(QtWidgets.QWidget):
         self.curve_plot.setLogMode(y=True)
         left = self.curve_plot.getAxis("left")
         left.enableAutoSIPrefix(False)
-        # labels on the decades only (the 2…9 minor ticks of a log axis ran into one another)
-        left.setStyle(maxTextLevel=0, autoExpandTextSpace=True)
-        left.setWidth(48)
+        left.setStyle(autoExpandTextSpace=True)
         self.curve_plot.setMinimumHeight(140)
         self.curve = self.curve_plot.plot(
             pen=pg.mkPen((255, 140, 0), width=2), symbol="o", symbolSize=4, stepMode=None
@@ -168,6 +166,18 @@ class StudyPanel(QtWidgets.QWidget):
         self.stop_button.setEnabled(running)
         self.progress_bar.setMaximum(f.n_trials)
 
+    def _decade_ticks(self, values: np.ndarray) -> None:
+        """Tick labels on whole decades only (``1e-5``): pyqtgraph's log axis labelled the 2…9
+        minor ticks too when the curve spans less than two decades, and they ran together."""
+        lo = math.floor(math.log10(float(values.min())))
+        hi = math.ceil(math.log10(float(values.max())))
+        if hi == lo:
+            hi += 1
+        step = max(1, (hi - lo + 5) // 6)  # at most ~6 labels
+        major = [(float(k), f"1e{k}") for k in range(lo, hi + 1, step)]
+        self.curve_plot.getAxis("left").setTicks([major, []])
+        self.curve_plot.setYRange(lo, hi, padding=0.02)
+
     def show_failures(self, failures) -> None:
         """Why trials failed, one line per distinct reason (hidden when none failed)."""
         if not failures:
@@ -191,6 +201,8 @@ class StudyPanel(QtWidgets.QWidget):
         if len(p.curve_t_s):
             ok = np.isfinite(p.curve_best) & (p.curve_best > 0)
             self.curve.setData(p.curve_t_s[ok], p.curve_best[ok])
+            if ok.any():
+                self._decade_ticks(p.curve_best[ok])
         else:
             self.curve.setData([], [])
         items = sorted(p.best_params.items())
