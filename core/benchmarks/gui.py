@@ -43,7 +43,7 @@ def _run_app(platform: str, quick: bool) -> dict:
 
 
 def run(quick: bool = False) -> dict:
-    result = {"offscreen": _run_app("offscreen", quick)}
+    result: dict[str, object] = {"offscreen": _run_app("offscreen", quick)}
     if shutil.which("xvfb-run"):
         result["xcb"] = _run_app("xcb", quick)
     else:
