@@ -26,7 +26,9 @@ def _cfar_text(c: dict) -> str:
 
 
 def _ms(value: float) -> str:
-    return "–" if not math.isfinite(value) else f"{value:.1f} ms"
+    if not math.isfinite(value):
+        return "–"
+    return f"{value:.2f} ms" if value < 1.0 else f"{value:.1f} ms"
 
 
 class ProcessingPanel(QtWidgets.QWidget):
