@@ -518,10 +518,11 @@ class MainWindow(QtWidgets.QMainWindow):
         now = time.perf_counter()
         recent = [t for t in self._draw_times if now - t <= 1.0]
         rendered = len(recent)
-        self.fps_label.setText(
-            f" rendered {rendered:d} fps · simulated {self.sim.rate_fps:.1f} fps"
-            + (" (done)" if self.cache.complete else "")
+        text = f" rendered {rendered:d} fps · simulated {self.sim.rate_fps:.1f} fps" + (
+            " (done)" if self.cache.complete else ""
         )
+        if text != self.fps_label.text():  # a label's setText re-lays out its bar
+            self.fps_label.setText(text)
         if now - self._t_timing_shown >= 0.5:  # the timing panel twice a second
             self._t_timing_shown = now
             costs = sorted(self._draw_costs_s)
