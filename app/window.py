@@ -40,9 +40,6 @@ from core.errors import InputError
 
 DRAW_INTERVAL_MS = 15  # GUI draw timer: at most ~66 redraws per second, stale frames dropped
 RETRACK_EVERY_N_FRAMES = 20  # while the simulation fills the cache
-#: while playing, a new frame is drawn at once unless the last redraw is younger than this (at
-#: 8x the frames come every 10 ms: every other one is drawn, 50 redraws/s)
-MIN_PLAY_DRAW_S = 0.012
 
 
 class MainWindow(QtWidgets.QMainWindow):
@@ -154,7 +151,7 @@ class MainWindow(QtWidgets.QMainWindow):
         )
         self.tracking_model.changed.connect(self._on_tracking_changed)
         self.params_model.changed.connect(self._on_params_changed)
-        self.playback.frame_changed.connect(self._on_frame_changed)
+        self.playback.frame_changed.connect(self._mark_dirty)
         for panel in (self.scene_panel, self.radar_panel, self.tracker_panel, self.study_panel):
             panel.error.connect(self.show_error)
         self.radar_panel.load_cfg_requested.connect(self.scene_control.load_cfg_dialog)
@@ -185,7 +182,6 @@ class MainWindow(QtWidgets.QMainWindow):
         self._draw_costs_s: deque[float] = deque(maxlen=60)
         self._track_ms_per_frame = float("nan")
         self._t_timing_shown = 0.0
-        self._t_last_draw = 0.0
         self.n_draws = 0
 
         if restore:
@@ -467,14 +463,6 @@ class MainWindow(QtWidgets.QMainWindow):
     def _mark_dirty(self, *_args) -> None:
         self._dirty = True
 
-    def _on_frame_changed(self, *_args) -> None:
-        """While playing, draw the new frame at once (the play timer paces the redraws; a draw
-        timer tick between two frames found nothing new and cost a frame at 4x); otherwise mark
-        it for the draw timer."""
-        self._dirty = True
-        if self.playback.playing and time.perf_counter() - self._t_last_draw >= MIN_PLAY_DRAW_S:
-            self._draw()
-
     def _on_view_options(self, *_args) -> None:
         self.top_view.set_colour_by(self.colour_combo.currentData())
         self.top_view.persistence = self.persistence_spin.value()
@@ -510,7 +498,6 @@ class MainWindow(QtWidgets.QMainWindow):
         self._show_metrics(index, result)
         self.n_draws += 1
         now = time.perf_counter()
-        self._t_last_draw = now
         self._draw_times.append(now)
         self._draw_costs_s.append(now - t0)
         self._update_fps()
