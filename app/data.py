@@ -141,6 +141,9 @@ class TrackingResult:
         Identifies the parameter vector the run used (drop stale results).
     elapsed_s
         Wall-clock time of the tracker run plus preparation, in s.
+    engine
+        ``"numba"`` or ``"numpy"`` (the readable tracker, equal to round-off, while the
+        compiled kernel is still being compiled on a cold start).
     """
 
     frames: tuple[TrackFrame, ...]
@@ -158,6 +161,8 @@ class TrackingResult:
     trail_id: np.ndarray
     params_key: str = ""
     elapsed_s: float = 0.0
+    #: the tracker that ran: "numba" (compiled kernel) or "numpy" (readable, until compiled)
+    engine: str = "numba"
 
     @property
     def n_frames(self) -> int:
@@ -177,6 +182,10 @@ class ParamSpec:
     high: float
     log: bool
     label: str = ""
+    #: SI unit of the value ("" for probabilities), from core/tracking/space.py
+    unit: str = ""
+    #: ``symbol meaning`` without the unit (the slider's first line)
+    title: str = ""
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -225,6 +234,8 @@ class StudyProgress:
     #: best-so-far loss against wall-clock seconds since the first trial started
     curve_t_s: np.ndarray = field(default_factory=lambda: np.zeros(0))
     curve_best: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    #: why trials failed: (reason, number of trials), most frequent first
+    failures: tuple[tuple[str, int], ...] = ()
 
     @property
     def n_finished(self) -> int:

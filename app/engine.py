@@ -13,6 +13,8 @@ import os
 import socket
 import subprocess
 import sys
+import tempfile
+import threading
 import time
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
@@ -170,7 +172,15 @@ def param_specs(model: str) -> list[ParamSpec]:
     from core.tracking.space import search_space
 
     return [
-        ParamSpec(name=p.name, low=p.low, high=p.high, log=p.log, label=p.label)
+        ParamSpec(
+            name=p.name,
+            low=p.low,
+            high=p.high,
+            log=p.log,
+            label=p.label,
+            unit=p.unit,
+            title=f"{p.symbol} {p.meaning}",
+        )
         for p in search_space(model)
     ]
 
@@ -247,6 +257,20 @@ def frame_views(rd_map_db, truth_xy_m: np.ndarray, radar: RadarConfig, settings)
     return {"cfar_threshold_db": th_db, "person_doppler_db": person_db}
 
 
+def fidelity_levels() -> list[str]:
+    """Simulator levels, most faithful first (the keys of ``core.simulation.LEVELS``)."""
+    from core.simulation import LEVELS
+
+    return list(LEVELS)
+
+
+def processing_settings(scene) -> dict:
+    """The processing chain's settings for ``scene`` (windows, CFAR stages, ranges) as JSON."""
+    from core.pipeline import processing_settings as _settings
+
+    return _settings(scene).to_dict()
+
+
 # ---- tracking ---------------------------------------------------------------------------------
 def _truth0(frames: Sequence[FrameData]) -> np.ndarray:
     return np.array(
@@ -265,15 +289,42 @@ def _ospa_per_frame(frames: Sequence[FrameData], confirmed_xy: Sequence[np.ndarr
     return out
 
 
+#: set once the compiled tracker kernel is loaded or compiled (:func:`warm_up_tracker`)
+TRACKER_COMPILED = threading.Event()
+
+
+def warm_up_tracker() -> float:
+    """Load (or, on a cold cache, compile) the compiled tracker kernel on a two-frame problem;
+    run in a background thread at start. Until it returns, :func:`track` uses the readable numpy
+    tracker (the same result to round-off). Returns the seconds it took."""
+    from core.tracking import TrackerParams, run_tracker
+
+    t0 = time.perf_counter()
+    z = np.array([[3.0, 0.1, 0.5], [3.04, 0.1, 0.5]])
+    run_tracker((z, np.array([0, 1, 2])), TrackerParams(), 0.08, keep_tracks=True, engine="numba")
+    TRACKER_COMPILED.set()
+    return time.perf_counter() - t0
+
+
+def tracker_compiled() -> bool:
+    return TRACKER_COMPILED.is_set()
+
+
 def track(
-    frames: Sequence[FrameData], params, frame_period_s: float, *, key: str = ""
+    frames: Sequence[FrameData],
+    params,
+    frame_period_s: float,
+    *,
+    key: str = "",
+    engine: str = "numba",
 ) -> TrackingResult:
     """Re-track the cached point clouds with the compiled kernel, recording every track of every
     frame (ids, ψ, status, gates), and prepare everything the overlay draws, in one step.
 
     ``run_tracker(..., engine="numba")``: the readable tracker's result (equal to round-off) in
     milliseconds. The loss follows eqs. (12)–(13) against person 0 (the paper's single-person
-    scenes).
+    scenes). ``engine="numpy"``: the readable tracker (the GUI's choice until
+    :data:`TRACKER_COMPILED` is set, so that a cold start shows tracks while numba compiles).
     """
     from core.tracking import run_tracker
 
@@ -285,7 +336,7 @@ def track(
         else np.zeros((0, 3))
     )
     f_off = np.concatenate(([0], np.cumsum(counts))).astype(np.int64)
-    res = run_tracker((z, f_off), params, frame_period_s, keep_tracks=True, engine="numba")
+    res = run_tracker((z, f_off), params, frame_period_s, keep_tracks=True, engine=engine)
     tfs, conf_list = [], []
     ids_l, t_l, xy_l, psi_l, conf_l = [], [], [], [], []
     for k, ft in enumerate(res.frames):
@@ -329,6 +380,7 @@ def track(
         trail_id=ids,
         params_key=key,
         elapsed_s=time.perf_counter() - t0,
+        engine=engine,
     )
 
 
@@ -418,9 +470,11 @@ class StudyProcesses:
 
 
 def storage_url(storage: str) -> str:
-    from core.optimization import normalize_url
+    """The storage's canonical URL with a file path made absolute (relative to this process's
+    working folder), so that a helper process started elsewhere opens the same file."""
+    from core.optimization.storage import absolute_url
 
-    return normalize_url(storage)
+    return absolute_url(storage)
 
 
 def scene_dataset(frames: Sequence[FrameData], scene, path: Path) -> Path:
@@ -487,6 +541,7 @@ def study_progress(form):
     else:
         t, best_curve = np.zeros(0), np.zeros(0)
     return StudyProgress(
+        failures=failure_reasons(summaries),
         n_complete=states.count("COMPLETE"),
         n_pruned=states.count("PRUNED"),
         n_failed=states.count("FAIL"),
@@ -497,6 +552,17 @@ def study_progress(form):
         curve_t_s=t,
         curve_best=best_curve,
     )
+
+
+def failure_reasons(summaries, n_max: int = 5) -> tuple[tuple[str, int], ...]:
+    """The distinct reasons of the FAIL trials with how many trials each, most frequent first
+    (at most ``n_max``); a trial without a recorded reason counts as "no reason recorded"."""
+    counts: dict[str, int] = {}
+    for s in summaries:
+        if s.state == "FAIL":
+            reason = getattr(s, "error", "") or "no reason recorded (see the workers' log)"
+            counts[reason] = counts.get(reason, 0) + 1
+    return tuple(sorted(counts.items(), key=lambda kv: (-kv[1], kv[0]))[:n_max])
 
 
 def enqueue_trial(form, values: dict[str, float], model: str) -> None:
@@ -522,8 +588,14 @@ class Dashboard:
         )
         cmd = [sys.executable, "-m", "core.cli", "dashboard", "--storage", storage]
         cmd += ["--port", str(self.port), "--no-browser"]
+        # the storage is an absolute URL (serve_dashboard); the process runs in the temporary
+        # folder, never in the install folder, so nothing it may write lands in the checkout
         self._proc = subprocess.Popen(
-            cmd, cwd=str(ROOT), env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL
+            cmd,
+            cwd=tempfile.gettempdir(),
+            env=env,
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.DEVNULL,
         )
 
     def alive(self) -> bool:
@@ -560,7 +632,11 @@ class Engine:
     default_extra = staticmethod(default_extra)
     make_params = staticmethod(make_params)
     simulate = staticmethod(simulate)
+    fidelity_levels = staticmethod(fidelity_levels)
+    processing_settings = staticmethod(processing_settings)
     track = staticmethod(track)
+    warm_up_tracker = staticmethod(warm_up_tracker)
+    tracker_compiled = staticmethod(tracker_compiled)
     read_ti_cfg = staticmethod(read_ti_cfg)
     scene_dataset = staticmethod(scene_dataset)
     start_study = staticmethod(start_study)

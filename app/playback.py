@@ -150,7 +150,9 @@ class PlaybackController(QtCore.QObject):
     def update_frame_label(self) -> None:
         total = self.cache.expected or len(self.cache)
         t = self.model.frame * self.frame_period_s
+        n = len(self.cache)
+        # the total once: "(of N)" only while the simulation still fills the cache
+        filling = f" (of {total} simulated)" if n < total else ""
         self.frame_label.setText(
-            f" frame {self.model.frame + 1 if len(self.cache) else 0} / {len(self.cache)}"
-            f" (of {total}) · {t:5.2f} s"
+            f" frame {self.model.frame + 1 if n else 0} / {n}{filling} · {t:5.2f} s"
         )

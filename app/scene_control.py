@@ -9,6 +9,7 @@ updates its views) and re-simulated after a short debounce, so a burst of edits 
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 from PySide6 import QtCore, QtWidgets
@@ -148,9 +149,35 @@ class SceneController(QtCore.QObject):
         spec = "paper" if radar == PAPER_RADAR else radar.to_dict()
         try:
             self.scene_model.edit(radar=spec)
+            return
         except InputError as exc:
-            self.error.emit(str(exc))
-            self.radar_model.set_radar(scene.radar)
+            refused = exc
+        aoi = dict(self.scene_model.document.get("aoi") or {})
+        # the area of interest reaches beyond the radar's maximum range: offer to shrink it
+        max_range_m = math.floor(radar.max_range_m * 100.0) / 100.0  # 1 cm inside the limit
+        if aoi.get("max_range_m", 0.0) > radar.max_range_m and self.ask_shrink_aoi(
+            aoi["max_range_m"], max_range_m
+        ):
+            try:
+                self.scene_model.edit(radar=spec, aoi={**aoi, "max_range_m": max_range_m})
+                self.message.emit(f"area of interest shrunk to {max_range_m:g} m for this radar")
+                return
+            except InputError as exc:
+                refused = exc
+        self.error.emit(str(refused))
+        self.radar_model.set_radar(scene.radar)
+
+    def ask_shrink_aoi(self, aoi_max_m: float, radar_max_m: float) -> bool:
+        """Ask whether to shrink the area of interest to the radar's maximum range."""
+        answer = QtWidgets.QMessageBox.question(
+            self._window,
+            "Radar range shorter than the area of interest",
+            f"This radar sees up to {radar_max_m:g} m, the area of interest reaches "
+            f"{aoi_max_m:g} m.\n\nShrink the area of interest to {radar_max_m:g} m?",
+            QtWidgets.QMessageBox.Yes | QtWidgets.QMessageBox.No,
+            QtWidgets.QMessageBox.Yes,
+        )
+        return answer == QtWidgets.QMessageBox.Yes
 
     def stop(self) -> None:
         self.timer.stop()

@@ -1,6 +1,9 @@
 """Screenshots of the running app for the user guide, one per view.
 
     QT_QPA_PLATFORM=offscreen python -m app.screenshots --out docs/screenshots
+    QT_QPA_PLATFORM=xcb xvfb-run -a -s "-screen 0 1920x1080x24" python -m app.screenshots
+
+The second form (Xvfb, Qt's real xcb platform) made the committed ones.
 
 Runs the real window on the paper scene (simulated through the radar chain, tracked with the
 default parameters), optionally runs a short study on the scene's point clouds (``--study N``)
@@ -77,6 +80,8 @@ def main(argv: list[str] | None = None) -> int:
     w.redraw()
     w.docks["Tracker"].raise_()
     w.docks["Scene"].raise_()
+    qa.processEvents()
+    w.redraw()
     save(w, "main_window.png")
     save(w.top_view, "top_view_snr.png")
     w.colour_combo.setCurrentIndex(w.colour_combo.findData("label"))
@@ -90,6 +95,7 @@ def main(argv: list[str] | None = None) -> int:
         ("Radar", "radar_panel.png"),
         ("Tracker", "tracker_panel.png"),
         ("Study", "study_panel.png"),
+        ("Processing", "processing_panel.png"),
     ):
         w.docks[title].raise_()
         save(w.docks[title], name)

@@ -37,6 +37,7 @@ def progress_to_dict(p) -> dict:
         "best_model": p.best_model,
         "curve_t_s": [float(v) for v in p.curve_t_s],
         "curve_best": [float(v) for v in p.curve_best],
+        "failures": [[reason, int(n)] for reason, n in p.failures],
     }
 
 
@@ -55,6 +56,7 @@ def progress_from_dict(d: dict):
         best_model=str(d["best_model"]),
         curve_t_s=np.asarray(d["curve_t_s"], dtype=float),
         curve_best=np.asarray(d["curve_best"], dtype=float),
+        failures=tuple((str(r), int(n)) for r, n in d.get("failures", [])),
     )
 
 

@@ -23,6 +23,7 @@ from app.models import (
     TrackerParamsModel,
     TrackingModel,
 )
+from app.panels.processing_panel import ProcessingPanel
 from app.panels.radar_panel import RadarPanel
 from app.panels.scene_panel import ScenePanel
 from app.panels.study_panel import StudyPanel
@@ -37,7 +38,7 @@ from app.workers import SimulationController, TrackingController, freeze_heap
 from core.config import PAPER_RADAR
 from core.errors import InputError
 
-DRAW_INTERVAL_MS = 30  # GUI draw timer: at most ~33 redraws per second, stale frames dropped
+DRAW_INTERVAL_MS = 15  # GUI draw timer: at most ~66 redraws per second, stale frames dropped
 RETRACK_EVERY_N_FRAMES = 20  # while the simulation fills the cache
 
 
@@ -92,6 +93,7 @@ class MainWindow(QtWidgets.QMainWindow):
         central.addWidget(right)
         central.setSizes([620, 480])
         self.central_splitter, self.right_splitter = central, right
+        self.compact = False
         self.setCentralWidget(central)
 
         # ---- panels in docks -----------------------------------------------------------------
@@ -104,6 +106,10 @@ class MainWindow(QtWidgets.QMainWindow):
         self._dock("Radar", self.radar_panel, QtCore.Qt.LeftDockWidgetArea)
         self._dock("Tracker", self.tracker_panel, QtCore.Qt.RightDockWidgetArea)
         self._dock("Study", self.study_panel, QtCore.Qt.RightDockWidgetArea)
+        # issue 17: fidelity level, processing settings and timing (app/panels/processing_panel)
+        self.processing_panel = ProcessingPanel(self.engine.fidelity_levels())
+        self._dock("Processing", self.processing_panel, QtCore.Qt.LeftDockWidgetArea)
+        self.tabifyDockWidget(self.docks["Radar"], self.docks["Processing"])
         self.tabifyDockWidget(self.docks["Scene"], self.docks["Radar"])
         self.tabifyDockWidget(self.docks["Tracker"], self.docks["Study"])
         self.docks["Scene"].raise_()
@@ -138,6 +144,7 @@ class MainWindow(QtWidgets.QMainWindow):
 
         # ---- wiring ----------------------------------------------------------------------------
         self.scene_control.info_changed.connect(self._on_scene_info)
+        self.processing_panel.fidelity_changed.connect(self.set_fidelity)
         self.scene_control.error.connect(self.show_error)
         self.scene_control.message.connect(lambda m: self.statusBar().showMessage(m, 5000))
         self.cache.reset.connect(self._on_cache_reset)
@@ -146,6 +153,9 @@ class MainWindow(QtWidgets.QMainWindow):
         self.sim.failed.connect(lambda m: self.show_error(f"simulation failed: {m}"))
         self.tracker.failed.connect(lambda m: self.show_error(f"tracking failed: {m}"))
         self.tracker.finished.connect(self._on_tracked)
+        self.tracker.compiled.connect(
+            lambda t: self.statusBar().showMessage(f"compiled tracker ready ({t:.1f} s)", 5000)
+        )
         self.tracking_model.changed.connect(self._on_tracking_changed)
         self.params_model.changed.connect(self._on_params_changed)
         self.playback.frame_changed.connect(self._mark_dirty)
@@ -154,7 +164,9 @@ class MainWindow(QtWidgets.QMainWindow):
         self.radar_panel.load_cfg_requested.connect(self.scene_control.load_cfg_dialog)
         self.scene_panel.draw_mode_changed.connect(self.top_view.set_draw_mode)
         self.top_view.waypoint_added.connect(self.scene_panel.append_waypoint)
-        self.top_view.waypoints_moved.connect(self.scene_panel.set_waypoints)
+        self.top_view.waypoints_moved.connect(self._on_waypoints_dragged)
+        self.scene_model.selection_changed.connect(self._show_selected_waypoints)
+        self.scene_model.selection_changed.connect(self.top_view.set_selected_person)
         self.tracker_panel.apply_best_requested.connect(self.apply_best)
         self.study_panel.apply_best_requested.connect(self.apply_best)
         self.study_panel.start_requested.connect(self.start_study)
@@ -174,10 +186,15 @@ class MainWindow(QtWidgets.QMainWindow):
         self._draw_timer.start()
         self._dirty = True
         self._draw_times: deque[float] = deque(maxlen=60)
+        self._draw_costs_s: deque[float] = deque(maxlen=60)
+        self._track_ms_per_frame = float("nan")
+        self._t_timing_shown = 0.0
         self.n_draws = 0
 
         if restore:
             self.restore_settings()
+        else:
+            self.fit_screen()
         if load_scene:
             self.scene_control.load_initial(scene_path)
         freeze_heap()
@@ -239,12 +256,66 @@ class MainWindow(QtWidgets.QMainWindow):
             view_menu.addAction(dock.toggleViewAction())
 
     def _build_status(self) -> None:
-        self.retrack_label = QtWidgets.QLabel()
+        # until the first frame: what is happening (a first start compiles the radar chain)
+        self.retrack_label = QtWidgets.QLabel(
+            "re-track: waiting for the first simulated frame (the first start after an install "
+            "compiles the radar chain)"
+        )
         self.retrack_label.setObjectName("retrackLabel")
         self.metrics_label = QtWidgets.QLabel()
         self.metrics_label.setObjectName("metricsLabel")
         self.statusBar().addPermanentWidget(self.metrics_label)
         self.statusBar().addPermanentWidget(self.retrack_label)
+
+    # ---- layout ----
+    def fit_screen(self, available: QtCore.QRect | None = None) -> None:
+        """First start: a window that fits the screen (1366×768 up, at 100 % or 150 %).
+
+        The panels share one tabbed dock on the right, as wide as the widest panel, so that the
+        top view keeps the width its locked aspect needs to show the whole area of interest
+        (with docks on both sides a 1920-px window showed 29 m for the 10 m area); the central
+        splitter gives the top view 60 % of what is left, or, on a very small logical screen
+        (1366×768 at 150 %), the top view goes above the two plots.
+        """
+        if available is None:
+            screen = self.screen() or QtWidgets.QApplication.primaryScreen()
+            available = screen.availableGeometry()
+        width = min(1800, available.width())
+        height = min(1000, available.height())
+        self.resize(width, height)
+        order = tuple(self.docks)
+        for title in order:
+            self.addDockWidget(QtCore.Qt.RightDockWidgetArea, self.docks[title])
+        for title in order[1:]:
+            self.tabifyDockWidget(self.docks[order[0]], self.docks[title])
+        self.docks["Scene"].raise_()
+        # wide enough for every panel's own minimum: no horizontal scroll bar in the dock
+        dock_w = max(self.panel_width(d) for d in self.docks.values())
+        self.resizeDocks([self.docks["Scene"]], [dock_w], QtCore.Qt.Horizontal)
+        centre = max(400, width - dock_w - 20)
+        if centre < 700:  # e.g. 1366x768 at 150 %: the plots under the top view
+            self.set_compact(True)
+            h = max(300, height - 150)
+            self.central_splitter.setSizes([h * 3 // 5, h - h * 3 // 5])
+            self.right_splitter.setSizes([centre * 11 // 20, centre - centre * 11 // 20])
+        else:
+            # the top view 60 %: the area of interest is wider (±60°) than deep
+            self.central_splitter.setSizes([centre * 3 // 5, centre - centre * 3 // 5])
+
+    def set_compact(self, compact: bool) -> None:
+        """Compact layout for small screens: the top view above, range-Doppler and ψ side by
+        side below it (the normal layout: top view left, the two plots stacked right)."""
+        self.compact = bool(compact)
+        vertical, horizontal = QtCore.Qt.Vertical, QtCore.Qt.Horizontal
+        self.central_splitter.setOrientation(vertical if compact else horizontal)
+        self.right_splitter.setOrientation(horizontal if compact else vertical)
+
+    @staticmethod
+    def panel_width(dock: QtWidgets.QDockWidget) -> int:
+        """The width a dock needs to show its panel without a horizontal scroll bar."""
+        scroll = dock.widget()
+        bar_w = scroll.verticalScrollBar().sizeHint().width()
+        return max(300, scroll.widget().minimumSizeHint().width() + bar_w + 4)
 
     # ---- errors ----
     def show_error(self, message: str) -> None:
@@ -277,11 +348,32 @@ class MainWindow(QtWidgets.QMainWindow):
         )
         self.top_view.set_reflectors(info.reflectors_xy_m)
         self.top_view.set_truth_paths(info.truth_paths)
-        doc = self.scene_model.document
-        sel = self.scene_model.selected_person
-        traj = doc["persons"][sel]["trajectory"] if doc.get("persons") else {}
-        self.top_view.set_waypoints(traj.get("waypoints"))
+        self._show_selected_waypoints()
+        self.top_view.set_selected_person(self.scene_model.selected_person)
         self.rd_view.set_radar(info.radar)
+        if self.scene_model.scene is not None:
+            self.processing_panel.show_settings(
+                self.engine.processing_settings(self.scene_model.scene)
+            )
+
+    def set_fidelity(self, name: str) -> None:
+        """Simulate the scene again at another fidelity level (a key of the core registry)."""
+        if name != self.sim.fidelity:
+            self.sim.fidelity = name
+            self.processing_panel.set_fidelity(name)
+            self.scene_control.resimulate()
+
+    def _show_selected_waypoints(self, *_args) -> None:
+        """The top view's handles: the selected person's waypoints (none for classes a–e)."""
+        persons = self.scene_model.document.get("persons") or []
+        sel = self.scene_model.selected_person
+        traj = persons[sel]["trajectory"] if 0 <= sel < len(persons) else {}
+        self.top_view.set_waypoints(traj.get("waypoints"))
+
+    def _on_waypoints_dragged(self, rows: list) -> None:
+        """A drag the scene refuses (e.g. outside the area of interest) puts the handles back."""
+        if not self.scene_panel.set_waypoints(rows):
+            self._show_selected_waypoints()
 
     # ---- tracker parameters ----
     def load_params_dialog(self) -> None:
@@ -348,6 +440,8 @@ class MainWindow(QtWidgets.QMainWindow):
         self._dirty = True
 
     def _on_frames_added(self, n: int) -> None:
+        if n == 1:  # the radar chain is compiled: now the tracker kernel (priority order)
+            self.tracker.start_warm_up()
         if n == 1 or n % RETRACK_EVERY_N_FRAMES == 0:
             self.tracker.request()
         if self.playback.frame >= n - 1:
@@ -359,7 +453,13 @@ class MainWindow(QtWidgets.QMainWindow):
 
     def _on_tracked(self, elapsed_s: float) -> None:
         n = self.tracking_model.result.n_frames if self.tracking_model.result else len(self.cache)
-        self.retrack_label.setText(f"re-track {n} frames: {elapsed_s * 1e3:.0f} ms")
+        result = self.tracking_model.result
+        numpy = result is not None and result.engine == "numpy"
+        self.retrack_label.setText(
+            f"re-track {n} frames: {elapsed_s * 1e3:.0f} ms"
+            + (" (readable numpy tracker while the compiled one compiles)" if numpy else "")
+        )
+        self._track_ms_per_frame = elapsed_s * 1e3 / max(n, 1)
         self.tracker_panel.show_timing(elapsed_s, n)
 
     def _on_tracking_changed(self, result) -> None:
@@ -394,6 +494,7 @@ class MainWindow(QtWidgets.QMainWindow):
         self.redraw()
 
     def redraw(self) -> None:
+        t0 = time.perf_counter()
         frames = self.cache.frames
         index = self.playback.frame
         result = self.tracking_model.result
@@ -404,7 +505,9 @@ class MainWindow(QtWidgets.QMainWindow):
         self.views_control.redraw(index, frame, result)  # radar views and track table
         self._show_metrics(index, result)
         self.n_draws += 1
-        self._draw_times.append(time.perf_counter())
+        now = time.perf_counter()
+        self._draw_times.append(now)
+        self._draw_costs_s.append(now - t0)
         self._update_fps()
 
     def _show_metrics(self, index: int, result) -> None:
@@ -423,10 +526,21 @@ class MainWindow(QtWidgets.QMainWindow):
         now = time.perf_counter()
         recent = [t for t in self._draw_times if now - t <= 1.0]
         rendered = len(recent)
-        self.fps_label.setText(
-            f" rendered {rendered:d} fps · simulated {self.sim.rate_fps:.1f} fps"
-            + (" (done)" if self.cache.complete else "")
+        text = f" rendered {rendered:d} fps · simulated {self.sim.rate_fps:.1f} fps" + (
+            " (done)" if self.cache.complete else ""
         )
+        if text != self.fps_label.text():  # a label's setText re-lays out its bar
+            self.fps_label.setText(text)
+        if now - self._t_timing_shown >= 0.5:  # the timing panel twice a second
+            self._t_timing_shown = now
+            costs = sorted(self._draw_costs_s)
+            self.processing_panel.show_timing(
+                chain_ms=self.sim.ms_per_frame,
+                track_ms=self._track_ms_per_frame,
+                draw_ms=costs[len(costs) // 2] * 1e3 if costs else float("nan"),
+                sim_fps=self.sim.rate_fps,
+                draw_fps=rendered,
+            )
 
     # ---- study ----
     def start_study(self) -> None:
@@ -490,6 +604,7 @@ class MainWindow(QtWidgets.QMainWindow):
         s.setValue("window/state", self.saveState())
         s.setValue("window/central_splitter", self.central_splitter.saveState())
         s.setValue("window/right_splitter", self.right_splitter.saveState())
+        s.setValue("window/compact", bool(self.compact))
         s.setValue("playback/speed", float(self.playback.speed))
         s.setValue("view/colour_by", str(self.top_view.colour_by))
         s.setValue("view/persistence", int(self.top_view.persistence))
@@ -511,10 +626,12 @@ class MainWindow(QtWidgets.QMainWindow):
         if geometry is not None and not geometry.isEmpty():
             self.restoreGeometry(geometry)
         else:
-            self.resize(1500, 900)
+            self.fit_screen()
         state = s.value("window/state", type=QtCore.QByteArray)
         if state is not None and not state.isEmpty():
             self.restoreState(state)
+        if s.value("window/compact", False, type=bool):
+            self.set_compact(True)
         for key, splitter in (
             ("window/central_splitter", self.central_splitter),
             ("window/right_splitter", self.right_splitter),

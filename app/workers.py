@@ -8,7 +8,9 @@ from __future__ import annotations
 
 import threading
 import time
+from collections import deque
 
+import numpy as np
 from PySide6 import QtCore
 
 from app.data import TrackingResult
@@ -43,16 +45,24 @@ class SimulationWorker(QtCore.QThread):
         self._scene = scene
         self.generation = generation
         self._stop = threading.Event()
+        self.fidelity = "exact"
+        #: seconds per simulated frame (radar chain: synthesis and processing), latest last
+        self.frame_times_s: deque[float] = deque(maxlen=50)
 
     def stop(self) -> None:
         self._stop.set()
 
     def run(self) -> None:  # worker thread
         try:
-            for frame in self._engine.simulate(self._scene):
+            frames = self._engine.simulate(self._scene, fidelity=self.fidelity)
+            t0 = time.perf_counter()
+            for frame in frames:
+                t1 = time.perf_counter()
+                self.frame_times_s.append(t1 - t0)  # synthesis + processing of one frame
                 if self._stop.is_set():
                     return
                 self.frame_ready.emit(self.generation, frame)
+                t0 = time.perf_counter()
             if not self._stop.is_set():
                 self.done.emit(self.generation)
         except Exception as exc:  # any failure becomes a message, never a crash
@@ -74,6 +84,8 @@ class SimulationController(QtCore.QObject):
         self._old: list[SimulationWorker] = []
         self._t_start = 0.0
         self.rate_fps = 0.0
+        #: simulator level of the next start (a key of core.simulation.LEVELS)
+        self.fidelity = "exact"
 
     def start(self, scene) -> None:
         """(Re)simulate ``scene``; a running simulation of an older scene is abandoned."""
@@ -81,6 +93,7 @@ class SimulationController(QtCore.QObject):
         info = self._engine.scene_info(scene)
         self._cache.clear(expected=info.n_frames, truth_paths=info.truth_paths)
         worker = SimulationWorker(self._engine, scene, self._cache.generation, self)
+        worker.fidelity = self.fidelity
         worker.frame_ready.connect(self._on_frame)
         worker.done.connect(self._on_done)
         worker.failed.connect(self._on_failed)
@@ -120,6 +133,16 @@ class SimulationController(QtCore.QObject):
     def running(self) -> bool:
         return self._worker is not None and self._worker.isRunning()
 
+    @property
+    def ms_per_frame(self) -> float:
+        """Median radar-chain time per frame of the current simulation (NaN before a frame;
+        the first frame, which may compile kernels, is left out once there are others)."""
+        w = self._worker or (self._old[-1] if self._old else None)
+        times = list(w.frame_times_s) if w is not None else []
+        if len(times) > 1:
+            times = times[1:]
+        return float(np.median(times)) * 1e3 if times else float("nan")
+
     def _on_frame(self, generation: int, frame) -> None:
         if generation != self._cache.generation:
             return  # stale: from an abandoned scene
@@ -142,6 +165,7 @@ class _Signals(QtCore.QObject):
     result = QtCore.Signal(int, object)
     failed = QtCore.Signal(int, str)
     done = QtCore.Signal(int)
+    compiled = QtCore.Signal()
 
 
 class _TrackJob(QtCore.QRunnable):
@@ -160,7 +184,10 @@ class _TrackJob(QtCore.QRunnable):
         engine, frames, params, frame_period_s, key = self._args
         try:
             if self._latest() == self._ticket:
-                result = engine.track(frames, params, frame_period_s, key=key)
+                # the readable numpy tracker until the compiled kernel is ready (cold start)
+                compiled = getattr(engine, "tracker_compiled", lambda: True)()
+                kw = {} if compiled else {"engine": "numpy"}
+                result = engine.track(frames, params, frame_period_s, key=key, **kw)
                 self._signals.result.emit(self._ticket, result)
         except Exception as exc:
             log_exception("re-tracking failed", exc)
@@ -178,6 +205,7 @@ class TrackingController(QtCore.QObject):
 
     failed = QtCore.Signal(str)
     finished = QtCore.Signal(float)  # elapsed s of the re-track (tracker + overlay preparation)
+    compiled = QtCore.Signal(float)  # the compiled tracker is ready (seconds it took)
 
     def __init__(
         self,
@@ -211,6 +239,34 @@ class TrackingController(QtCore.QObject):
         self.last_elapsed_s = float("nan")
         self.n_runs = 0
         params.changed.connect(self.request)
+        self.compile_s = float("nan")  # seconds the compiled tracker took to load or compile
+        self._warming = False
+
+    def start_warm_up(self) -> None:
+        """Load or compile the tracker kernel in a background thread (a cold start compiles for
+        a minute or more); when ready, re-track with it (the numpy tracker's overlay is shown
+        meanwhile). The window calls this once the first frame is simulated: two compilations
+        at once share the GIL and delayed the first frame from 35 s to 171 s (app-06)."""
+        warm = getattr(self._engine, "warm_up_tracker", None)
+        if self._warming or warm is None or self._engine.tracker_compiled():
+            return
+        self._warming = True
+
+        def run() -> None:
+            try:
+                self.compile_s = warm()
+            except Exception as exc:  # the numpy tracker stays in use
+                log_exception("compiling the tracker kernel failed", exc)
+                return
+            self._signals.compiled.emit()
+
+        self._signals.compiled.connect(self._on_compiled)
+        threading.Thread(target=run, name="tracker-warm-up", daemon=True).start()
+
+    def _on_compiled(self) -> None:
+        self.compiled.emit(self.compile_s)
+        if self._cache.frames:
+            self.request()
 
     def request(self) -> None:
         self._timer.start()

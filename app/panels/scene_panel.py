@@ -5,11 +5,12 @@ from __future__ import annotations
 
 import random
 
-from PySide6 import QtCore, QtWidgets
+from PySide6 import QtCore, QtGui, QtWidgets
 
 from app.models import SceneModel
+from app.person_colours import person_colour
 from core.errors import InputError
-from core.limits import PERSON_HEIGHT_RANGE_M
+from core.limits import MAX_PERSONS, PERSON_HEIGHT_RANGE_M
 from core.scene.scene import DEFAULT_PERSON_MODEL, PERSON_MODELS, person_model_kind
 from core.scene.walking import DEFAULT_HEIGHT_M
 
@@ -449,6 +450,9 @@ class ScenePanel(QtWidgets.QWidget):
                 else:
                     desc = "explicit profile"
                 self.person_list.addItem(f"person {k}: {desc}")
+                swatch = QtGui.QPixmap(12, 12)
+                swatch.fill(QtGui.QColor(*person_colour(k)))
+                self.person_list.item(k).setIcon(QtGui.QIcon(swatch))
             sel = self.model.selected_person
             self.person_list.setCurrentRow(sel)
             person = persons[sel] if persons else {"trajectory": {}}
@@ -486,6 +490,10 @@ class ScenePanel(QtWidgets.QWidget):
                 ]
             )
             self.remove_button.setEnabled(len(persons) > 1)
+            full = len(persons) >= MAX_PERSONS
+            for b in (self.add_class_button, self.add_wp_button):
+                b.setEnabled(not full)
+                b.setToolTip(f"a scene holds at most {MAX_PERSONS} persons" if full else "")
         finally:
             for w in widgets:
                 w.blockSignals(False)

@@ -78,6 +78,13 @@ class StudyPanel(QtWidgets.QWidget):
         self.counts = QtWidgets.QLabel()
         self.counts.setObjectName("studyCounts")
         outer.addWidget(self.counts)
+        self.failures = QtWidgets.QLabel()
+        self.failures.setObjectName("studyFailures")
+        self.failures.setWordWrap(True)
+        self.failures.setTextInteractionFlags(QtCore.Qt.TextSelectableByMouse)
+        self.failures.setStyleSheet("color: #c0392b;")
+        self.failures.hide()
+        outer.addWidget(self.failures)
 
         self.curve_plot = pg.PlotWidget()
         self.curve_plot.setObjectName("studyCurve")
@@ -85,7 +92,9 @@ class StudyPanel(QtWidgets.QWidget):
         self.curve_plot.setLabel("bottom", "wall-clock time", units="s")
         self.curve_plot.setLabel("left", "loss L_t [m²]")
         self.curve_plot.setLogMode(y=True)
-        self.curve_plot.getAxis("left").enableAutoSIPrefix(False)
+        left = self.curve_plot.getAxis("left")
+        left.enableAutoSIPrefix(False)
+        left.setStyle(autoExpandTextSpace=True)
         self.curve_plot.setMinimumHeight(140)
         self.curve = self.curve_plot.plot(
             pen=pg.mkPen((255, 140, 0), width=2), symbol="o", symbolSize=4, stepMode=None
@@ -157,6 +166,29 @@ class StudyPanel(QtWidgets.QWidget):
         self.stop_button.setEnabled(running)
         self.progress_bar.setMaximum(f.n_trials)
 
+    def _decade_ticks(self, values: np.ndarray) -> None:
+        """Tick labels on whole decades only (``1e-5``): pyqtgraph's log axis labelled the 2…9
+        minor ticks too when the curve spans less than two decades, and they ran together."""
+        lo = math.floor(math.log10(float(values.min())))
+        hi = math.ceil(math.log10(float(values.max())))
+        if hi == lo:
+            hi += 1
+        step = max(1, (hi - lo + 5) // 6)  # at most ~6 labels
+        major = [(float(k), f"1e{k}") for k in range(lo, hi + 1, step)]
+        self.curve_plot.getAxis("left").setTicks([major, []])
+        self.curve_plot.setYRange(lo, hi, padding=0.02)
+
+    def show_failures(self, failures) -> None:
+        """Why trials failed, one line per distinct reason (hidden when none failed)."""
+        if not failures:
+            self.failures.hide()
+            self.failures.setText("")
+            return
+        lines = [f"{n} × {reason}" for reason, n in failures]
+        self.failures.setText("failed trials:\n" + "\n".join(lines))
+        self.failures.setToolTip("\n".join(lines))
+        self.failures.show()
+
     def show_progress(self, p: StudyProgress) -> None:
         self.progress_bar.setMaximum(max(self.model.form.n_trials, p.n_finished))
         self.progress_bar.setValue(p.n_finished)
@@ -165,9 +197,12 @@ class StudyPanel(QtWidgets.QWidget):
             f"complete {p.n_complete} · pruned {p.n_pruned} · failed {p.n_failed} · "
             f"running {p.n_running} · best loss {best}"
         )
+        self.show_failures(p.failures)
         if len(p.curve_t_s):
             ok = np.isfinite(p.curve_best) & (p.curve_best > 0)
             self.curve.setData(p.curve_t_s[ok], p.curve_best[ok])
+            if ok.any():
+                self._decade_ticks(p.curve_best[ok])
         else:
             self.curve.setData([], [])
         items = sorted(p.best_params.items())

@@ -33,6 +33,17 @@ def from_slider(spec: ParamSpec, position: int) -> float:
     return spec.low + u * (spec.high - spec.low)
 
 
+def bounds_text(spec: ParamSpec) -> str:
+    """The slider's label: ``symbol meaning`` over its bounds and unit (and the scale)."""
+    unit = f" {spec.unit}" if spec.unit else " (no unit)"
+    scale = ", log" if spec.log else ""
+    title = spec.title or spec.label or spec.name
+    return (
+        f"{title}<br><span style='color:gray; font-size:small'>"
+        f"{spec.low:g} … {spec.high:g}{unit}{scale}</span>"
+    )
+
+
 class ParamRow(QtCore.QObject):
     """Slider + spin box of one parameter; both edit the model."""
 
@@ -43,7 +54,8 @@ class ParamRow(QtCore.QObject):
         self.spec = spec
         self._model = model
         self._on_error = on_error
-        self.label = QtWidgets.QLabel((spec.label or spec.name) + (" (log)" if spec.log else ""))
+        self.label = QtWidgets.QLabel(bounds_text(spec))
+        self.label.setObjectName(f"label_{spec.name}")
         self.slider = QtWidgets.QSlider(QtCore.Qt.Horizontal)
         self.slider.setObjectName(f"slider_{spec.name}")
         self.slider.setRange(0, SLIDER_STEPS)
@@ -54,7 +66,12 @@ class ParamRow(QtCore.QObject):
         self.spin.setSingleStep((spec.high - spec.low) / 100)
         self.spin.setKeyboardTracking(False)
         self.spin.setMinimumWidth(80)
-        tip = f"{spec.name} ∈ [{spec.low:g}, {spec.high:g}]" + (", log scale" if spec.log else "")
+        if spec.unit:
+            self.spin.setSuffix(f" {spec.unit}")
+        unit = f" {spec.unit}" if spec.unit else ""
+        tip = f"{spec.name} ∈ [{spec.low:g}, {spec.high:g}]{unit}" + (
+            ", log scale" if spec.log else ""
+        )
         for w in (self.label, self.slider, self.spin):
             w.setToolTip(tip)
         layout.addWidget(self.label, row, 0)
@@ -146,7 +163,7 @@ class TrackerPanel(QtWidgets.QWidget):
         buttons.addWidget(self.reset_button)
         buttons.addWidget(self.apply_best_button)
         outer.addLayout(buttons)
-        self.timing = QtWidgets.QLabel("re-track: –")
+        self.timing = QtWidgets.QLabel("re-track: waiting for the first simulated frames")
         self.timing.setObjectName("retrackTiming")
         outer.addWidget(self.timing)
         outer.addStretch(1)

@@ -8,6 +8,7 @@ import pyqtgraph as pg
 from PySide6 import QtCore
 
 from app.data import TrackingResult
+from app.views.axis_cache import cache_axes
 
 
 class PsiView(pg.GraphicsLayoutWidget):
@@ -17,10 +18,10 @@ class PsiView(pg.GraphicsLayoutWidget):
         super().__init__(parent)
         self.setObjectName("psiView")
         self.psi_plot = self.addPlot(row=0, col=0)
-        self.psi_plot.setTitle("Existence probability ψ")
+        self.psi_plot.setTitle("existence probability ψ", size="9pt")
         self.psi_plot.setLabel("left", "ψ")
         self.psi_plot.setLabel("bottom", "time", units="s")
-        self.psi_plot.setYRange(0.0, 1.05, padding=0)
+        self.psi_plot.setYRange(-0.02, 1.08, padding=0)
         self.psi_plot.showGrid(y=True, alpha=0.2)
         self.psi_all = self.psi_plot.plot(pen=pg.mkPen((240, 220, 40, 120), width=1))
         self.psi_confirmed = self.psi_plot.plot(pen=pg.mkPen((0, 220, 90), width=2))
@@ -28,13 +29,15 @@ class PsiView(pg.GraphicsLayoutWidget):
             angle=0,
             pen=pg.mkPen((0, 220, 90), style=QtCore.Qt.DashLine),
             label="confirm {value:.2f}",
-            labelOpts={"position": 0.9, "color": (0, 220, 90), "anchors": [(1, 1), (1, 1)]},
+            # inside the plot at the left, below its line (between the two thresholds): clear of
+            # the axis, the title and the other label
+            labelOpts={"position": 0.02, "color": (0, 220, 90), "anchors": [(0, 0), (0, 0)]},
         )
         self.delete_line = pg.InfiniteLine(
             angle=0,
             pen=pg.mkPen((255, 80, 80), style=QtCore.Qt.DashLine),
             label="delete {value:.2f}",
-            labelOpts={"position": 0.9, "color": (255, 80, 80), "anchors": [(1, 0), (1, 0)]},
+            labelOpts={"position": 0.02, "color": (255, 80, 80), "anchors": [(0, 1), (0, 1)]},
         )
         self.psi_plot.addItem(self.confirm_line)
         self.psi_plot.addItem(self.delete_line)
@@ -42,10 +45,13 @@ class PsiView(pg.GraphicsLayoutWidget):
         self.psi_plot.addItem(self.cursor)
 
         self.metric_plot = self.addPlot(row=1, col=0)
-        self.metric_plot.setTitle("Running metrics")
+        self.metric_plot.setTitle("running metrics", size="9pt")
         self.metric_plot.setLabel("bottom", "time", units="s")
         self.metric_plot.setLabel("left", "RMSE, OSPA", units="m")
-        self.metric_plot.addLegend(offset=(5, 5))
+        # one row in the top right corner, translucent: the curves start at the left
+        self.metric_plot.addLegend(
+            offset=(-5, 5), colCount=2, brush=pg.mkBrush(0, 0, 0, 120), labelTextSize="8pt"
+        )
         self.metric_plot.setXLink(self.psi_plot)
         self.rmse_curve = self.metric_plot.plot(pen=pg.mkPen((255, 140, 0), width=2), name="RMSE")
         self.ospa_curve = self.metric_plot.plot(pen=pg.mkPen((60, 140, 255), width=1), name="OSPA")
@@ -60,6 +66,7 @@ class PsiView(pg.GraphicsLayoutWidget):
         self._result: TrackingResult | None = None
         self._metric_text = ""
         self.n_draws = 0
+        cache_axes(self.psi_plot, self.metric_plot)
 
     def set_thresholds(self, confirm: float, delete: float) -> None:
         self.confirm_line.setValue(confirm)

@@ -7,6 +7,7 @@ import pyqtgraph as pg
 from PySide6 import QtCore
 
 from app.data import FrameData
+from app.views.axis_cache import cache_axes
 from core.config import RadarConfig
 
 #: Fixed colour levels in dB relative to the map's noise floor estimate are not used: the map is
@@ -23,13 +24,20 @@ class RangeDopplerView(pg.GraphicsLayoutWidget):
         self.plot = self.addPlot(row=0, col=0)
         self.plot.setLabel("bottom", "radial velocity", units="m/s")
         self.plot.setLabel("left", "range", units="m")
-        self.plot.setTitle("Range-Doppler map (dB)")
+        # no title: its width was the plot's minimum width and pushed the colour bar out of a
+        # narrow view at 150 %; the axes and the colour bar's "dB" say what it is
+        self.setToolTip("range-Doppler map, dB (CFAR detections: red squares)")
         self.image = pg.ImageItem(axisOrder="row-major")
         self.plot.addItem(self.image)
         self.colorbar = pg.ColorBarItem(
-            values=(0.0, DEFAULT_LEVEL_SPAN_DB), colorMap=pg.colormap.get("viridis"), width=12
+            values=(0.0, DEFAULT_LEVEL_SPAN_DB),
+            colorMap=pg.colormap.get("viridis"),
+            width=12,
+            label="dB",
         )
-        self.colorbar.setImageItem(self.image, insert_in=self.plot)
+        # its own column of the layout (not inside the plot): its tick labels get their width
+        self.colorbar.setImageItem(self.image)
+        self.addItem(self.colorbar, row=0, col=1)
         self.detections = pg.ScatterPlotItem(
             size=9, symbol="s", pen=pg.mkPen("r", width=1.5), brush=None, pxMode=True
         )
@@ -39,6 +47,7 @@ class RangeDopplerView(pg.GraphicsLayoutWidget):
         self._radar: RadarConfig | None = None
         self._levels: tuple[float, float] | None = None
         self.n_draws = 0
+        cache_axes(self.plot, self.colorbar)
 
     def set_radar(self, radar: RadarConfig) -> None:
         """Axes from the radar: range bins → m, Doppler bins → m/s (zero velocity centred)."""

@@ -15,6 +15,9 @@ from PySide6 import QtCore, QtGui
 from app.colours import IDENTITY_PALETTE, LABEL_COLOURS, identity_colour, identity_index, label_key
 from app.data import FrameData, TrackFrame, TrackingResult
 from app.geometry import aoi_polyline, ellipse_polyline, trails_polyline
+from app.person_colours import person_colour
+from app.views.axis_cache import cache_axes
+from core.limits import MAX_PERSONS
 
 SNR_MIN_DB = 10.0
 SNR_MAX_DB = 50.0
@@ -51,7 +54,8 @@ class TopView(pg.PlotWidget):
         self.setLabel("left", "y", units="m")
         self.setTitle("Top view · points: SNR 10–50 dB")
         self.showGrid(x=True, y=True, alpha=0.2)
-        self.addLegend(offset=(5, 5))
+        # two columns, translucent: half the height over the plot
+        self.addLegend(offset=(5, 5), colCount=2, brush=pg.mkBrush(0, 0, 0, 140))
         self._snr_brushes = _snr_palette()
         self._label_brushes = {k: pg.mkBrush(*c, 220) for k, c in LABEL_COLOURS.items()}
         self._snr_array = np.empty(N_SNR_COLOURS, dtype=object)
@@ -72,9 +76,14 @@ class TopView(pg.PlotWidget):
             name="static reflector",
         )
         self.addItem(self.reflectors)
+        # the legend's entry; the paths themselves are one item per person (person_colour)
         self.truth_path = self.plot(
             pen=pg.mkPen((255, 255, 255, 110), width=1.5), connect="finite", name="truth path"
         )
+        self._person_paths: list[pg.PlotDataItem] = []
+        self._selected_person = 0
+        self._n_persons = 0
+        self._truth_brushes = [pg.mkPen(person_colour(k), width=1.5) for k in range(MAX_PERSONS)]
         self.points = pg.ScatterPlotItem(size=6, pen=None, name="points")
         self.addItem(self.points)
         self.trails = self.plot(pen=pg.mkPen((0, 220, 90, 150), width=1.5), connect="finite")
@@ -129,6 +138,7 @@ class TopView(pg.PlotWidget):
         self.last_n_points = 0
         self.last_n_tracks = 0
         self.set_aoi(0.5, 10.0, 60.0)
+        cache_axes(self.getPlotItem())
         # once the user pans or zooms, the view stays where they put it
         self.getPlotItem().vb.sigRangeChangedManually.connect(self._stop_auto_fit)
 
@@ -158,13 +168,32 @@ class TopView(pg.PlotWidget):
         self.reflectors.setData(xy[:, 0], xy[:, 1])
 
     def set_truth_paths(self, paths_m: Sequence[np.ndarray]) -> None:
-        """Full ground-truth path of every person, each ``(F_i, 2)`` in m."""
-        parts = []
-        for p in paths_m:
-            parts.append(np.asarray(p, dtype=float).reshape(-1, 2))
-            parts.append(np.full((1, 2), np.nan))
-        line = np.vstack(parts) if parts else np.zeros((0, 2))
-        self.truth_path.setData(line[:, 0], line[:, 1], connect="finite")
+        """Full ground-truth path of every person, each ``(F_i, 2)`` in m, one colour each."""
+        paths = [np.asarray(p, dtype=float).reshape(-1, 2) for p in paths_m]
+        while len(self._person_paths) < len(paths):  # items created once, reused
+            k = len(self._person_paths)
+            item = self.plot(connect="finite")
+            item.setZValue(self.truth_path.zValue())
+            self._person_paths.append(item)
+        for k, item in enumerate(self._person_paths):
+            if k < len(paths):
+                item.setData(paths[k][:, 0], paths[k][:, 1], connect="finite")
+            else:
+                item.setData([], [])
+        self._n_persons = len(paths)
+        self._style_person_paths()
+
+    def set_selected_person(self, index: int) -> None:
+        """Draw the selected person's path wider (the one the editor edits)."""
+        self._selected_person = int(index)
+        self._style_person_paths()
+
+    def _style_person_paths(self) -> None:
+        for k, item in enumerate(self._person_paths):
+            r, g, b = person_colour(k)
+            selected = k == self._selected_person and self._n_persons > 1
+            item.setPen(pg.mkPen((r, g, b, 200 if selected else 130), width=3 if selected else 1.5))
+        self._truth_brushes = [pg.mkPen(person_colour(k), width=1.5) for k in range(MAX_PERSONS)]
 
     # ---- waypoint editor ---------------------------------------------------------------------
     def set_draw_mode(self, on: bool) -> None:
@@ -270,7 +299,8 @@ class TopView(pg.PlotWidget):
         self.last_n_points = len(x)
         truth = frames[index].truth_xy_m
         ok = np.isfinite(truth).all(axis=1)
-        self.truth_now.setData(truth[ok, 0], truth[ok, 1])
+        pens = [self._truth_brushes[k % MAX_PERSONS] for k in np.flatnonzero(ok)]
+        self.truth_now.setData(truth[ok, 0], truth[ok, 1], pen=pens)
         if tracking is not None and index < tracking.n_frames:
             self._show_tracks(tracking.frames[index], tracking, index)
         else:

@@ -20,15 +20,15 @@ BENCHMARKS = ("sim", "track", "tune", "fidelity", "dataset", "false_alarms", "cv
 #: benchmark name -> module in core.benchmarks, where the name is a Python keyword
 MODULES = {"import": "import_"}
 #: not part of ``all``: hours of studies (16 x 1000 trials); person clouds (a calibration, not
-#: a speed figure)
-LONG = ("cvca_seeds", "clouds")
+#: a speed figure); the desktop app (needs Qt)
+LONG = ("cvca_seeds", "clouds", "gui")
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "bench",
         help="measure speed (and error against run time); cvca, cvca_seeds: CV against CA; "
-        "import: reading real recordings",
+        "import: reading real recordings; gui: the desktop app (offscreen and under Xvfb)",
     )
     p.add_argument("name", choices=(*BENCHMARKS, *LONG, "all"))
     p.add_argument(

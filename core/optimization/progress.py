@@ -34,6 +34,8 @@ class TrialSummary:
     datetime_start: dt.datetime | None
     datetime_complete: dt.datetime | None
     worker: str = ""
+    #: why a FAIL trial failed (``"TypeName: message"``, recorded by the worker); "" otherwise
+    error: str = ""
 
     def tracker_params(self, model: str) -> dict[str, Any]:
         """The trial's parameters as TrackerParams JSON."""
@@ -57,6 +59,7 @@ def _summary(t: Any) -> TrialSummary:
         datetime_start=t.datetime_start,
         datetime_complete=t.datetime_complete,
         worker=str(t.user_attrs.get("worker", "")),
+        error=str(t.user_attrs.get("error", "")),
     )
 
 

@@ -456,7 +456,8 @@ def run_worker(
         except KeyboardInterrupt:
             study.tell(trial, state=TrialState.FAIL)
             raise
-        except InputError:
+        except InputError as exc:
+            trial.set_user_attr("error", f"{type(exc).__name__}: {exc}"[:500])
             study.tell(trial, state=TrialState.FAIL)
             raise
         except Exception as exc:  # a tracker error fails the trial, not the study

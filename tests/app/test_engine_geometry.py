@@ -108,7 +108,16 @@ def test_sliders_and_their_defaults_are_the_search_space_table(model: str) -> No
 
     rows = search_space(model)
     assert engine.param_specs(model) == [
-        ParamSpec(name=p.name, low=p.low, high=p.high, log=p.log, label=p.label) for p in rows
+        ParamSpec(
+            name=p.name,
+            low=p.low,
+            high=p.high,
+            log=p.log,
+            label=p.label,
+            unit=p.unit,
+            title=f"{p.symbol} {p.meaning}",
+        )
+        for p in rows
     ]
     for p in rows:  # labels show the unit of every dimensioned parameter
         assert p.label.startswith(p.symbol) and (not p.unit or p.label.endswith(f"[{p.unit}]"))

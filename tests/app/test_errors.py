@@ -124,7 +124,7 @@ def test_tracking_worker_failure_is_one_line_and_logged(qtbot, caplog) -> None:
 
     class FailingTracker(Engine):
         @staticmethod
-        def track(frames, params, frame_period_s, *, key=""):
+        def track(frames, params, frame_period_s, *, key="", engine="numba"):
             raise OverflowError("r22 = 3e298 overflows the kernel")
 
     eng = FailingTracker()

@@ -99,7 +99,7 @@ def test_settings_persist_with_types(qtbot, settings, tmp_path) -> None:
     w.study_model.set_form(n_trials=17, n_jobs=2, storage=str(tmp_path / "st.db"))
     w.show()
     qtbot.waitExposed(w)
-    w.resize(700, 520)  # the offscreen screen is small; restoreGeometry clamps to it
+    w.resize(790, 560)  # the offscreen screen is 800 px; restoreGeometry clamps to it
     qtbot.wait(50)
     size = (w.width(), w.height())
     w.save_settings()

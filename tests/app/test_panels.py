@@ -44,8 +44,14 @@ def test_tracker_panel_both_ways(window) -> None:
     model.set_extra(clutter_density=0.01)
     assert not panel.rho_np.isChecked() and panel.rho.value() == pytest.approx(0.01)
     # labels with units, from the search-space table
-    assert panel.rows["r11"].label.text() == "r11 range σ [m] (log)"
-    assert panel.rows["p_d"].label.text() == "P_D detection probability"
+    # each slider shows its bounds and unit (from core/tracking/space.py), the spin box the unit
+    assert "r11 range σ<br>" in panel.rows["r11"].label.text()
+    assert "0.01 … 0.5 m, log" in panel.rows["r11"].label.text()
+    assert "q_coeff process noise<br>" in panel.rows["q_coeff"].label.text()
+    assert "0.1 … 30 m²/s⁴, log" in panel.rows["q_coeff"].label.text()
+    assert panel.rows["q_coeff"].spin.suffix() == " m²/s⁴"
+    assert "0.8 … 0.99 (no unit)" in panel.rows["p_d"].label.text()
+    assert panel.rows["p_d"].spin.suffix() == ""
     # reset
     panel.reset_button.click()
     assert model.values == engine.default_values("cv")
@@ -168,6 +174,7 @@ def test_playback_bar_both_ways(window, long_scene_frames, long_scene_doc, fill_
     window.playback.set_frame(100)
     assert window.timeline.value() == 100
     assert "frame 101 / 250" in window.frame_label.text()
+    assert "(of" not in window.frame_label.text()  # the total once when the cache is full
     window.act_fwd.trigger()
     assert window.playback.frame == 101
     window.act_back.trigger()

@@ -21,7 +21,7 @@ class OneSlowFrameEngine:
     def scene_info(self, scene):
         return SimpleNamespace(n_frames=1, truth_paths=[])
 
-    def simulate(self, scene):
+    def simulate(self, scene, *, fidelity="exact"):
         time.sleep(BUSY_S)
         yield SimpleNamespace(index=0)
 

@@ -1,0 +1,204 @@
+"""The GUI benchmark behind ``radartune bench gui``: the real window on the paper scene, with a
+timer probe in the event loop.
+
+    python -m app.bench_gui --json OUT.json [--quick]
+
+Measures (medians over repetitions, this machine is shared):
+
+* **slider → overlay drawn**: a tracker slider moved, until the views have drawn the re-tracked
+  overlay (the first redraw after the new tracking result reached the GUI thread);
+* **playback redraws/s** at 4× and 8× while playing the cached scene;
+* **event-loop gaps while a study runs**: a 5 ms ``QTimer`` probe records its ticks; a gap is
+  the time between two ticks (the longest, and how many exceed 100 ms).
+
+Also the probe's gaps while idle (the reference of the same run). Settings go to a temporary
+file; the study to a temporary storage.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import shutil
+import statistics
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import app  # noqa: F401  (thread settings before numpy)
+
+PROBE_MS = 5
+
+
+def _wait(qa, cond, timeout_s: float) -> bool:
+    """Run the real event loop (``QEventLoop.exec``) until ``cond()`` or the time-out; ``cond``
+    is checked by a 2 ms timer in that loop, as any other timer of the app."""
+    from PySide6 import QtCore
+
+    if cond():
+        return True
+    loop = QtCore.QEventLoop()
+    poll = QtCore.QTimer()
+    poll.setInterval(2)
+    poll.timeout.connect(lambda: cond() and loop.quit())
+    deadline = QtCore.QTimer()
+    deadline.setSingleShot(True)
+    deadline.timeout.connect(loop.quit)
+    poll.start()
+    deadline.start(int(timeout_s * 1000))
+    loop.exec()
+    poll.stop()
+    deadline.stop()
+    return bool(cond())
+
+
+class Probe:
+    """A 5 ms timer in the GUI's event loop: the gaps between its ticks."""
+
+    def __init__(self) -> None:
+        from PySide6 import QtCore
+
+        self.ticks: list[float] = []
+        self.timer = QtCore.QTimer()
+        self.timer.setTimerType(QtCore.Qt.PreciseTimer)
+        self.timer.setInterval(PROBE_MS)
+        self.timer.timeout.connect(lambda: self.ticks.append(time.perf_counter()))
+
+    def start(self) -> None:
+        self.ticks = []
+        self.timer.start()
+
+    def stop(self) -> dict:
+        self.timer.stop()
+        gaps = [1e3 * (b - a) for a, b in zip(self.ticks, self.ticks[1:])]
+        return {
+            "n_ticks": len(self.ticks),
+            "max_gap_ms": round(max(gaps), 1) if gaps else None,
+            "n_gaps_over_100_ms": sum(g > 100 for g in gaps),
+            "n_gaps_over_50_ms": sum(g > 50 for g in gaps),
+            "median_gap_ms": round(statistics.median(gaps), 2) if gaps else None,
+        }
+
+
+def run(quick: bool = False) -> dict:
+    import pyqtgraph as pg
+    from PySide6 import QtCore, QtWidgets
+
+    from app.window import MainWindow
+
+    qa = QtWidgets.QApplication.instance() or QtWidgets.QApplication(sys.argv[:1])
+    pg.setConfigOptions(imageAxisOrder="row-major")
+    tmp = Path(tempfile.mkdtemp(prefix="radartune-bench-gui-"))
+    settings = QtCore.QSettings(str(tmp / "settings.ini"), QtCore.QSettings.IniFormat)
+    t0 = time.perf_counter()
+    w = MainWindow(settings, restore=False)
+    w.resize(1600, 1000)
+    w.show()
+    out: dict = {"platform": qa.platformName()}
+    try:
+        if not _wait(qa, lambda: w.cache.complete, 600):
+            raise RuntimeError("the scene was not simulated within 10 minutes")
+        _wait(qa, lambda: w.tracking_model.result is not None and w.tracker.idle, 600)
+        out["first_track_s"] = round(time.perf_counter() - t0, 2)
+        out["scene_frames"] = len(w.cache)
+        _wait(qa, lambda: False, 1.0)  # settle
+
+        # ---- idle probe (reference) ----
+        probe = Probe()
+        probe.start()
+        _wait(qa, lambda: False, 2.0)
+        out["idle"] = probe.stop()
+
+        # ---- slider → overlay drawn ----
+        row = w.tracker_panel.rows["q_coeff"]
+        state = {"changed": None, "drawn": None}
+        w.tracking_model.changed.connect(lambda _r: state.__setitem__("changed", True))
+        real_redraw = w.redraw
+
+        def redraw() -> None:
+            real_redraw()
+            if state["changed"] and state["drawn"] is None:
+                state["drawn"] = time.perf_counter()
+
+        w.redraw = redraw
+        latencies = []
+        n = 5 if quick else 15
+        for i in range(n):
+            state["changed"], state["drawn"] = None, None
+            position = 200 + (i * 37) % 600
+            t_move = time.perf_counter()
+            row.slider.setValue(position)
+            if not _wait(qa, lambda: state["drawn"] is not None, 60):
+                continue
+            latencies.append(1e3 * (state["drawn"] - t_move))
+            _wait(qa, lambda: w.tracker.idle, 30)
+            _wait(qa, lambda: False, 0.1)
+        w.redraw = real_redraw
+        out["slider_to_overlay_ms"] = {
+            "median": round(statistics.median(latencies), 1),
+            "min": round(min(latencies), 1),
+            "max": round(max(latencies), 1),
+            "n": len(latencies),
+        }
+
+        # ---- playback ----
+        out["playback"] = {}
+        seconds = 2.0 if quick else 4.0
+        for speed in (4.0, 8.0):
+            w.playback.set_speed(speed)
+            w.playback.set_frame(0)
+            w.playback.loop = True
+            probe.start()
+            n0 = w.n_draws
+            w.playback.set_playing(True)
+            t_start = time.perf_counter()
+            _wait(qa, lambda: False, seconds)
+            elapsed = time.perf_counter() - t_start
+            w.playback.set_playing(False)
+            gaps = probe.stop()
+            out["playback"][f"{speed:g}x"] = {
+                "redraws_per_s": round((w.n_draws - n0) / elapsed, 1),
+                "max_gap_ms": gaps["max_gap_ms"],
+            }
+
+        # ---- study ----
+        n_trials = 4 if quick else 12
+        w.study_model.set_form(n_trials=n_trials, n_jobs=1, storage=str(tmp / "study.db"))
+        probe.start()
+        t_start = time.perf_counter()
+        w.start_study()
+        _wait(qa, lambda: w.study_model.running, 10)
+        _wait(qa, lambda: not w.study_model.running, 300)
+        study = probe.stop()
+        p = w.study_model.progress
+        study.update(
+            n_trials=n_trials,
+            n_complete=p.n_complete,
+            n_pruned=p.n_pruned,
+            n_failed=p.n_failed,
+            wall_s=round(time.perf_counter() - t_start, 1),
+            errors=list(w.errors),
+        )
+        out["study"] = study
+    finally:
+        w.shutdown()
+        w.close()
+        shutil.rmtree(tmp, ignore_errors=True)
+    return out
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog="python -m app.bench_gui", description=__doc__)
+    parser.add_argument("--json", required=True, help="write the figures here")
+    parser.add_argument("--quick", action="store_true")
+    args = parser.parse_args(argv)
+    result = run(quick=args.quick)
+    result["qpa_platform"] = os.environ.get("QT_QPA_PLATFORM", "")
+    Path(args.json).write_text(json.dumps(result, indent=1))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

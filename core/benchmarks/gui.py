@@ -1,0 +1,74 @@
+"""``radartune bench gui``: the desktop app's responsiveness, measured in the real window.
+
+The measurement itself is :mod:`app.bench_gui` (it needs Qt, which ``core`` never imports): it
+runs here as a child process (``python -m app.bench_gui``), once with Qt's ``offscreen`` platform
+and once under Xvfb with the real ``xcb`` platform when ``xvfb-run`` is installed. Figures: slider
+to overlay drawn (median, ms; target ≤ 100 on the paper scene), playback redraws per second at
+4× and 8× (target ≥ 45), and the event loop's longest gap and gaps over 100 ms while a study runs
+(target: none over 100 ms), with an idle probe of the same run as reference.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+from core.errors import InputError
+
+ROOT = Path(__file__).resolve().parents[2]
+#: the Xvfb screen of the ``xcb`` run
+XVFB_SCREEN = "1920x1080x24"
+
+
+def _run_app(platform: str, quick: bool) -> dict:
+    with tempfile.TemporaryDirectory(prefix="radartune-bench-gui-") as tmp:
+        out = Path(tmp) / "gui.json"
+        cmd = [sys.executable, "-m", "app.bench_gui", "--json", str(out)]
+        if quick:
+            cmd.append("--quick")
+        env = dict(os.environ, QT_QPA_PLATFORM=platform)
+        env["PYTHONPATH"] = os.pathsep.join(p for p in (str(ROOT), env.get("PYTHONPATH")) if p)
+        if platform == "xcb":
+            cmd = ["xvfb-run", "-a", "-s", f"-screen 0 {XVFB_SCREEN}", *cmd]
+        done = subprocess.run(cmd, cwd=tmp, env=env, capture_output=True, text=True)
+        if done.returncode != 0 or not out.exists():
+            tail = " ".join(done.stderr.strip().splitlines()[-3:])
+            raise InputError(f"the GUI benchmark failed on {platform}: {tail}", "bench gui")
+        return json.loads(out.read_text())
+
+
+def run(quick: bool = False) -> dict:
+    result: dict[str, object] = {"offscreen": _run_app("offscreen", quick)}
+    if shutil.which("xvfb-run"):
+        result["xcb"] = _run_app("xcb", quick)
+    else:
+        result["xcb"] = None  # Xvfb not installed: `apt-get install xvfb`
+    result["targets"] = {
+        "slider_to_overlay_median_ms": 100,
+        "playback_redraws_per_s": 45,
+        "study_gaps_over_100_ms": 0,
+    }
+    return result
+
+
+def summary(result: dict) -> str:
+    lines = []
+    for platform in ("offscreen", "xcb"):
+        r = result.get(platform)
+        if not r:
+            lines.append(f"{platform}: not run (no xvfb-run)")
+            continue
+        s, pb, st = r["slider_to_overlay_ms"], r["playback"], r["study"]
+        lines.append(
+            f"{platform}: first track {r['first_track_s']} s · slider→overlay median "
+            f"{s['median']} ms ({s['min']}–{s['max']}, n={s['n']}) · playback 4x "
+            f"{pb['4x']['redraws_per_s']} / 8x {pb['8x']['redraws_per_s']} redraws/s · study: "
+            f"longest gap {st['max_gap_ms']} ms, {st['n_gaps_over_100_ms']} over 100 ms "
+            f"(idle: longest {r['idle']['max_gap_ms']} ms)"
+        )
+    return "\n".join(lines)
