@@ -62,5 +62,5 @@ def test_study_data_set_of_a_two_person_scene_gives_finite_losses(tmp_path) -> N
     ds = Dataset.load(engine.scene_dataset(frames, scene, tmp_path / "scene.npz"))
     assert ds.truth_xy_m.shape == (len(frames), 2, 2)
     assert np.isnan(ds.truth_xy_m).any()  # a person absent in some frames
-    ((value, _mse, n_c),) = TrackerLosses(ds).losses(tracker_params_dict(defaults("cv"), "cv"), [0])
-    assert math.isfinite(value) and value > 0 and n_c > 0
+    (score,) = TrackerLosses(ds).losses(tracker_params_dict(defaults("cv"), "cv"), [0])
+    assert math.isfinite(score.loss) and score.loss > 0 and score.n_c > 0
