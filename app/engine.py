@@ -79,10 +79,17 @@ def describe(exc: BaseException) -> str:
 
 # ---- scenes -----------------------------------------------------------------------------------
 def paper_document() -> dict:
-    """The paper scene document (``resources/scenes/paper_class_c.json``)."""
+    """The app's default scene: the paper scene (``resources/scenes/paper_class_c.json``) with
+    the default person model (a walking body, decision scene-07) where its file names none."""
+    from core.scene.scene import DEFAULT_PERSON_MODEL
+
     if PAPER_SCENE_FILE.is_file():
-        return json.loads(PAPER_SCENE_FILE.read_text())
-    return json.loads(json.dumps(PAPER_SCENE_DOCUMENT))
+        doc = json.loads(PAPER_SCENE_FILE.read_text())
+    else:
+        doc = json.loads(json.dumps(PAPER_SCENE_DOCUMENT))
+    for person in doc.get("persons", []):
+        person.setdefault("model", DEFAULT_PERSON_MODEL)
+    return doc
 
 
 def scene_from_document(doc: dict, base_dir: Path, source: str | None = None):

@@ -3,6 +3,8 @@ drawn in its own colour, the selected one wider; the list shows the same colours
 
 from __future__ import annotations
 
+import json
+
 from app import engine
 from app.person_colours import person_colour
 from core.limits import MAX_PERSONS
@@ -64,3 +66,17 @@ def test_study_data_set_of_a_two_person_scene_gives_finite_losses(tmp_path) -> N
     assert np.isnan(ds.truth_xy_m).any()  # a person absent in some frames
     (score,) = TrackerLosses(ds).losses(tracker_params_dict(defaults("cv"), "cv"), [0])
     assert math.isfinite(score.loss) and score.loss > 0 and score.n_c > 0
+
+
+def test_the_default_scene_is_the_paper_walk_with_a_walking_body() -> None:
+    """Decision scene-07: the app starts with the paper's class-c walk, walked by the default
+    person model; the scene file itself (no model: a point) is unchanged."""
+    from core.scene.scene import DEFAULT_PERSON_MODEL
+
+    doc = engine.paper_document()
+    raw = json.loads(engine.PAPER_SCENE_FILE.read_text())
+    assert [p["model"] for p in doc["persons"]] == [DEFAULT_PERSON_MODEL] == ["walking"]
+    assert all("model" not in p for p in raw["persons"])
+    assert [p["trajectory"] for p in doc["persons"]] == [p["trajectory"] for p in raw["persons"]]
+    scene = engine.scene_from_document(doc, engine.PAPER_SCENE_FILE.parent)
+    assert scene.persons[0].model == "walking"
