@@ -22,7 +22,8 @@ from pathlib import Path
 import app  # noqa: F401  (thread settings before numpy)
 
 
-def _wait(qa, cond, timeout_s: float) -> bool:
+def wait_until(qa, cond, timeout_s: float) -> bool:
+    """Process Qt events until ``cond()`` is true or ``timeout_s`` passed; ``cond()``."""
     end = time.monotonic() + timeout_s
     while time.monotonic() < end:
         qa.processEvents()
@@ -57,11 +58,11 @@ def main(argv: list[str] | None = None) -> int:
     w = MainWindow(settings, restore=False)
     w.resize(args.width, args.height)
     w.show()
-    if not _wait(qa, lambda: w.cache.complete, 300):
+    if not wait_until(qa, lambda: w.cache.complete, 300):
         print("simulation did not finish", file=sys.stderr)
         return 1
-    _wait(qa, lambda: w.tracking_model.result is not None, 120)
-    _wait(qa, lambda: w.tracker.idle, 60)
+    wait_until(qa, lambda: w.tracking_model.result is not None, 120)
+    wait_until(qa, lambda: w.tracker.idle, 60)
     shots: list[str] = []
 
     def save(widget, name: str) -> None:
@@ -72,7 +73,7 @@ def main(argv: list[str] | None = None) -> int:
     if args.study > 0:
         w.study_model.set_form(n_trials=args.study, storage=str(tmp / "study.db"))
         w.start_study()
-        ok = _wait(qa, lambda: not w.study_model.running, 600)
+        ok = wait_until(qa, lambda: not w.study_model.running, 600)
         if not ok or not w.study_model.progress.best_params:
             print(f"demo study: no completed trial ({w.errors})", file=sys.stderr)
     frame = min(args.frame, len(w.cache) - 1)

@@ -13,11 +13,11 @@ import argparse
 import shutil
 import sys
 import tempfile
-import time
 from pathlib import Path
 
 import app  # noqa: F401  (thread settings before numpy)
 from app.engine import ROOT
+from app.screenshots import wait_until
 
 SHOTS = (
     ("ra_view", "views_range_azimuth.png"),
@@ -26,16 +26,6 @@ SHOTS = (
     ("elevation_view", "views_elevation.png"),
     ("track_table", "views_track_table.png"),
 )
-
-
-def _wait(qa, cond, timeout_s: float) -> bool:
-    end = time.monotonic() + timeout_s
-    while time.monotonic() < end:
-        qa.processEvents()
-        if cond():
-            return True
-        time.sleep(0.01)
-    return cond()
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -61,10 +51,10 @@ def main(argv: list[str] | None = None) -> int:
     w = MainWindow(settings, restore=False, scene_path=args.scene)
     w.resize(1600, 1000)
     w.show()
-    if not _wait(qa, lambda: w.cache.complete, 600):
+    if not wait_until(qa, lambda: w.cache.complete, 600):
         print("simulation did not finish", file=sys.stderr)
         return 1
-    _wait(qa, lambda: w.tracking_model.result is not None and w.tracker.idle, 300)
+    wait_until(qa, lambda: w.tracking_model.result is not None and w.tracker.idle, 300)
     w.playback.set_frame(min(args.frame, len(w.cache) - 1))
     w.colour_combo.setCurrentIndex(w.colour_combo.findData("label"))
     w.redraw()
