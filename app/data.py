@@ -7,6 +7,7 @@ and the x-y plane is the radar's (x to the right, y along boresight).
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -144,6 +145,10 @@ class TrackingResult:
     engine
         ``"numba"`` or ``"numpy"`` (the readable tracker, equal to round-off, while the
         compiled kernel is still being compiled on a cold start).
+    people
+        Every several-person metric of the run (:class:`core.evaluation.people.PeopleRun`: the
+        paper's loss per person, GOSPA and its decomposition per frame, the people-count error,
+        identity switches); None for a scene without persons.
     """
 
     frames: tuple[TrackFrame, ...]
@@ -163,6 +168,7 @@ class TrackingResult:
     elapsed_s: float = 0.0
     #: the tracker that ran: "numba" (compiled kernel) or "numpy" (readable, until compiled)
     engine: str = "numba"
+    people: Any = None
 
     @property
     def n_frames(self) -> int:

@@ -19,6 +19,7 @@ import time
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -285,6 +286,21 @@ def _truth0(frames: Sequence[FrameData]) -> np.ndarray:
     ).reshape(-1, 2)
 
 
+def _people(frames: Sequence[FrameData], track_frames) -> Any:
+    """Several-person metrics of the run (:func:`core.evaluation.people.people_run`); None
+    without persons."""
+    from core.evaluation.people import people_run
+    from core.tracking.batch import ConfirmedTracks
+
+    n_persons = max((len(f.truth_xy_m) for f in frames), default=0)
+    if n_persons == 0:
+        return None
+    truth = np.full((len(frames), n_persons, 2), np.nan)
+    for k, f in enumerate(frames):
+        truth[k, : len(f.truth_xy_m)] = f.truth_xy_m
+    return people_run(truth, ConfirmedTracks.from_frames(track_frames))
+
+
 def _ospa_per_frame(frames: Sequence[FrameData], confirmed_xy: Sequence[np.ndarray]) -> np.ndarray:
     """OSPA (c = 1 m, p = 2) between confirmed tracks and the persons present, per frame."""
     from core.evaluation import ospa
@@ -372,6 +388,7 @@ def track(
     truth0 = _truth0(frames)
     loss, rmse = running_loss(est, has, truth0)
     return TrackingResult(
+        people=_people(frames, res.frames),
         frames=tuple(tfs),
         estimate_xy_m=est,
         truth_xy_m=truth0,

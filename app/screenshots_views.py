@@ -25,6 +25,7 @@ SHOTS = (
     ("spectrogram_view", "views_micro_doppler.png"),
     ("elevation_view", "views_elevation.png"),
     ("track_table", "views_track_table.png"),
+    ("people_table", "views_people_table.png"),
 )
 
 

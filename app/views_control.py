@@ -9,6 +9,7 @@ import numpy as np
 from PySide6 import QtCore, QtWidgets
 
 from app.views.elevation_view import ElevationView
+from app.views.people_table import PeopleTable
 from app.views.ra_view import RangeAzimuthView
 from app.views.range_profile_view import RangeProfileView
 from app.views.spectrogram_view import MicroDopplerView
@@ -29,6 +30,10 @@ class ViewsController(QtCore.QObject):
         self.spectrogram_view = MicroDopplerView()
         self.elevation_view = ElevationView()
         self.track_table = TrackTable()
+        self.people_table = PeopleTable()
+        tracks_and_people = QtWidgets.QSplitter(QtCore.Qt.Vertical)
+        tracks_and_people.addWidget(self.track_table)
+        tracks_and_people.addWidget(self.people_table)
         self.tabs = QtWidgets.QTabWidget()
         self.tabs.setObjectName("radarViewTabs")
         self.tabs.addTab(self.ra_view, "Range-azimuth")
@@ -36,11 +41,11 @@ class ViewsController(QtCore.QObject):
         self.tabs.addTab(self.spectrogram_view, "Micro-Doppler")
         self.tabs.addTab(self.elevation_view, "Elevation")
         # small minimum heights: the window must still fit 1366x768 at 150 % (512 logical px)
-        for widget in (self.tabs, self.track_table, self.ra_view, self.profile_view,
-                       self.spectrogram_view, self.elevation_view):  # fmt: skip
+        for widget in (self.tabs, self.track_table, self.people_table, self.ra_view,
+                       self.profile_view, self.spectrogram_view, self.elevation_view):  # fmt: skip
             widget.setMinimumSize(80, 40)
         self.views_dock = self._dock("Radar views", self.tabs)
-        self.tracks_dock = self._dock("Tracks", self.track_table)
+        self.tracks_dock = self._dock("Tracks", tracks_and_people)
         # side by side under the central views: the track table beside the radar views
         window.splitDockWidget(self.views_dock, self.tracks_dock, QtCore.Qt.Horizontal)
         window.resizeDocks([self.views_dock], [250], QtCore.Qt.Vertical)
@@ -108,6 +113,7 @@ class ViewsController(QtCore.QObject):
         if self.tracks_dock.isVisible() and not self.tracks_dock.visibleRegion().isEmpty():
             tf = result.frames[index] if result is not None and index < result.n_frames else None
             self.track_table.show_tracks(tf, index)
+            self.people_table.show_people(None if result is None else result.people, index)
 
     def draw_all(self, index: int, frame, result) -> None:
         """Draw every view whether visible or not (exports, tests)."""
@@ -119,3 +125,4 @@ class ViewsController(QtCore.QObject):
         self.elevation_view.show_frame(index, frames)
         tf = result.frames[index] if result is not None and index < result.n_frames else None
         self.track_table.show_tracks(tf, index)
+        self.people_table.show_people(None if result is None else result.people, index)
