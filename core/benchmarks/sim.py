@@ -323,6 +323,10 @@ def walking_case(quick: bool = False) -> dict:
     fps = {k: v[2] / v[0] for k, v in spent.items()}
     fps_cpu = {k: v[2] / v[1] for k, v in spent.items()}
     fast_fps = reps * n / t_fast
+    stages = {
+        name: _fast_stage_profile(radar, antenna, settings, frames[:n], reps)
+        for name, frames in (("walking", walk), ("point", point))
+    }
     return {
         "frames": spent["walking"][2],
         "frames_per_trajectory": n,
@@ -341,12 +345,80 @@ def walking_case(quick: bool = False) -> dict:
         "fast_fps_cpu_walking": reps * n / c_fast,
         "fast_over_exact_walking": fast_fps / fps["walking"],
         "fast_over_exact_walking_cpu": (reps * n / c_fast) / fps_cpu["walking"],
+        "fast_stages_ms_walking": stages["walking"],
+        "fast_stages_ms_point": stages["point"],
         "goal": {
             "exact_fps_walking": 150.0,
             "exact_point_over_walking": 2.0,
             "fast_over_exact": 10,
         },
     }
+
+
+def _fast_stage_profile(
+    radar: RadarConfig, antenna, settings: ProcessingSettings, frames, reps: int
+) -> dict:
+    """CPU ms per frame of the ``fast`` level's stages on ``frames`` (one batch, ``reps`` times).
+
+    The per-scatterer inputs (link budget, slow-time sequences, steering vectors; computed once
+    for all frames), the noise map, the patches (range and Doppler responses of every
+    scatterer, patch cells and their sums: :func:`~core.simulation.fast_model.patches_kernel`)
+    run separately with the same functions as :func:`~core.simulation.fast.simulate_frames_fast`;
+    ``rest`` (CFAR, detected channels, points, labels) is the whole batch minus those.
+    """
+    from core.simulation import Scatterers
+    from core.simulation.baseband import steering_vectors
+    from core.simulation.fast import simulate_frames_fast, spectrum_tables
+    from core.simulation.fast_model import (
+        beat_rad_per_sample_per_m,
+        noise_map,
+        patches_kernel,
+        slow_time_sequences,
+    )
+    from core.simulation.gaussian import state_from
+    from core.simulation.link import received_power_w, signal_amplitude_v
+
+    n_f = len(frames)
+    rngs = [np.random.default_rng(100 + i) for i in range(n_f)]
+    every = Scatterers.concatenate(list(frames))
+    start = np.concatenate(([0], np.cumsum([len(f) for f in frames]))).astype(np.int64)
+    spec = spectrum_tables(radar, settings, False)
+    t_mid = 0.5 * radar.n_loops * radar.n_tx * radar.chirp_period_s
+    rd = np.empty((radar.n_samples, radar.n_loops), dtype=np.float32)
+    spent = dict.fromkeys(("whole", "inputs", "noise map", "patches"), 0.0)
+    for _ in range(reps):
+        c0 = time.process_time()
+        simulate_frames_fast(radar, frames, rngs, antenna=antenna, settings=settings)
+        c1 = time.process_time()
+        power = received_power_w(radar, every.range_m, every.azimuth_rad, every.rcs_dbsm, antenna)
+        amp = signal_amplitude_v(radar, power)
+        r_mid = np.linalg.norm(every.position_m + every.velocity_mps * t_mid, axis=1)
+        theta = beat_rad_per_sample_per_m(radar) * r_mid
+        slow, slow1 = slow_time_sequences(radar, every, settings)
+        steer = np.ascontiguousarray(steering_vectors(radar, every))
+        c2 = time.process_time()
+        states = np.zeros((n_f, 6), dtype=np.uint64)
+        for f in range(n_f):
+            states[f, :4] = state_from(rngs[f])
+        for f in range(n_f):
+            noise_map(states[f], rd, spec.s2, spec.n_use, spec.n_v)
+        c3 = time.process_time()
+        for f in range(n_f):
+            a, b = start[f], start[f + 1]
+            patches_kernel(
+                states[f], rd, amp[a:b], theta[a:b], slow[a:b], slow1[a:b], spec.wd, spec.b,
+                spec.s2, steer[a:b], spec.slot, spec.threshold, spec.tw_r, spec.tw_d, True,
+                spec.n_use,
+            )  # fmt: skip
+        c4 = time.process_time()
+        spent["whole"] += c1 - c0
+        spent["inputs"] += c2 - c1
+        spent["noise map"] += c3 - c2
+        spent["patches"] += c4 - c3
+    ms = {k: 1e3 * v / (reps * n_f) for k, v in spent.items()}
+    ms["rest"] = ms["whole"] - ms["inputs"] - ms["noise map"] - ms["patches"]
+    ms["scatterers_per_frame"] = len(every) / n_f
+    return ms
 
 
 def _stage_profile(radar: RadarConfig, settings: ProcessingSettings, antenna, frames) -> dict:
