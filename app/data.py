@@ -54,6 +54,10 @@ class FrameData:
     ra_map_db: np.ndarray | None = None
     cfar_threshold_db: np.ndarray | None = None
     person_doppler_db: np.ndarray | None = None
+    #: wall-clock seconds of the radar chain's synthesis and processing halves of this frame
+    #: where the fidelity level runs them apart (exact), else NaN
+    synthesis_s: float = float("nan")
+    processing_s: float = float("nan")
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)

@@ -238,6 +238,8 @@ def simulate(scene, *, fidelity: str = "exact") -> Iterator[FrameData]:
             rd_map_db=fr.rd_map_db,
             detections=np.asarray(fr.detections).reshape(-1, 2),
             ra_map_db=fr.ra_map_db,
+            synthesis_s=fr.synthesis_s,
+            processing_s=fr.processing_s,
             **frame_views(fr.rd_map_db, truth, scene.radar, settings),
         )
 

@@ -48,6 +48,9 @@ class SimulationWorker(QtCore.QThread):
         self.fidelity = "exact"
         #: seconds per simulated frame (radar chain: synthesis and processing), latest last
         self.frame_times_s: deque[float] = deque(maxlen=50)
+        #: (synthesis, processing) seconds of the same frames (NaN where the level does both in
+        #: one kernel)
+        self.half_times_s: deque[tuple[float, float]] = deque(maxlen=50)
 
     def stop(self) -> None:
         self._stop.set()
@@ -59,6 +62,7 @@ class SimulationWorker(QtCore.QThread):
             for frame in frames:
                 t1 = time.perf_counter()
                 self.frame_times_s.append(t1 - t0)  # synthesis + processing of one frame
+                self.half_times_s.append((frame.synthesis_s, frame.processing_s))
                 if self._stop.is_set():
                     return
                 self.frame_ready.emit(self.generation, frame)
@@ -142,6 +146,21 @@ class SimulationController(QtCore.QObject):
         if len(times) > 1:
             times = times[1:]
         return float(np.median(times)) * 1e3 if times else float("nan")
+
+    @property
+    def ms_per_frame_halves(self) -> tuple[float, float]:
+        """Median synthesis and processing time per frame (ms; NaN where the level does not run
+        them apart, or before a frame), over the frames :attr:`ms_per_frame` uses."""
+        w = self._worker or (self._old[-1] if self._old else None)
+        halves = list(w.half_times_s) if w is not None else []
+        if len(halves) > 1:
+            halves = halves[1:]
+        if not halves:
+            return float("nan"), float("nan")
+        a = np.array(halves, dtype=float) * 1e3
+        if not np.isfinite(a).all():
+            return float("nan"), float("nan")
+        return float(np.median(a[:, 0])), float(np.median(a[:, 1]))
 
     def _on_frame(self, generation: int, frame) -> None:
         if generation != self._cache.generation:

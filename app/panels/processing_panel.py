@@ -76,7 +76,11 @@ class ProcessingPanel(QtWidgets.QWidget):
         self.timing_labels: dict[str, QtWidgets.QLabel] = {}
         for key, title, tip in (
             ("chain", "simulate + process", "radar chain of one frame: baseband synthesis, FFTs, "
-             "CFAR, angle, point cloud (one call; median of the last 50 frames)"),
+             "CFAR, angle, point cloud (median of the last 50 frames)"),
+            ("synthesis", "  simulate", "baseband synthesis and receiver noise of one frame "
+             "(exact level; the fast and measurement levels do both halves in one kernel: –)"),
+            ("processing", "  process", "range and Doppler FFTs, clutter removal, CFAR, angles "
+             "and point cloud of one frame (exact level)"),
             ("track", "track", "last re-track of the whole scene divided by its frames "
              "(tracker, ψ, gates, metrics)"),
             ("draw", "draw", "last redraw of the views (median of the last 60)"),
@@ -117,9 +121,18 @@ class ProcessingPanel(QtWidgets.QWidget):
             self.settings_labels[key].setText(value)
 
     def show_timing(
-        self, *, chain_ms: float, track_ms: float, draw_ms: float, sim_fps: float, draw_fps: int
+        self,
+        *,
+        chain_ms: float,
+        track_ms: float,
+        draw_ms: float,
+        sim_fps: float,
+        draw_fps: int,
+        halves_ms: tuple[float, float] = (float("nan"), float("nan")),
     ) -> None:
         self.timing_labels["chain"].setText(_ms(chain_ms))
+        self.timing_labels["synthesis"].setText(_ms(halves_ms[0]))
+        self.timing_labels["processing"].setText(_ms(halves_ms[1]))
         self.timing_labels["track"].setText(_ms(track_ms))
         self.timing_labels["draw"].setText(_ms(draw_ms))
         self.timing_labels["sim_fps"].setText("–" if sim_fps <= 0 else f"{sim_fps:.1f}")

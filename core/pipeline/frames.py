@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import math
 import time
 from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
@@ -40,6 +41,10 @@ class FrameResult:
     detections: np.ndarray
     n_clutter: int
     ra_map_db: np.ndarray | None = None
+    #: wall-clock seconds of the frame's synthesis and processing where the level runs them
+    #: apart (:class:`core.simulation.frame.FrameOutput`), else NaN; not compared
+    synthesis_s: float = field(default=math.nan, compare=False)
+    processing_s: float = field(default=math.nan, compare=False)
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -129,6 +134,8 @@ def iter_frames(
             detections=out.detections,
             n_clutter=fi.n_clutter,
             ra_map_db=out.ra_map_db if p.keep_rd_maps else None,
+            synthesis_s=out.synthesis_s,
+            processing_s=out.processing_s,
         )
 
 

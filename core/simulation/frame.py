@@ -2,7 +2,10 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import dataclasses
+import math
+import time
+from dataclasses import dataclass, field
 
 import numpy as np
 import scipy.fft
@@ -41,12 +44,18 @@ class FrameOutput:
         ``[range bin, angle index]`` float32 range-azimuth map in dB
         (:func:`core.processing.range_azimuth.range_azimuth_map`, angle index centred), kept
         with ``rd_map_db`` by the levels that have a Doppler cube (exact); None otherwise.
+    synthesis_s, processing_s
+        Wall-clock seconds of the frame's two halves where the level runs them apart (exact:
+        baseband synthesis with noise, then FFTs, CFAR, angles and points); NaN where one
+        kernel does both (fast, measurement). Not part of the result (not compared).
     """
 
     point_cloud: PointCloud
     rd_map_db: np.ndarray | None
     detections: np.ndarray
     ra_map_db: np.ndarray | None = None
+    synthesis_s: float = field(default=math.nan, compare=False)
+    processing_s: float = field(default=math.nan, compare=False)
 
 
 def processed_range_bins(radar: RadarConfig, settings: ProcessingSettings) -> int:
@@ -88,6 +97,7 @@ def simulate_frame(
     noise
         Add receiver noise (switch off only for noise-free tests).
     """
+    t0 = time.perf_counter()
     cube = synthesize_signal(radar, scatterers, antenna)
     # the range window is applied while the noise is added (one pass over the cube); the
     # transform then runs on the windowed cube
@@ -98,9 +108,11 @@ def simulate_frame(
         cube *= w
     if elevation is None:
         elevation = needs_elevation(radar, scatterers)
-    return process_windowed_cube(
+    t1 = time.perf_counter()
+    out = process_windowed_cube(
         cube, radar, scatterers, settings=settings, keep_rd_map=keep_rd_map, elevation=elevation
     )
+    return dataclasses.replace(out, synthesis_s=t1 - t0, processing_s=time.perf_counter() - t1)
 
 
 def process_windowed_cube(

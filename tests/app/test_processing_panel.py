@@ -40,3 +40,15 @@ def test_panel_shows_the_chain_settings_and_switches_fidelity(window, qtbot, mon
     window._update_fps()
     assert panel.timing_labels["chain"].text().endswith(" ms")
     assert panel.timing_labels["draw"].text().endswith(" ms")
+    # the measurement level runs both halves in one kernel: no split to show
+    assert panel.timing_labels["synthesis"].text() == "–"
+    assert panel.timing_labels["processing"].text() == "–"
+    # the exact level runs them apart: each half shown, and they make up the chain's time
+    panel.fidelity.setCurrentIndex(panel.fidelity.findData("exact"))
+    qtbot.waitUntil(lambda: window.cache.complete and len(window.cache) > 2, timeout=120000)
+    window._t_timing_shown = 0.0
+    window._update_fps()
+    synth, proc = window.sim.ms_per_frame_halves
+    assert 0 < synth and 0 < proc and synth + proc <= window.sim.ms_per_frame * 1.5
+    assert panel.timing_labels["synthesis"].text().endswith(" ms")
+    assert panel.timing_labels["processing"].text().endswith(" ms")

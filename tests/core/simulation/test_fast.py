@@ -225,3 +225,30 @@ def test_noise_free_frame_runs_and_reports_infinite_snr_where_the_noise_estimate
     assert len(f.point_cloud) >= 3
     assert set(f.point_cloud.source.tolist()) >= {0, 1, 2}
     assert not np.any(np.isnan(f.point_cloud.snr_db))
+
+
+def test_only_the_exact_level_times_its_two_halves_apart() -> None:
+    """The exact chain reports its synthesis and processing seconds; the fast level, one kernel
+    for both, reports none; the timings are not part of the result (equal outputs compare
+    equal)."""
+    import math
+
+    import numpy as np
+
+    from core.config import PAPER_RADAR
+    from core.simulation import AntennaGain, Scatterers, simulate_frame
+    from core.simulation.fast import simulate_frame_fast
+
+    sc = Scatterers(
+        position_m=np.array([[0.5, 4.0, 0.0]]),
+        velocity_mps=np.array([[0.0, 1.0, 0.0]]),
+        rcs_dbsm=np.array([-8.0]),
+        source=np.array([0], dtype=np.int64),
+    )
+    ant = AntennaGain.draw(PAPER_RADAR, np.random.default_rng(0))
+    a = simulate_frame(PAPER_RADAR, sc, np.random.default_rng(1), antenna=ant)
+    b = simulate_frame(PAPER_RADAR, sc, np.random.default_rng(1), antenna=ant)
+    assert a.synthesis_s > 0 and a.processing_s > 0
+    assert np.array_equal(a.detections, b.detections)
+    fast = simulate_frame_fast(PAPER_RADAR, sc, np.random.default_rng(1), antenna=ant)
+    assert math.isnan(fast.synthesis_s) and math.isnan(fast.processing_s)
