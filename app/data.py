@@ -88,7 +88,8 @@ class TrackFrame:
         ``(n,)`` int measurements in each track's gate this frame; −1 where the tracker does
         not report it.
     nis
-        ``(n,)`` normalised innovation squared of the last update; NaN where not reported.
+        ``(n,)`` normalised innovation squared ε = ν̃ᵀ S⁻¹ ν̃ of this frame's update (ν̃ = Σ βᵢ νᵢ,
+        see ``core.tracking.results.FrameTracks``); NaN where none or not reported.
     """
 
     track_id: np.ndarray

@@ -20,8 +20,16 @@ COLUMNS = (
     ("vy (m/s)", "estimated velocity y"),
     ("σx, σy (m)", "standard deviations of the position estimate, √P_xx and √P_yy"),
     ("age (s)", "time since the track was born"),
-    ("assoc. points", "measurements in the track's gate this frame (– : not reported)"),
-    ("last NIS", "normalised innovation squared of the last update (– : not reported)"),
+    (
+        "assoc. points",
+        "measurements in the track's gate this frame, those of its (J)IPDA update"
+        " (0: born this frame or none gated; – : not reported)",
+    ),
+    (
+        "last NIS",
+        "normalised innovation squared of this frame's update, ε = ν̃ᵀ S⁻¹ ν̃ with ν̃ = Σ βᵢ νᵢ"
+        " (– : no measurement gated, born this frame, or not reported)",
+    ),
 )
 
 

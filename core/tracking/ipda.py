@@ -21,6 +21,7 @@ import numpy as np
 from scipy.linalg import cho_solve
 
 from core.tracking.ekf import joseph_update, symmetrize
+from core.tracking.gating import mahalanobis_squared
 
 __all__ = [
     "LOG_2PI",
@@ -31,6 +32,7 @@ __all__ = [
     "associate",
     "update_existence",
     "pda_update",
+    "combined_nis",
 ]
 
 LOG_2PI = math.log(2.0 * math.pi)
@@ -173,3 +175,28 @@ def pda_update(
     # P = β₀ P⁻ + (1 − β₀) P_c + K (Σβνν' − ν̄ν̄') Kᵀ
     P = assoc.beta0 * P_pred + (1.0 - assoc.beta0) * P_c + K @ spread @ K.T
     return x, symmetrize(P)
+
+
+def combined_nis(nu: np.ndarray, beta: np.ndarray, L: np.ndarray) -> float:
+    """Normalised innovation squared of the PDA update, ε = ν̃ᵀ S⁻¹ ν̃ (unitless).
+
+    Parameters
+    ----------
+    nu
+        Innovations of the validated measurements (m, 3), azimuth wrapped.
+    beta
+        Their association probabilities given existence βᵢ (m,), as in :func:`pda_update`.
+    L
+        Lower Cholesky factor of S = H P⁻ Hᵀ + R, (3, 3).
+
+    Returns
+    -------
+    float
+        ε with ν̃ = Σᵢ βᵢ νᵢ the combined innovation; NaN when m = 0 (no update).
+    """
+    if len(nu) == 0:
+        return math.nan
+    # ν̃ = Σ βᵢ νᵢ
+    nu_bar = beta @ nu
+    # ε = ν̃ᵀ S⁻¹ ν̃
+    return float(mahalanobis_squared(nu_bar[None, :], L)[0])

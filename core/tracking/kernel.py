@@ -99,8 +99,8 @@ def track_frames(
         ψ outside [0, 1], P not symmetric positive definite); returned as a 9th array.
     record
         Record every live track of every frame (id, state, covariance, ψ, status, birth frame,
-        gate) into preallocated (F_sel, max_tracks, ...) arrays; returned last as a
-        :class:`TrackRecord`. Off, the kernel allocates nothing for it.
+        gate, gated measurements and NIS) into preallocated (F_sel, max_tracks, ...) arrays;
+        returned last as a :class:`TrackRecord`. Off, the kernel allocates nothing for it.
 
     Returns
     -------
@@ -190,6 +190,8 @@ def run_tracker_compiled(
                 gate_center_xy=rec.gate_center_xy[f, :n],
                 gate_shape_xy=rec.gate_shape_xy[f, :n],
                 birth_frame=rec.birth_frame[f, :n],
+                n_associated=rec.n_associated[f, :n],
+                nis=rec.nis[f, :n],
                 estimate=int(rec.estimate[f]),
             )
             for f, n in enumerate(rec.n_tracks.tolist())

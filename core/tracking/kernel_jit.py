@@ -267,8 +267,9 @@ def _compact(keep, nt, X, P, psi, conf, ids):
 
 
 @njit(cache=True)
-def _compact_rec(keep, nt, birth, gc, gs):
-    """Compact the per-slot recording arrays (birth frame, gate) like :func:`_compact`."""
+def _compact_rec(keep, nt, birth, gc, gs, na, ns):
+    """Compact the per-slot recording arrays (birth frame, gate, gated count, NIS) like
+    :func:`_compact`."""
     j = 0
     for i in range(nt):
         if keep[i]:
@@ -276,7 +277,28 @@ def _compact_rec(keep, nt, birth, gc, gs):
                 birth[j] = birth[i]
                 gc[j] = gc[i]
                 gs[j] = gs[i]
+                na[j] = na[i]
+                ns[j] = ns[i]
             j += 1
+
+
+@njit(cache=True)
+def _nis(L, nu, beta, mval, v, w):
+    """ε = ν̃ᵀ S⁻¹ ν̃ of the combined innovation ν̃ = Σ βᵢ νᵢ (m ≥ 1), S = L Lᵀ."""
+    # ν̃ = Σ βᵢ νᵢ
+    nb0 = 0.0
+    nb1 = 0.0
+    nb2 = 0.0
+    for j in range(mval):
+        nb0 += beta[j] * nu[j, 0]
+        nb1 += beta[j] * nu[j, 1]
+        nb2 += beta[j] * nu[j, 2]
+    v[0] = nb0
+    v[1] = nb1
+    v[2] = nb2
+    # ε = ‖L⁻¹ ν̃‖²
+    _fwd3(L, v, w)
+    return w[0] * w[0] + w[1] * w[1] + w[2] * w[2]
 
 
 @njit(cache=True)
@@ -443,11 +465,13 @@ def track_kernel(frames_, c_, out_, check, record, rec_):
     ids = np.zeros(cap, dtype=np.int64)
     keep = np.zeros(cap, dtype=np.bool_)
     order = np.zeros(cap, dtype=np.int64)
-    # recording slots (birth frame, gate), allocated only when recording
+    # recording slots (birth frame, gate, gated count, NIS), allocated only when recording
     n_rec = cap if record else 0
     birth = np.zeros(n_rec, dtype=np.int64)
     gc = np.zeros((n_rec, 2))
     gs = np.zeros((n_rec, 2, 2))
+    na = np.zeros(n_rec, dtype=np.int64)
+    ns = np.zeros(n_rec)
     gated_any = np.zeros(max_m + 1, dtype=np.bool_)
     beta = np.zeros(max_m + 1)
     # per track of a frame: prediction, gate and validated measurements (pass 1 → pass 2);
@@ -574,6 +598,10 @@ def track_kernel(frames_, c_, out_, check, record, rec_):
                     t = members[q]
                     mval = MV[t]
                     pp = PSP[t]
+                    if record:
+                        # gated measurements of this update; ε set below when there is one
+                        na[t] = mval
+                        ns[t] = math.nan
                     if mval == 0 and nk == 1 or mval == 0 and bound > max_events:
                         # ψ = (1 − P_D P_G) ψ⁻ / (1 − P_D P_G ψ⁻); state unchanged
                         if pp <= 0.0:
@@ -650,6 +678,8 @@ def track_kernel(frames_, c_, out_, check, record, rec_):
                         w,
                         v,
                     )
+                    if record:
+                        ns[t] = _nis(LL[t], NU[t], beta, mval, v, w)
             # initiation: measurements outside every gate start tentative tracks
             for j in range(m):
                 if not gated_any[j]:
@@ -669,6 +699,8 @@ def track_kernel(frames_, c_, out_, check, record, rec_):
                     ids[nt] = next_id
                     if record:
                         birth[nt] = f - fa
+                        na[nt] = 0
+                        ns[nt] = math.nan
                         # gate of a newborn track: S₀ = H(x₀) P₀ H(x₀)ᵀ + R around x₀
                         _measure(X[nt], zp, H)
                         _innov_cov(H, P0, R, S, HP)
@@ -681,7 +713,7 @@ def track_kernel(frames_, c_, out_, check, record, rec_):
                     conf[t] = True
                 keep[t] = psi[t] >= delete_th
             if record:
-                _compact_rec(keep, nt, birth, gc, gs)
+                _compact_rec(keep, nt, birth, gc, gs, na, ns)
             nt = _compact(keep, nt, X, P, psi, conf, ids)
             # merging: greedy in ψ order, within the 2-D gate of the combined position covariance
             if nt > 1:
@@ -721,7 +753,7 @@ def track_kernel(frames_, c_, out_, check, record, rec_):
                                 continue
                         keep[b] = False
                 if record:
-                    _compact_rec(keep, nt, birth, gc, gs)
+                    _compact_rec(keep, nt, birth, gc, gs, na, ns)
                 nt = _compact(keep, nt, X, P, psi, conf, ids)
             # cap: the lowest ψ go (ties: the youngest)
             if nt > max_tracks:
@@ -731,7 +763,7 @@ def track_kernel(frames_, c_, out_, check, record, rec_):
                 for ia in range(max_tracks):
                     keep[order[ia]] = True
                 if record:
-                    _compact_rec(keep, nt, birth, gc, gs)
+                    _compact_rec(keep, nt, birth, gc, gs, na, ns)
                 nt = _compact(keep, nt, X, P, psi, conf, ids)
             # outputs: the estimate is the confirmed track with the highest ψ (ties: older)
             best = -1
@@ -768,6 +800,8 @@ def track_kernel(frames_, c_, out_, check, record, rec_):
                     rec.birth_frame[o, t] = birth[t]
                     rec.gate_center_xy[o, t, :] = gc[t]
                     rec.gate_shape_xy[o, t, :, :] = gs[t]
+                    rec.n_associated[o, t] = na[t]
+                    rec.nis[o, t] = ns[t]
             o += 1
 
 

@@ -42,6 +42,16 @@ class FrameTracks:
         r–az plane, linearised into x–y).
     birth_frame
         Frame (index within the run) in which each track was born (n,), int64.
+    n_associated
+        (n,) int64 number m_τ of measurements inside each track's gate in this frame (νᵢᵀ S⁻¹ νᵢ
+        ≤ γ), the measurements that took part in its (J)IPDA update; 0 for a track born in this
+        frame.
+    nis
+        (n,) normalised innovation squared of this frame's update, ε = ν̃ᵀ S⁻¹ ν̃ with
+        ν̃ = Σᵢ βᵢ νᵢ the combined (PDA) innovation over the m_τ gated measurements (βᵢ the
+        association probabilities given existence, as in the state update x = x⁻ + K ν̃) and
+        S = H P⁻ Hᵀ + R the predicted innovation covariance (unitless); NaN when no measurement
+        was gated and for a track born in this frame.
     estimate
         Index into these arrays of the single-person estimate, or −1.
     """
@@ -54,6 +64,8 @@ class FrameTracks:
     gate_center_xy: np.ndarray
     gate_shape_xy: np.ndarray
     birth_frame: np.ndarray
+    n_associated: np.ndarray
+    nis: np.ndarray
     estimate: int = -1
 
     def __len__(self) -> int:
@@ -126,6 +138,9 @@ class TrackRecord(NamedTuple):
     gate_center_xy, gate_shape_xy
         (F, cap, 2) and (F, cap, 2, 2): the gate in x–y (see :class:`FrameTracks`), from the
         predicted covariance of the frame (for a newborn track: P₀).
+    n_associated, nis
+        (F, cap) int64 and float: gated measurements and NIS of the frame's update (see
+        :class:`FrameTracks`).
     estimate
         (F,) slot of the single-person estimate, −1 when no track is confirmed.
     """
@@ -139,6 +154,8 @@ class TrackRecord(NamedTuple):
     birth_frame: np.ndarray
     gate_center_xy: np.ndarray
     gate_shape_xy: np.ndarray
+    n_associated: np.ndarray
+    nis: np.ndarray
     estimate: np.ndarray
 
     @classmethod
@@ -154,5 +171,7 @@ class TrackRecord(NamedTuple):
             birth_frame=np.full((n_frames, cap), -1, dtype=np.int64),
             gate_center_xy=np.full((n_frames, cap, 2), np.nan),
             gate_shape_xy=np.full((n_frames, cap, 2, 2), np.nan),
+            n_associated=np.full((n_frames, cap), -1, dtype=np.int64),
+            nis=np.full((n_frames, cap), np.nan),
             estimate=np.full(n_frames, -1, dtype=np.int64),
         )

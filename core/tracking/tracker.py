@@ -36,6 +36,8 @@ class _Track:  # mutable working record of the reference tracker
     birth: int = 0
     confirmed: bool = False
     updated: bool = False
+    n_associated: int = 0  # measurements gated in this frame (0 when born in it)
+    nis: float = math.nan  # ε = ν̃ᵀ S⁻¹ ν̃ of this frame's update (NaN: none)
     gate_center: np.ndarray = field(default_factory=lambda: np.zeros(2))
     gate_shape: np.ndarray = field(default_factory=lambda: np.eye(2))
 
@@ -66,6 +68,13 @@ def _ipda_update(t: _Track, g: _Gated, c: TrackerConstants) -> None:
     assoc = ipda.associate(g.log_lr, c.pdpg)
     t.psi = ipda.update_existence(g.psi_pred, assoc, c.pdpg, len(g.nu))
     t.x, t.P = ipda.pda_update(g.x_pred, g.P_pred, g.H, c.R, g.L, g.nu, assoc)
+    _record_update(t, g, assoc.beta)
+
+
+def _record_update(t: _Track, g: _Gated, beta: np.ndarray) -> None:
+    """Record the frame's gated-measurement count and NIS on the track (read only)."""
+    t.n_associated = len(g.nu)
+    t.nis = ipda.combined_nis(g.nu, beta, g.L)
 
 
 def _step(
@@ -134,6 +143,7 @@ def _step(
                 delta=math.nan, one_minus_delta=math.nan, beta0=float(ja.beta0[i]), beta=ja.beta[i]
             )
             t.x, t.P = ipda.pda_update(gk.x_pred, gk.P_pred, gk.H, c.R, gk.L, gk.nu, assoc)
+            _record_update(t, gk, assoc.beta)
     # initiation from the measurements outside every gate
     for j in np.flatnonzero(initiation.unassociated(gated)):
         x0 = initiation.initial_state(z[j], params.state_dim)
@@ -265,6 +275,8 @@ def run_tracker(
                     gate_center_xy=np.array([t.gate_center for t in tracks]).reshape(n, 2),
                     gate_shape_xy=np.array([t.gate_shape for t in tracks]).reshape(n, 2, 2),
                     birth_frame=np.array([t.birth for t in tracks], dtype=np.int64),
+                    n_associated=np.array([t.n_associated for t in tracks], dtype=np.int64),
+                    nis=np.array([t.nis for t in tracks], dtype=np.float64),
                     estimate=b,
                 )
             )

@@ -102,7 +102,12 @@ def test_micro_doppler_columns_are_the_selected_persons(tracked) -> None:
 def test_track_table_rows_equal_the_trackers_tracks(tracked) -> None:
     window, scene, frames = tracked
     result = window.tracking_model.result
-    k = next(i for i in range(100, 250) if len(result.frames[i]) >= 1)
+    # a frame in which a confirmed track took a measurement into its update
+    k = next(
+        i
+        for i in range(100, 250)
+        if np.any(result.frames[i].confirmed & (result.frames[i].n_associated > 0))
+    )
     window.playback.set_frame(k)
     window.views_control.draw_all(k, frames[k], result)
     table = window.views_control.track_table
@@ -124,6 +129,12 @@ def test_track_table_rows_equal_the_trackers_tracks(tracked) -> None:
         age = (k - ft.birth_frame[r]) * scene.radar.frame_period_s
         assert table.item(r, 8).text() == f"{age:.2f}"
         assert table.item(r, 1).text() == ("confirmed" if ft.confirmed[r] else "tentative")
+        # gated measurements and NIS ε = ν̃ᵀ S⁻¹ ν̃ of this frame's update, as recorded
+        assert table.item(r, 9).text() == str(int(ft.n_associated[r]))
+        nis = f"{ft.nis[r]:.2f}" if np.isfinite(ft.nis[r]) else "–"
+        assert table.item(r, 10).text() == nis
+    shown = [r for r in range(table.rowCount()) if ft.confirmed[r] and ft.n_associated[r] > 0]
+    assert shown and all(table.item(r, 10).text() != "–" for r in shown)
     assert track_rows(result.frames[k], k, scene.radar.frame_period_s)[0][0] == str(ids[0])
 
 

@@ -117,6 +117,8 @@ def _equal_tracks(a, b, tol=1e-10):
         np.testing.assert_allclose(x.state, y.state, rtol=tol, atol=tol)
         np.testing.assert_allclose(x.covariance, y.covariance, rtol=tol, atol=tol)
         np.testing.assert_allclose(x.psi, y.psi, rtol=0, atol=tol)
+        np.testing.assert_array_equal(x.n_associated, y.n_associated)
+        np.testing.assert_allclose(x.nis, y.nis, rtol=tol, atol=tol)  # NaN where NaN
 
 
 def _shared_gate_frames(ds, params):

@@ -85,7 +85,7 @@ def _trajectory(dataset, k):
 def test_recorded_tracks_equal_the_reference(dataset, name):
     p = CASES[name]
     tol = dict(rtol=1e-10, atol=1e-10)
-    n_checked = n_tentative = n_confirmed = 0
+    n_checked = n_tentative = n_confirmed = n_updated = 0
     ids_seen: set[int] = set()
     for k in range(1 if name == "cv-corner-immortal" else dataset.n_trajectories):
         frames = _trajectory(dataset, k)
@@ -116,13 +116,20 @@ def test_recorded_tracks_equal_the_reference(dataset, name):
             np.testing.assert_allclose(
                 a.gate_shape_xy, b.gate_shape_xy, rtol=1e-10, atol=1e-10 * scale
             )
+            # gated measurements and NIS of the frame's update (NaN in the same places)
+            np.testing.assert_array_equal(a.n_associated, b.n_associated)
+            np.testing.assert_allclose(a.nis, b.nis, **tol)
+            newborn = a.birth_frame == f
+            assert np.all(a.n_associated[newborn] == 0) and np.all(np.isnan(a.nis[newborn]))
+            assert np.all(np.isnan(a.nis) == (a.n_associated == 0))
+            n_updated += int((a.n_associated > 0).sum())
             assert np.all(a.birth_frame <= f) and np.all(a.birth_frame >= 0)
             n_checked += len(a)
             n_tentative += int((~a.confirmed).sum())
             n_confirmed += int(a.confirmed.sum())
             ids_seen.update(a.ids.tolist())
     # the comparison is not vacuous: many tracks, both states, births and deaths
-    assert n_checked >= 100 and n_tentative > 0 and n_confirmed > 0
+    assert n_checked >= 100 and n_tentative > 0 and n_confirmed > 0 and n_updated > 0
     if name != "ca-corner-upper":  # there the huge gates swallow all clutter: one track lives
         assert len(ids_seen) > 5  # clutter tracks are born, merged and deleted
 
