@@ -1,0 +1,105 @@
+"""Test data sets: per-set scores are the tracked losses, summaries and ratios bracket them."""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from core.errors import InputError
+from core.evaluation import evaluate as evaluate_table
+from core.evaluation.intervals import bootstrap_interval
+from core.optimization.testsets import compare_models, score_test_sets, summarise
+from core.tracking import TrackerParams, track_dataset
+from core.tracking.synthetic import synthetic_dataset
+
+CV = TrackerParams(model="cv").to_dict()
+CA = TrackerParams(model="ca").to_dict()
+
+
+@pytest.fixture(scope="module")
+def paths(tmp_path_factory) -> list[str]:
+    d = tmp_path_factory.mktemp("tests")
+    out = []
+    for seed in (11, 12, 13):
+        p = d / f"s{seed}.npz"
+        synthetic_dataset(seed=seed, n_per_class=1, classes="abc", n_frames=40).save(p)
+        out.append(str(p))
+    return out
+
+
+@pytest.fixture(scope="module")
+def scores(paths) -> dict[str, list]:
+    return {
+        m: score_test_sets(p, paths, training_path=paths[0]) for m, p in (("cv", CV), ("ca", CA))
+    }
+
+
+def test_per_set_totals_are_the_tracked_loss(paths, scores) -> None:
+    from core.dataset import Dataset
+
+    for path, s in zip(paths, scores["cv"], strict=True):
+        ds = Dataset.load(path)
+        ev = evaluate_table(ds, track_dataset(ds, TrackerParams.from_dict(CV)))
+        assert s.loss["total"] == pytest.approx(ev.loss_total, rel=1e-12)
+        rows = {r["class"]: r["loss"] for r in ev.to_dict()["table"]}
+        for c in "ABC":
+            assert s.loss[c] == pytest.approx(rows[c], rel=1e-12)
+        # one trajectory per class: the total is the mean of the three classes
+        assert s.loss["total"] == pytest.approx(np.mean([s.loss[c] for c in "ABC"]))
+        assert 0.0 <= s.unconfirmed["total"] <= 1.0
+        # a capped trajectory loss never exceeds c² = 0.25 m²
+        assert 0.0 <= s.capped["total"] <= 0.25
+
+
+def test_summary_brackets_mean_and_median(scores) -> None:
+    summ = summarise(scores["cv"])
+    assert list(summ) == ["A", "B", "C", "total"]
+    totals = np.array([s.loss["total"] for s in scores["cv"]])
+    t = summ["total"]
+    assert t.n_sets == 3
+    assert t.mean == pytest.approx(totals.mean()) and t.median == pytest.approx(np.median(totals))
+    assert t.mean_lo <= t.mean <= t.mean_hi
+    assert t.median_lo <= t.median <= t.median_hi
+    # a resampled mean or median lies within the range of the sets
+    assert totals.min() <= t.mean_lo and t.mean_hi <= totals.max()
+    with pytest.raises(InputError, match="metric must be one of"):
+        summarise(scores["cv"], "rmse")
+
+
+def test_identical_sets_give_zero_width_intervals(paths) -> None:
+    s = score_test_sets(CV, [paths[0]] * 4)
+    t = summarise(s)["total"]
+    assert t.mean_lo == t.mean == t.mean_hi == t.median_lo == t.median_hi
+    r = compare_models(s, s)
+    assert r["median_ratio"] == r["median_ratio_lo"] == r["median_ratio_hi"] == 1.0
+    assert r["mean_ratio"] == 1.0 and r["cv_better_sets"] == 0
+
+
+def test_model_ratio_is_paired(scores) -> None:
+    r = compare_models(scores["cv"], scores["ca"])
+    a = np.array([s.loss["total"] for s in scores["cv"]])
+    b = np.array([s.loss["total"] for s in scores["ca"]])
+    assert r["median_ratio"] == pytest.approx(np.median(a) / np.median(b))
+    assert r["mean_ratio"] == pytest.approx(a.mean() / b.mean())
+    assert r["mean_ratio_lo"] <= r["mean_ratio"] <= r["mean_ratio_hi"]
+    # paired resampling: a constant ratio between the models has a zero-width interval
+    v, lo, hi = bootstrap_interval(lambda x, y: x.mean(-1) / y.mean(-1), a, 2 * a)
+    assert v == lo == hi == pytest.approx(0.5)
+    with pytest.raises(InputError, match="different test data sets"):
+        compare_models(scores["cv"], scores["ca"][:2])
+
+
+def test_a_test_set_of_another_radar_is_refused(paths, tmp_path: Path) -> None:
+    from core.dataset import Dataset
+
+    ds = Dataset.load(paths[1])
+    radar = json.loads(ds.radar_json) if ds.radar_json else {}
+    radar["frame_period_s"] = 0.05
+    other = tmp_path / "other.npz"
+    dataclasses.replace(ds, radar_json=json.dumps(radar)).save(other)
+    with pytest.raises(InputError, match="test data set .* another radar configuration"):
+        score_test_sets(CV, [paths[1], str(other)], training_path=paths[0])
