@@ -83,6 +83,14 @@ def _median(x: np.ndarray) -> np.ndarray:
     return np.median(x, axis=-1)
 
 
+def check_test_sets(n_sets: int) -> int:
+    """``n_sets`` if it is a valid number of paper test sets (0: none), else one
+    :class:`InputError` line."""
+    if not 0 <= n_sets <= len(TEST_SEEDS):
+        raise InputError(f"--test-sets must be in [0, {len(TEST_SEEDS)}], got {n_sets}")
+    return n_sets
+
+
 def default_test_paths(training_path: str, n_sets: int) -> list[str]:
     """Paths of the first ``n_sets`` paper test data sets (:data:`TEST_SEEDS`), made like the
     training set (its person model, trajectory count and persons per trajectory); simulated
@@ -90,8 +98,7 @@ def default_test_paths(training_path: str, n_sets: int) -> list[str]:
     from core.dataset import Dataset
     from core.pipeline import paper_dataset_file
 
-    if not 0 <= n_sets <= len(TEST_SEEDS):
-        raise InputError(f"--test-sets must be in [0, {len(TEST_SEEDS)}], got {n_sets}")
+    check_test_sets(n_sets)
     train = Dataset.load(training_path)
     scenes = train.scene()
     first = scenes[0] if isinstance(scenes, list) and scenes else {}
@@ -207,39 +214,49 @@ def compare_models(cv: Sequence[SetScore], ca: Sequence[SetScore]) -> dict[str, 
     }
 
 
-def chosen_params(storage: str, study: str, model: str) -> tuple[dict[str, Any], int, str]:
-    """The study's chosen parameters: the trial with the lowest validation objective when the
-    study recorded a ``validation`` user attribute (:func:`validate_study`), else its best
-    trial. Returns (TrackerParams JSON, trial number, ``"validation"`` or ``"training"``)."""
+def chosen_params(
+    storage: str, studies: Sequence[str], model: str
+) -> tuple[dict[str, Any], str, int, str]:
+    """The chosen parameters among ``studies`` (all of one motion model ``model``).
+
+    The trial with the lowest validation objective when any study recorded a ``validation``
+    user attribute (:func:`core.optimization.validation.validate_study`; with
+    ``tune --repeats`` the choice is among all studies' validated trials), else the best trial
+    by training objective. Returns (TrackerParams JSON, study, trial number, ``"validation"`` or
+    ``"training"``).
+    """
     from core.optimization.space import tracker_params_dict
     from core.optimization.storage import load_existing_study, open_storage, redact
 
-    s = load_existing_study(open_storage(storage, create=False), study)
-    if s is None:
-        raise InputError(f"no study {study!r} in {redact(storage)}")
-    done = {
-        t.number: t
-        for t in s.get_trials(deepcopy=False)
-        if t.state.name == "COMPLETE" and t.value is not None
-    }
-    if not done:
-        raise InputError(f"study {study!r} has no completed trial")
-    record = (s.user_attrs.get("validation") or {}).get("trials") or {}
-    known = {int(k): float(v[0]) for k, v in record.items() if int(k) in done}
-    if known:
-        number = min(known, key=lambda k: (known[k], k))
-        how = "validation"
-    else:
-        number = min(done, key=lambda k: (done[k].value, k))
-        how = "training"
-    flat = {k: float(v) for k, v in done[number].params.items()}
-    return tracker_params_dict(flat, model), number, how
+    store = open_storage(storage, create=False)
+    validated: list[tuple[float, str, int, Any]] = []
+    trained: list[tuple[float, str, int, Any]] = []
+    for name in studies:
+        s = load_existing_study(store, name)
+        if s is None:
+            raise InputError(f"no study {name!r} in {redact(storage)}")
+        done = {
+            t.number: t
+            for t in s.get_trials(deepcopy=False)
+            if t.state.name == "COMPLETE" and t.value is not None
+        }
+        record = (s.user_attrs.get("validation") or {}).get("trials") or {}
+        validated += [(float(v[0]), name, int(k), done[int(k)]) for k, v in record.items()
+                      if int(k) in done]  # fmt: skip
+        trained += [(float(t.value), name, n, t) for n, t in done.items()]
+    pool, how = (validated, "validation") if validated else (trained, "training")
+    if not pool:
+        raise InputError(f"no completed trial in the {model.upper()} studies {list(studies)}")
+    _, name, number, trial = min(pool, key=lambda v: (v[0], v[1], v[2]))
+    flat = {k: float(v) for k, v in trial.params.items()}
+    return tracker_params_dict(flat, model), name, number, how
 
 
 __all__ = [
     "METRICS",
     "SetScore",
     "Spread",
+    "check_test_sets",
     "chosen_params",
     "compare_models",
     "default_test_paths",

@@ -103,3 +103,78 @@ def test_a_test_set_of_another_radar_is_refused(paths, tmp_path: Path) -> None:
     dataclasses.replace(ds, radar_json=json.dumps(radar)).save(other)
     with pytest.raises(InputError, match="test data set .* another radar configuration"):
         score_test_sets(CV, [paths[1], str(other)], training_path=paths[0])
+
+
+@pytest.fixture(scope="module")
+def storage(paths, tmp_path_factory) -> str:
+    from core.optimization import StudySettings, prepare_study, run_worker
+
+    d = tmp_path_factory.mktemp("studies")
+    url = f"sqlite:///{d}/s.db"
+    for model in ("cv", "ca"):
+        s = StudySettings(model=model, n_trials=3, storage=url, study_name=f"{model}-main",
+                          dataset=paths[0], pruner="none")  # fmt: skip
+        prepare_study(s, dataset_path=paths[0])
+        run_worker(url, s.name, seed=0)
+    return url
+
+
+def test_report_scores_the_chosen_parameters_on_the_test_sets(
+    paths, storage, tmp_path: Path, capsys
+) -> None:
+    from core.cli import main
+    from core.optimization.testsets import chosen_params
+    from core.optimization.validation import validate_study
+
+    # CV validated on the second set: the report takes its validated choice, CA its best trial
+    validated = validate_study(storage, "cv-main", paths[1], top_k=3)
+    out = tmp_path / "out"
+    argv = ["report", "--storage", storage, "--out", str(out), "--generalisation", "none"]
+    code = main([*argv, *(a for p in paths[1:] for a in ("--test-set", p))])
+    assert code == 0, capsys.readouterr().err
+    r = json.loads((out / "report.json").read_text())
+    t = r["test_sets"]
+    assert t["datasets"] == [Path(p).name for p in paths[1:]]
+    cv, ca = t["models"]["cv"], t["models"]["ca"]
+    assert (cv["chosen_by"], cv["trial"]) == ("validation", validated[0].number)
+    assert ca["chosen_by"] == "training"
+    params, _, number, _ = chosen_params(storage, ["ca-main"], "ca")
+    assert number == ca["trial"]
+    expect = score_test_sets(params, paths[1:])
+    assert [s["loss"]["total"] for s in ca["per_set"]] == [s.loss["total"] for s in expect]
+    assert ca["loss"]["total"]["median"] == pytest.approx(
+        np.median([s.loss["total"] for s in expect])
+    )
+    assert t["cv_over_ca"]["n_sets"] == 2
+    assert (out / "test_sets.png").stat().st_size > 0
+    md = (out / "report.md").read_text()
+    assert "## Test data sets (2 sets no study saw)" in md
+    assert f"{ca['loss']['total']['median'] * 1e3:.4f}" in md
+
+
+def test_report_bad_test_set_arguments(paths, storage, tmp_path: Path, capsys) -> None:
+    from core.cli import main
+    from core.dataset import Dataset
+
+    argv = [
+        "report",
+        "--storage",
+        storage,
+        "--out",
+        str(tmp_path / "o"),
+        "--generalisation",
+        "none",
+    ]
+    assert main([*argv, "--test-sets", "-1"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "--test-sets must be in [0, 20], got -1" in err and len(err.splitlines()) == 1
+    assert not (tmp_path / "o").exists() or not any((tmp_path / "o").iterdir())
+    ds = Dataset.load(paths[1])
+    radar = json.loads(ds.radar_json) if ds.radar_json else {}
+    radar["frame_period_s"] = 0.05
+    other = tmp_path / "other.npz"
+    dataclasses.replace(ds, radar_json=json.dumps(radar)).save(other)
+    assert main([*argv, "--test-set", str(other)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "another radar configuration" in err and len(err.splitlines()) == 1
+    assert not (tmp_path / "o").exists() or not any((tmp_path / "o").iterdir())
