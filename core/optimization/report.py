@@ -447,12 +447,20 @@ def plot_test_sets(entry: dict[str, Any], path: Path) -> None:
     models = [m for m in ("cv", "ca") if m in entry["models"]]
     data = [[s["loss"]["total"] * 1e3 for s in entry["models"][m]["per_set"]] for m in models]
     fig, ax = plt.subplots(figsize=(5.5, 4.2))
-    ax.boxplot(data, showmeans=True, meanprops={"marker": "D", "markerfacecolor": "w"})
+    # every set is drawn as a point, so the box shows no outliers of its own
+    ax.boxplot(
+        data,
+        showmeans=True,
+        showfliers=False,
+        meanprops={"marker": "D", "markerfacecolor": "w", "markeredgecolor": "k"},
+        medianprops={"color": "tab:orange", "lw": 2},
+    )
     ax.set_xticks(range(1, len(models) + 1), [m.upper() for m in models])
     rng = np.random.default_rng(0)  # horizontal jitter of the points only
     for i, d in enumerate(data, start=1):
         ax.plot(i + rng.uniform(-0.12, 0.12, len(d)), d, "o", ms=4, alpha=0.6, color="tab:blue")
     ax.set_ylabel("L_t per test data set (×10⁻³)")
+    ax.set_xlabel("box: quartiles, line: median, ◇: mean, whiskers: 1.5 IQR; dots: the sets")
     ax.set_title(f"Chosen parameters on {len(entry['datasets'])} test data sets")
     ax.grid(True, axis="y", alpha=0.3)
     _save_fig(fig, path)
@@ -470,8 +478,9 @@ def _test_section(r: dict[str, Any]) -> list[str]:
         "",
         "The chosen parameters (by validation when the studies were validated, else the best "
         "trial) tracked on every test set; per class and in total the mean and the median of "
-        "the per-set L over the sets, ×10⁻³, with 95 % bootstrap intervals over the sets; the "
-        "capped loss and the fraction of trajectories never confirmed in total.",
+        "the per-set L over the sets with 95 % bootstrap intervals over the sets, and the same "
+        "for the capped loss (both ×10⁻³) and the percentage of trajectories never confirmed, "
+        "in total.",
         "",
         "| model | class | mean | 95 % interval | median | 95 % interval |",
         "|---|---|---|---|---|---|",
