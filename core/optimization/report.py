@@ -404,7 +404,10 @@ def score_chosen(
         summarise,
     )
 
-    say = progress or (lambda line: None)
+    def say(line: str) -> None:
+        if progress is not None:
+            progress(line)
+
     if not paths:
         say(
             f"making {n_sets} paper test data sets (simulated on first use: minutes of CPU each, "
@@ -418,10 +421,11 @@ def score_chosen(
         if not names:
             continue
         params, study, number, how = chosen_params(storage, names, model)
-        sc = score_test_sets(
-            params, paths, training_path=train_file,
-            progress=lambda i, n, m=model: say(f"{m.upper()}: test set {i}/{n} tracked"),
-        )  # fmt: skip
+
+        def tracked(i: int, n: int, m: str = model) -> None:
+            say(f"{m.upper()}: test set {i}/{n} tracked")
+
+        sc = score_test_sets(params, paths, training_path=train_file, progress=tracked)
         scores[model] = sc
         entry["models"][model] = {
             "study": study,

@@ -101,7 +101,7 @@ def default_test_paths(training_path: str, n_sets: int) -> list[str]:
     check_test_sets(n_sets)
     train = Dataset.load(training_path)
     scenes = train.scene()
-    first = scenes[0] if isinstance(scenes, list) and scenes else {}
+    first: Any = scenes[0] if isinstance(scenes, list) and scenes else {}
     persons = first.get("persons", [{}]) if isinstance(first, dict) else [{}]
     model = str((persons[0] if persons else {}).get("model", "point"))
     return [
