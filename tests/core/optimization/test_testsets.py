@@ -178,3 +178,34 @@ def test_report_bad_test_set_arguments(paths, storage, tmp_path: Path, capsys) -
     err = capsys.readouterr().err.strip()
     assert "another radar configuration" in err and len(err.splitlines()) == 1
     assert not (tmp_path / "o").exists() or not any((tmp_path / "o").iterdir())
+
+
+def test_default_test_sets_are_made_like_the_training_set(paths, tmp_path: Path, monkeypatch):
+    """The paper test seeds, with the training set's trajectory count, person model and persons
+    (the generator is replaced: no paper data set is simulated here)."""
+    import core.pipeline
+    from core.dataset import Dataset
+    from core.optimization.testsets import default_test_paths
+    from core.optimization.validation import TEST_SEEDS
+
+    ds = Dataset.load(paths[0])
+    scenes = [{"persons": [{"model": "walking"}]}] * ds.n_trajectories
+    train = tmp_path / "walking.npz"
+    dataclasses.replace(ds, scene_json=json.dumps(scenes)).save(train)
+    calls = []
+
+    def fake(seed, n, *, person_model, n_persons):
+        calls.append((seed, n, person_model, n_persons))
+        return tmp_path / f"{seed}.npz"
+
+    monkeypatch.setattr(core.pipeline, "paper_dataset_file", fake)
+    got = default_test_paths(str(train), 3)
+    assert (
+        got
+        == [str(tmp_path / f"{s}.npz") for s in TEST_SEEDS[:3]]
+        == [str(tmp_path / f"{s}.npz") for s in (2000, 2001, 2002)]
+    )
+    assert calls == [(s, ds.n_trajectories, "walking", 1) for s in (2000, 2001, 2002)]
+    assert default_test_paths(str(train), 0) == []
+    with pytest.raises(InputError, match=r"--test-sets must be in \[0, 20\], got 21"):
+        default_test_paths(str(train), 21)
