@@ -23,6 +23,22 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         help="person model of a paper:SEED generalisation set: point (default), blob "
         "(former name extended) or walking",
     )
+    p.add_argument(
+        "--test-sets",
+        type=int,
+        default=20,
+        metavar="N",
+        help="score the chosen parameters on N paper test data sets (seeds 2000…; made like the "
+        "training set; simulated on first use, minutes each, cached) (default: %(default)s; 0: "
+        "off)",
+    )
+    p.add_argument(
+        "--test-set",
+        action="append",
+        default=None,
+        metavar="PATH",
+        help="a test data-set file instead of the paper ones (repeatable)",
+    )
     p.set_defaults(func=run)
 
 
@@ -38,13 +54,27 @@ def run(args: argparse.Namespace) -> int:
             gen = f"{gen}:{args.person_model}"
     command = "radartune " + " ".join(shlex.quote(a) for a in sys.argv[1:])
     r = write_report(
-        args.storage, args.out, dataset=args.dataset, generalisation_dataset=gen, command=command
+        args.storage,
+        args.out,
+        dataset=args.dataset,
+        generalisation_dataset=gen,
+        command=command,
+        test_sets=args.test_sets,
+        test_paths=args.test_set,
+        progress=lambda line: print(line, file=sys.stderr, flush=True),
     )
     for model, m in r["models"].items():
         line = f"{model.upper()}: L_t = {m['training']['loss_total_x1e3']:.4f} x1e-3"
         if "generalisation" in m:
             line += f" (other seed: {m['generalisation']['loss_total_x1e3']:.4f} x1e-3)"
         print(line)
+    for model, m in r.get("test_sets", {}).get("models", {}).items():
+        t = m["loss"]["total"]
+        print(
+            f"{model.upper()} on {t['n_sets']} test sets: median L_t = {t['median'] * 1e3:.4f} "
+            f"[{t['median_lo'] * 1e3:.4f}, {t['median_hi'] * 1e3:.4f}] x1e-3, mean "
+            f"{t['mean'] * 1e3:.4f} [{t['mean_lo'] * 1e3:.4f}, {t['mean_hi'] * 1e3:.4f}] x1e-3"
+        )
     if "conclusion" in r:
         print(f"CV/CA = {r['conclusion']['cv_over_ca']:.3f}")
     print(f"written: {args.out}/report.md")

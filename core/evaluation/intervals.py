@@ -6,6 +6,8 @@ seed, trajectory) with a mask of the runs that had a confirmed track. Used by th
 
 - :func:`loss_ratio_interval` — ratio of mean losses with a paired bootstrap interval over the
   trajectories, and :func:`verdict` on it against a tolerance band;
+- :func:`bootstrap_interval` — any statistic of one or several paired samples (e.g. the median
+  loss over test data sets, or the ratio of two models' medians) with a percentile interval;
 - :func:`regular_loss` — the loss of the runs with a confirmed track (the runs without one,
   ``L = 1 m^2`` by SPEC §5, are counted apart: :func:`rate_interval`);
 - :func:`exact_median_loss` and :func:`split_tail` — the runs with a track split into rare *tail
@@ -20,12 +22,15 @@ of a mean loss can come from a handful of runs.
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 
 __all__ = [
     "LOSS_TOLERANCE",
     "N_BOOTSTRAP",
     "TAIL_FACTOR",
+    "bootstrap_interval",
     "exact_median_loss",
     "loss_ratio_interval",
     "rate_interval",
@@ -72,6 +77,45 @@ def loss_ratio_interval(
     boot = num[den > 0] / den[den > 0]
     lo, hi = np.percentile(boot, [2.5, 97.5]) if len(boot) else (np.nan, np.nan)
     return float(level.sum() / exact.sum()), float(lo), float(hi)
+
+
+def bootstrap_interval(
+    statistic: Callable[..., np.ndarray],
+    *samples: np.ndarray,
+    n_boot: int = N_BOOTSTRAP,
+    seed: int = 0,
+) -> tuple[float, float, float]:
+    """A statistic of paired samples with its 95 % percentile bootstrap interval.
+
+    Parameters
+    ----------
+    statistic
+        ``statistic(*arrays)`` → value; called once on the ``(n,)`` samples and once on the
+        ``(n_boot, n)`` resamples, where it must reduce along the last axis (``(n_boot,)``), as
+        ``lambda x: np.median(x, axis=-1)`` does.
+    samples
+        ``(n,)`` each, the same units in the same order (paired: every sample is resampled with
+        the same indices), e.g. one total loss per test data set for each of two models.
+
+    Returns
+    -------
+    value, lo, hi
+        The statistic and its 2.5 / 97.5 % percentiles over the resamples (non-finite
+        resampled values, e.g. a ratio with a zero denominator, left out; NaN when none is
+        finite). With identical units the interval has zero width.
+    """
+    xs = [np.asarray(x, float) for x in samples]
+    n = len(xs[0])
+    if n == 0 or any(len(x) != n for x in xs):
+        raise ValueError(f"samples must be non-empty and of one length, got {[len(x) for x in xs]}")
+    rng = np.random.default_rng(seed)
+    idx = rng.integers(0, n, (n_boot, n))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        value = float(statistic(*xs))
+        boot = np.asarray(statistic(*(x[idx] for x in xs)), float)
+    boot = boot[np.isfinite(boot)]
+    lo, hi = np.percentile(boot, [2.5, 97.5]) if len(boot) else (np.nan, np.nan)
+    return value, float(lo), float(hi)
 
 
 def regular_loss(loss: np.ndarray, seen: np.ndarray) -> np.ndarray:

@@ -13,6 +13,10 @@ second data set of another seed with the best parameters, and writes into one fo
 - ``loss_vs_time_<model>.png`` — best loss so far against wall-clock seconds for every study of
   the model (TPE / random sampling, with / without pruning);
 - ``tracks.png`` — truth and CV / CA estimates on maneuvering trajectories (classes c, d, e);
+- ``test_sets.png`` — the per-set L_t of the chosen parameters on the test data sets
+  (:mod:`core.optimization.testsets`; chosen by validation when the studies were validated),
+  a box and strip plot per model, beside a table per class of mean and median with 95 %
+  intervals over the sets and the CV / CA ratios;
 - ``report.json`` — every number above.
 
 Every file is written to a temporary name and renamed.
@@ -24,7 +28,7 @@ import datetime as dt
 import json
 import math
 import os
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -245,6 +249,9 @@ def write_report(
     dataset: str | None = None,
     generalisation_dataset: str | None = "paper:1",
     command: str = "",
+    test_sets: int = 0,
+    test_paths: Sequence[str] | None = None,
+    progress: Callable[[str], None] | None = None,
 ) -> dict[str, Any]:
     """Write the report folder (see the module docstring); return the JSON dict.
 
@@ -260,11 +267,20 @@ def write_report(
         Second data set from another seed (``paper:SEED`` or a path); None: skipped.
     command
         The command line that made the report, quoted in it.
+    test_sets
+        Number of paper test data sets (:data:`core.optimization.validation.TEST_SEEDS`, made
+        like the training set) the chosen parameters are scored on; 0: none.
+    test_paths
+        Test data-set files instead of the paper ones (``test_sets`` is then ignored).
+    progress
+        Called with a line of progress while the test sets are made and tracked.
     """
     from core.dataset import Dataset
     from core.optimization.data import resolve_dataset
+    from core.optimization.testsets import check_test_sets
     from core.tracking import TrackerParams
 
+    check_test_sets(test_sets)
     studies = load_studies(storage)
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
@@ -281,9 +297,16 @@ def write_report(
     train_path = dataset or next(iter(mains.values())).dataset
     if not train_path:
         raise InputError("the studies record no data set; pass --dataset")
-    train = Dataset.load(resolve_dataset(train_path))
+    train_file = resolve_dataset(train_path)
+    train = Dataset.load(train_file)
     other = (
         Dataset.load(resolve_dataset(generalisation_dataset)) if generalisation_dataset else None
+    )
+    # the test sets first: a refused one stops the report before any file is written
+    tests = (
+        score_chosen(storage, studies, train_file, test_sets, test_paths, progress)
+        if test_paths or test_sets
+        else None
     )
 
     result: dict[str, Any] = {
@@ -347,6 +370,10 @@ def write_report(
     if picks:
         plot_tracks(train, estimates, picks, out / "tracks.png")
         plots.append("tracks.png")
+    if tests is not None:
+        result["test_sets"] = tests
+        plot_test_sets(result["test_sets"], out / "test_sets.png")
+        plots.append("test_sets.png")
     result["plots"] = plots
     if "cv" in result["models"] and "ca" in result["models"]:
         cv = result["models"]["cv"]["training"]["loss_total"]
@@ -358,6 +385,139 @@ def write_report(
     write_json_atomic(out / "report.json", result)
     write_text_atomic(out / "report.md", render_markdown(result))
     return result
+
+
+def score_chosen(
+    storage: str,
+    studies: Sequence[StudyRecord],
+    train_file: str,
+    n_sets: int,
+    paths: Sequence[str] | None,
+    progress: Callable[[str], None] | None = None,
+) -> dict[str, Any]:
+    """The ``test_sets`` entry of the report: each model's chosen parameters on the test sets."""
+    from core.optimization.testsets import (
+        chosen_params,
+        compare_models,
+        default_test_paths,
+        score_test_sets,
+        summarise,
+    )
+
+    def say(line: str) -> None:
+        if progress is not None:
+            progress(line)
+
+    if not paths:
+        say(
+            f"making {n_sets} paper test data sets (simulated on first use: minutes of CPU each, "
+            "cached afterwards)"
+        )
+        paths = default_test_paths(train_file, n_sets)
+    scores = {}
+    entry: dict[str, Any] = {"datasets": [Path(p).name for p in paths], "models": {}}
+    for model in ("cv", "ca"):
+        names = sorted(s.name for s in studies if s.model == model and s.best is not None)
+        if not names:
+            continue
+        params, study, number, how = chosen_params(storage, names, model)
+
+        def tracked(i: int, n: int, m: str = model) -> None:
+            say(f"{m.upper()}: test set {i}/{n} tracked")
+
+        sc = score_test_sets(params, paths, training_path=train_file, progress=tracked)
+        scores[model] = sc
+        entry["models"][model] = {
+            "study": study,
+            "trial": number,
+            "chosen_by": how,
+            "params": params,
+            "per_set": [s.to_dict() for s in sc],
+            **{m: {c: v.to_dict() for c, v in summarise(sc, m).items()}
+               for m in ("loss", "capped", "unconfirmed")},
+        }  # fmt: skip
+    if len(scores) == 2:
+        entry["cv_over_ca"] = compare_models(scores["cv"], scores["ca"])
+    return entry
+
+
+def plot_test_sets(entry: dict[str, Any], path: Path) -> None:
+    """Box and strip plot of the per-set L_t (×10⁻³) of each model's chosen parameters."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    models = [m for m in ("cv", "ca") if m in entry["models"]]
+    data = [[s["loss"]["total"] * 1e3 for s in entry["models"][m]["per_set"]] for m in models]
+    fig, ax = plt.subplots(figsize=(5.5, 4.2))
+    # every set is drawn as a point, so the box shows no outliers of its own
+    ax.boxplot(
+        data,
+        showmeans=True,
+        showfliers=False,
+        meanprops={"marker": "D", "markerfacecolor": "w", "markeredgecolor": "k"},
+        medianprops={"color": "tab:orange", "lw": 2},
+    )
+    ax.set_xticks(range(1, len(models) + 1), [m.upper() for m in models])
+    rng = np.random.default_rng(0)  # horizontal jitter of the points only
+    for i, d in enumerate(data, start=1):
+        ax.plot(i + rng.uniform(-0.12, 0.12, len(d)), d, "o", ms=4, alpha=0.6, color="tab:blue")
+    ax.set_ylabel("L_t per test data set (×10⁻³)")
+    ax.set_xlabel("box: quartiles, line: median, ◇: mean, whiskers: 1.5 IQR; dots: the sets")
+    ax.set_title(f"Chosen parameters on {len(entry['datasets'])} test data sets")
+    ax.grid(True, axis="y", alpha=0.3)
+    _save_fig(fig, path)
+    plt.close(fig)
+
+
+def _test_section(r: dict[str, Any]) -> list[str]:
+    """Markdown of the test-set distributions."""
+    t = r.get("test_sets")
+    if not t:
+        return []
+    lines = [
+        "",
+        f"## Test data sets ({len(t['datasets'])} sets no study saw)",
+        "",
+        "The chosen parameters (by validation when the studies were validated, else the best "
+        "trial) tracked on every test set; per class and in total the mean and the median of "
+        "the per-set L over the sets with 95 % bootstrap intervals over the sets, and the same "
+        "for the capped loss (both ×10⁻³) and the percentage of trajectories never confirmed, "
+        "in total.",
+        "",
+        "| model | class | mean | 95 % interval | median | 95 % interval |",
+        "|---|---|---|---|---|---|",
+    ]
+
+    def row(model: str, label: str, v: dict[str, Any], scale: float, fmt: str) -> str:
+        def iv(a: str) -> str:
+            return f"[{_f(v[a + '_lo'] * scale, fmt)}, {_f(v[a + '_hi'] * scale, fmt)}]"
+
+        return (
+            f"| {model.upper()} | {label} | {_f(v['mean'] * scale, fmt)} | {iv('mean')} | "
+            f"{_f(v['median'] * scale, fmt)} | {iv('median')} |"
+        )
+
+    for model, m in t["models"].items():
+        for c, v in m["loss"].items():
+            lines.append(row(model, c, v, 1e3, ".4f"))
+        lines.append(row(model, "capped loss, total", m["capped"]["total"], 1e3, ".4f"))
+        lines.append(row(model, "% never confirmed", m["unconfirmed"]["total"], 100.0, ".1f"))
+    lines.append("")
+    for model, m in t["models"].items():
+        lines.append(f"- {model.upper()}: study `{m['study']}`, trial {m['trial']} "
+                     f"(chosen by {m['chosen_by']})")  # fmt: skip
+    if "cv_over_ca" in t:
+        c = t["cv_over_ca"]
+        lines += [
+            "",
+            f"CV / CA over the test sets (paired bootstrap): ratio of medians "
+            f"{c['median_ratio']:.3f} [{c['median_ratio_lo']:.3f}, {c['median_ratio_hi']:.3f}], "
+            f"ratio of means {c['mean_ratio']:.3f} [{c['mean_ratio_lo']:.3f}, "
+            f"{c['mean_ratio_hi']:.3f}]; CV lower on {c['cv_better_sets']} of {c['n_sets']} sets.",
+        ]
+    return lines
 
 
 def render_markdown(r: dict[str, Any]) -> str:
@@ -466,6 +626,7 @@ def render_markdown(r: dict[str, Any]) -> str:
                 f"{_f(e['ospa_mean_m'], '.3f')} |"
             )
     lines += _people_section(r)
+    lines += _test_section(r)
     lines += ["", "## Best parameters", ""]
     for model in ("cv", "ca"):
         if model not in models:
