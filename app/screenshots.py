@@ -33,6 +33,23 @@ def wait_until(qa, cond, timeout_s: float) -> bool:
     return cond()
 
 
+def open_window(out: Path, scene_path: str | None = None):
+    """The application, a main window on fresh settings (in a temporary folder, also returned)
+    and the output folder ``out`` created: what both screenshot scripts start from."""
+    import pyqtgraph as pg
+    from PySide6 import QtCore, QtWidgets
+
+    from app.window import MainWindow
+
+    qa = QtWidgets.QApplication.instance() or QtWidgets.QApplication(sys.argv[:1])
+    pg.setConfigOptions(imageAxisOrder="row-major")
+    out.mkdir(parents=True, exist_ok=True)
+    tmp = Path(tempfile.mkdtemp(prefix="radartune-shots-"))
+    settings = QtCore.QSettings(str(tmp / "settings.ini"), QtCore.QSettings.IniFormat)
+    kwargs = {} if scene_path is None else {"scene_path": scene_path}
+    return qa, MainWindow(settings, restore=False, **kwargs), tmp
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m app.screenshots", description=__doc__)
     parser.add_argument("--out", default="docs/screenshots", help="output folder")
@@ -44,18 +61,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--height", type=int, default=1000)
     args = parser.parse_args(argv)
 
-    import pyqtgraph as pg
-    from PySide6 import QtCore, QtWidgets
-
-    from app.window import MainWindow
-
-    qa = QtWidgets.QApplication.instance() or QtWidgets.QApplication(sys.argv[:1])
-    pg.setConfigOptions(imageAxisOrder="row-major")
     out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
-    tmp = Path(tempfile.mkdtemp(prefix="radartune-shots-"))
-    settings = QtCore.QSettings(str(tmp / "settings.ini"), QtCore.QSettings.IniFormat)
-    w = MainWindow(settings, restore=False)
+    qa, w, tmp = open_window(out)
     w.resize(args.width, args.height)
     w.show()
     if not wait_until(qa, lambda: w.cache.complete, 300):

@@ -12,12 +12,11 @@ from __future__ import annotations
 import argparse
 import shutil
 import sys
-import tempfile
 from pathlib import Path
 
 import app  # noqa: F401  (thread settings before numpy)
 from app.engine import ROOT
-from app.screenshots import wait_until
+from app.screenshots import open_window, wait_until
 
 SHOTS = (
     ("ra_view", "views_range_azimuth.png"),
@@ -38,18 +37,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--frame", type=int, default=60, help="frame shown (0-based)")
     args = parser.parse_args(argv)
 
-    import pyqtgraph as pg
-    from PySide6 import QtCore, QtWidgets
-
-    from app.window import MainWindow
-
-    qa = QtWidgets.QApplication.instance() or QtWidgets.QApplication(sys.argv[:1])
-    pg.setConfigOptions(imageAxisOrder="row-major")
     out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
-    tmp = Path(tempfile.mkdtemp(prefix="radartune-shots-"))
-    settings = QtCore.QSettings(str(tmp / "settings.ini"), QtCore.QSettings.IniFormat)
-    w = MainWindow(settings, restore=False, scene_path=args.scene)
+    qa, w, tmp = open_window(out, args.scene)
     w.resize(1600, 1000)
     w.show()
     if not wait_until(qa, lambda: w.cache.complete, 600):

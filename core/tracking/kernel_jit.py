@@ -252,6 +252,18 @@ def _better(psi_a, id_a, psi_b, id_b):
 
 
 @njit(cache=True)
+def _pair_d2(X, P, a, b, i):
+    """Squared Mahalanobis distance of tracks ``a`` and ``b`` in state components ``i, i+1``
+    (position: 0, velocity: 2): Δᵀ (P_a + P_b)⁻¹ Δ with the 2 × 2 inverse written out."""
+    dx = X[a, i] - X[b, i]
+    dy = X[a, i + 1] - X[b, i + 1]
+    c00 = P[a, i, i] + P[b, i, i]
+    c01 = P[a, i, i + 1] + P[b, i, i + 1]
+    c11 = P[a, i + 1, i + 1] + P[b, i + 1, i + 1]
+    return (c11 * dx * dx - 2.0 * c01 * dx * dy + c00 * dy * dy) / (c00 * c11 - c01 * c01)
+
+
+@njit(cache=True)
 def _compact(keep, nt, X, P, psi, conf, ids):
     j = 0
     for i in range(nt):
@@ -728,28 +740,12 @@ def track_kernel(frames_, c_, out_, check, record, rec_):
                         b = order[ib]
                         if not keep[b]:
                             continue
-                        dx = X[a, 0] - X[b, 0]
-                        dy = X[a, 1] - X[b, 1]
-                        c00 = P[a, 0, 0] + P[b, 0, 0]
-                        c01 = P[a, 0, 1] + P[b, 0, 1]
-                        c11 = P[a, 1, 1] + P[b, 1, 1]
                         # d² = Δpᵀ (P_a + P_b)⁻¹ Δp
-                        dd = (c11 * dx * dx - 2.0 * c01 * dx * dy + c00 * dy * dy) / (
-                            c00 * c11 - c01 * c01
-                        )
-                        if dd > gamma2:
+                        if _pair_d2(X, P, a, b, 0) > gamma2:
                             continue
                         if joint and conf[a] and conf[b]:
                             # confirmed pairs (JIPDA): also Δvᵀ (P_v,a + P_v,b)⁻¹ Δv ≤ 2 ln 10
-                            dx = X[a, 2] - X[b, 2]
-                            dy = X[a, 3] - X[b, 3]
-                            c00 = P[a, 2, 2] + P[b, 2, 2]
-                            c01 = P[a, 2, 3] + P[b, 2, 3]
-                            c11 = P[a, 3, 3] + P[b, 3, 3]
-                            dd = (c11 * dx * dx - 2.0 * c01 * dx * dy + c00 * dy * dy) / (
-                                c00 * c11 - c01 * c01
-                            )
-                            if dd > VELOCITY_MERGE_D2:
+                            if _pair_d2(X, P, a, b, 2) > VELOCITY_MERGE_D2:
                                 continue
                         keep[b] = False
                 if record:
