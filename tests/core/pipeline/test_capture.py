@@ -8,6 +8,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from core.benchmarks.clouds import real_data_dir
 from core.config import SPEED_OF_LIGHT_MPS
 from core.dataset import Dataset
 from core.errors import InputError
@@ -27,10 +28,8 @@ from core.scene import Scene
 from core.simulation.frame import process_cube
 from tests.scenes import small_scene
 
-ROOT = Path(__file__).resolve().parents[3]
-REAL = ROOT.parent.parent / "shared" / "real" / "openradar_adc"
-if not REAL.is_dir():  # the worktrees sit two levels below /work
-    REAL = Path("/work/shared/real/openradar_adc")
+#: the real DCA1000 frames beside the checkout (../shared/real; $RADARTUNE_REAL_DATA overrides)
+REAL = real_data_dir() / "openradar_adc"
 
 
 @pytest.fixture(scope="module")
@@ -241,6 +240,7 @@ def _plain_peak(x: np.ndarray) -> tuple[int, int]:
     return int(k), int(j) - x.shape[0] // 2
 
 
+@pytest.mark.skipif(not REAL.is_dir(), reason=f"real recordings not present: {REAL}")
 @pytest.mark.parametrize(
     ("name", "range_m", "velocity_mps"),
     [("doppler_example_1", 2.9, 0.6), ("simple_frame_1", 2.0, -0.7)],
