@@ -194,15 +194,17 @@ def run(args: argparse.Namespace) -> int:
             plans.append((_repeat(base, i, args.repeats, dataset=sets[i]), train_path))
     else:
         plans = [(_repeat(base, i, args.repeats, dataset=None), None) for i in range(args.repeats)]
-    chosen = []
+    chosen: list[dict] = []
     for settings, path in plans:
         code, best = run_study(settings, path, progress=not args.no_progress)
-        if code != EXIT_OK:
-            return code
         record: dict = {"study": settings.name}
         if best is not None:
             record.update(best_trial=best.number, best_loss=best.value)
             record["params"] = best.tracker_params(settings.model)
+        if code != EXIT_OK:
+            # interrupted or a worker lost: the best so far, not validated, and the study's code
+            print(json.dumps({"loss": args.loss, "studies": [*chosen, record]}))
+            return code
         if validation is not None and best is not None:
             from core.optimization.validation import validate_study
 

@@ -8,6 +8,7 @@ server binaries are missing the test fails; elsewhere it is skipped with the rea
 from __future__ import annotations
 
 import glob
+import json
 import os
 import pwd
 import shutil
@@ -304,7 +305,7 @@ def test_killed_worker_exits_3_resumable_and_the_same_command_completes(tmp_path
             parent.kill()
             pytest.fail(f"no running trial to kill: {parent.communicate()[1]}")
         os.kill(victim, signal.SIGKILL)
-        _, err = parent.communicate(timeout=30)
+        out, err = parent.communicate(timeout=30)
     finally:
         if parent.poll() is None:
             parent.kill()
@@ -314,6 +315,11 @@ def test_killed_worker_exits_3_resumable_and_the_same_command_completes(tmp_path
     assert f"worker {victim} was killed by SIGKILL" in last
     assert "resumable" in last and "run the same command again" in last
     assert "Traceback" not in err
+    # the best trial so far is still printed (not validated: the study is unfinished)
+    (study,) = json.loads(out)["studies"]
+    assert study["study"] == "k" and study["best_trial"] in {
+        n for n, (state, _) in _states(url, "k").items() if state == "COMPLETE"
+    }
 
     again = cli(*args)
     assert again.returncode == EXIT_OK, again.stderr
