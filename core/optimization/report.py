@@ -291,8 +291,9 @@ def write_report(
     used = {s.dataset for s in studies if s.dataset}
     if dataset is None and len(used) > 1:
         raise InputError(
-            f"storage {redact(storage)}: studies ran on different data sets {sorted(used)}; "
-            "pass --dataset to choose one (best parameters are compared on one data set)"
+            f"storage {redact(storage)}: studies ran on different data sets {sorted(used)} "
+            "(tune --repeats trains each study on its own); pass --dataset to choose the one "
+            "Table I is re-made on (best parameters are compared on one data set)"
         )
     train_path = dataset or next(iter(mains.values())).dataset
     if not train_path:
