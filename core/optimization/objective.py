@@ -127,11 +127,18 @@ class TrackerLosses:
     base_params
         TrackerParams JSON keys that are not optimised (``p_g``, thresholds, ``clutter_density``);
         the trial's parameters override them.
+    capped
+        Also score the capped loss ``C(k)`` (:mod:`core.evaluation.robust`); without it the
+        scores' ``capped`` is NaN. It costs about a tenth of a trial, so a study computes it
+        only when its objective uses it (:func:`uses_capped`).
     """
 
-    def __init__(self, dataset: Any, base_params: dict[str, Any] | None = None) -> None:
+    def __init__(
+        self, dataset: Any, base_params: dict[str, Any] | None = None, *, capped: bool = True
+    ) -> None:
         self.dataset = dataset
         self.base_params = dict(base_params or {})
+        self.capped = capped
 
     @property
     def trajectory_classes(self) -> tuple[str, ...]:
@@ -160,7 +167,9 @@ class TrackerLosses:
         several = self.dataset.n_persons > 1
         est = track_dataset(self.dataset, tp, trajectories=list(ks), with_tracks=several)
         terms = trajectory_loss_terms(self.dataset, est)
-        capped = trajectory_capped_losses(self.dataset, est)
+        capped = (
+            trajectory_capped_losses(self.dataset, est) if self.capped else [math.nan] * len(terms)
+        )
         return [
             TrajectoryScore(float(value), float(mse), int(n_c), c)
             for (value, mse, n_c), c in zip(terms, capped, strict=True)
@@ -268,7 +277,7 @@ def evaluate(
         for score in losses.losses(params, order[start:end]):
             k = order[len(ls)]
             for name, value in (("loss", score.loss), ("capped loss", score.capped)):
-                if not math.isfinite(value):
+                if (name == "loss" or per_trajectory == "capped") and not math.isfinite(value):
                     raise FloatingPointError(f"trajectory {k}: {name} is {value}")
             ls.append(score.loss)
             cs.append(score.capped)
@@ -288,13 +297,21 @@ def evaluate(
     return result(pruned=False)
 
 
+def uses_capped(loss: str) -> bool:
+    """Whether the study objective ``loss`` needs the capped loss per trajectory."""
+    return OBJECTIVES[check_objective(loss)][0] == "capped"
+
+
 def make_losses(objective: str, model: str, dataset: Any = None, **kwargs: Any) -> TrajectoryLosses:
-    """Loss source by name: ``"tracker"`` (needs ``dataset``) or ``"quadratic"`` (tests)."""
+    """Loss source by name: ``"tracker"`` (needs ``dataset``; ``capped=False`` skips the capped
+    loss) or ``"quadratic"`` (tests)."""
     check_model(model)
     if objective == "tracker":
         if dataset is None:
             raise InputError("objective 'tracker' needs a data set")
-        return TrackerLosses(dataset, kwargs.get("base_params"))
+        return TrackerLosses(
+            dataset, kwargs.get("base_params"), capped=bool(kwargs.get("capped", True))
+        )
     if objective == "quadratic":
         return QuadraticLosses(
             model=model,
@@ -314,5 +331,6 @@ __all__ = [
     "evaluate",
     "make_losses",
     "round_robin_order",
+    "uses_capped",
     "tracker_params_dict",
 ]

@@ -43,7 +43,7 @@ import numpy as np
 
 from core.errors import InputError
 from core.evaluation.robust import check_objective
-from core.optimization.objective import evaluate, make_losses
+from core.optimization.objective import evaluate, make_losses, uses_capped
 from core.optimization.space import check_model, suggest_params, tracker_params_dict
 from core.optimization.storage import (
     DEFAULT_STORAGE,
@@ -423,6 +423,7 @@ def run_worker(
         attrs["objective"],
         model,
         load_dataset_for(attrs, dataset_path),
+        capped=uses_capped(str(attrs.get("loss", "paper"))),
         **dict(attrs.get("objective_options") or {}),
     )
     if hasattr(losses, "warm_up"):

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from core.errors import InputError
-from core.optimization.objective import evaluate, make_losses
+from core.optimization.objective import evaluate, make_losses, uses_capped
 from core.optimization.storage import load_existing_study, open_storage, redact
 
 #: Seed of the paper validation data set (training seeds must lie below it).
@@ -138,7 +138,7 @@ def validate_study(
         if t.state.name == "COMPLETE" and t.value is not None and math.isfinite(t.value)
     ]
     best = sorted(done, key=lambda t: (t.value, t.number))[:top_k]
-    losses = make_losses("tracker", model, Dataset.load(validation_path))
+    losses = make_losses("tracker", model, Dataset.load(validation_path), capped=uses_capped(loss))
     out = []
     for t in best:
         params = tracker_params_dict({k: float(v) for k, v in t.params.items()}, model)
