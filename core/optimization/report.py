@@ -45,6 +45,13 @@ PAPER_TABLE_I = {
     "cv": {"A": 1.279, "B": 1.639, "C": 1.142, "D": 0.729, "E": 0.476, "total": 1.021},
     "ca": {"A": 1.283, "B": 1.791, "C": 1.180, "D": 0.709, "E": 0.488, "total": 1.046},
 }
+#: How the report names the data set Table I is re-made on, by its role (:func:`table_dataset`).
+TABLE_ROLE = {
+    "training": "Training data set",
+    "validation": "Data set of Table I: the validation set the studies chose their parameters on "
+    "(each study trained on its own set)",
+    "given": "Data set of Table I (--dataset)",
+}
 #: The paper's conclusion: CV not worse than CA by more than this fraction in total.
 CV_TOLERANCE = 0.05
 
@@ -59,6 +66,8 @@ class StudyRecord:
     pruner: str
     dataset: str
     trials: tuple[TrialSummary, ...]
+    #: the validation data set of :func:`core.optimization.validation.validate_study` ("": none)
+    validation: str = ""
 
     @property
     def best(self) -> TrialSummary | None:
@@ -107,6 +116,7 @@ def load_studies(storage: str) -> list[StudyRecord]:
                 pruner=attrs.get("pruner", "?"),
                 dataset=attrs.get("dataset", ""),
                 trials=tuple(trials),
+                validation=str((attrs.get("validation") or {}).get("dataset", "")),
             )
         )
     if not out:
@@ -277,27 +287,20 @@ def write_report(
     """
     from core.dataset import Dataset
     from core.optimization.data import resolve_dataset
-    from core.optimization.testsets import check_test_sets
+    from core.optimization.testsets import check_test_sets, chosen_params
     from core.tracking import TrackerParams
 
     check_test_sets(test_sets)
     studies = load_studies(storage)
     out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
     mains = {m: main_study(studies, m) for m in ("cv", "ca")}
     mains = {m: s for m, s in mains.items() if s is not None}
     if not mains:
         raise InputError(f"storage {redact(storage)}: no study has a completed trial")
-    used = {s.dataset for s in studies if s.dataset}
-    if dataset is None and len(used) > 1:
-        raise InputError(
-            f"storage {redact(storage)}: studies ran on different data sets {sorted(used)} "
-            "(tune --repeats trains each study on its own); pass --dataset to choose the one "
-            "Table I is re-made on (best parameters are compared on one data set)"
-        )
-    train_path = dataset or next(iter(mains.values())).dataset
-    if not train_path:
-        raise InputError("the studies record no data set; pass --dataset")
+    choices = {m: chosen_params(storage, [s.name for s in studies if s.model == m
+                                          and s.best is not None], m) for m in mains}  # fmt: skip
+    train_path, role = table_dataset(studies, dataset, storage)
+    out.mkdir(parents=True, exist_ok=True)
     train_file = resolve_dataset(train_path)
     train = Dataset.load(train_file)
     other = (
@@ -314,7 +317,7 @@ def write_report(
         "generated": dt.datetime.now(dt.UTC).isoformat(timespec="seconds"),
         "command": command,
         "storage": redact(storage),
-        "training_dataset": {"file": Path(train_path).name, "seed": int(train.seed),
+        "training_dataset": {"file": Path(train_path).name, "seed": int(train.seed), "role": role,
                              "trajectories": train.n_trajectories, "frames": train.n_frames,
                              "persons": train.n_persons},
         "paper_table_i_x1e3": PAPER_TABLE_I,
@@ -330,15 +333,18 @@ def write_report(
             "persons": other.n_persons,
         }
     estimates = {}
-    for model, study in mains.items():
-        best = study.best
-        params = TrackerParams.from_dict(best.tracker_params(model)).to_dict()
+    for model in mains:
+        chosen, name, number, how = choices[model]
+        study = next(s for s in studies if s.name == name)
+        trial = next(t for t in study.trials if t.number == number)
+        params = TrackerParams.from_dict(chosen).to_dict()
         est, ev = evaluate_params(train, params)
         estimates[model] = est
         entry: dict[str, Any] = {
-            "study": study.name,
-            "best_trial": best.number,
-            "best_value_in_study": best.value,
+            "study": name,
+            "best_trial": number,
+            "chosen_by": how,
+            "best_value_in_study": trial.value,
             "params": params,
             "training": ev.to_dict(),
         }
@@ -386,6 +392,32 @@ def write_report(
     write_json_atomic(out / "report.json", result)
     write_text_atomic(out / "report.md", render_markdown(result))
     return result
+
+
+def table_dataset(
+    studies: Sequence[StudyRecord], dataset: str | None, storage: str
+) -> tuple[str, str]:
+    """The data set Table I is re-made on, and its role (``training``, ``validation``, ``given``).
+
+    ``dataset`` when given; else the studies' one training set; after ``tune --repeats`` (each
+    study trained on its own set) the validation set they all were validated on. Studies that
+    share neither are refused: CV and CA are compared on one data set.
+    """
+    if dataset is not None:
+        return dataset, "given"
+    used = {s.dataset for s in studies if s.dataset}
+    if len(used) == 1:
+        return next(iter(used)), "training"
+    validated = {s.validation for s in studies if s.validation}
+    if len(used) > 1 and len(validated) == 1 and all(s.validation for s in studies if s.dataset):
+        return next(iter(validated)), "validation"
+    if len(used) > 1:
+        raise InputError(
+            f"storage {redact(storage)}: studies ran on different data sets {sorted(used)} "
+            "and were not all validated on one set; pass --dataset to choose the one Table I "
+            "is re-made on (the chosen parameters are compared on one data set)"
+        )
+    raise InputError("the studies record no data set; pass --dataset")
 
 
 def score_chosen(
@@ -533,7 +565,8 @@ def render_markdown(r: dict[str, Any]) -> str:
         r["command"] or "radartune report",
         "```",
         "",
-        f"Training data set: the paper's data set, seed {r['training_dataset']['seed']}, "
+        f"{TABLE_ROLE[r['training_dataset'].get('role', 'training')]}: the paper's data set, "
+        f"seed {r['training_dataset']['seed']}, "
         f"{r['training_dataset']['trajectories']} trajectories, "
         f"{r['training_dataset']['frames']} frames"
         + (
@@ -628,14 +661,21 @@ def render_markdown(r: dict[str, Any]) -> str:
             )
     lines += _people_section(r)
     lines += _test_section(r)
-    lines += ["", "## Best parameters", ""]
+    lines += ["", "## Chosen parameters", ""]
     for model in ("cv", "ca"):
         if model not in models:
             continue
         m = models[model]
+        how = m.get("chosen_by", "training")
+        why = (
+            "the lowest validation objective among the studies' best trials"
+            if how == "validation"
+            else "the lowest objective on the training set"
+        )
         lines += [
-            f"{model.upper()}: study `{m['study']}`, trial {m['best_trial']} "
-            f"(L_t = {m['best_value_in_study'] * 1e3:.4f} ×10⁻³), file `best_{model}.json`:",
+            f"{model.upper()}: study `{m['study']}`, trial {m['best_trial']}, chosen by {why} "
+            f"(its objective on its training set: {m['best_value_in_study'] * 1e3:.4f} ×10⁻³), "
+            f"file `best_{model}.json`:",
             "",
             "```json",
             json.dumps(m["params"], indent=2),

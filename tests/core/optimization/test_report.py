@@ -80,3 +80,44 @@ def test_report_on_a_two_person_data_set(tmp_path: Path) -> None:
     md = (tmp_path / "out" / "report.md").read_text()
     assert "## Persons: GOSPA, people count, identities" in md and "2 persons per" in md
     assert "nan" not in md.lower()
+
+
+def test_report_after_repeats_uses_the_validated_choice(tmp_path: Path) -> None:
+    """Studies trained on their own sets (tune --repeats): Table I is re-made on the shared
+    validation set with the trial validation chose, not with the best training trial; without
+    validation such studies are refused with one line."""
+    from core.errors import InputError
+    from core.optimization.validation import validate_study
+
+    paths = {}
+    for name, seed in (("t0", 1), ("t1", 2), ("val", 3)):
+        paths[name] = str(tmp_path / f"{name}.npz")
+        synthetic_dataset(seed=seed, n_per_class=1, n_frames=40).save(paths[name])
+    url = f"memory://{tmp_path}"
+    for i in (0, 1):
+        s = StudySettings(model="cv", n_trials=4, storage=url, study_name=f"cv-r{i}",
+                          dataset=paths[f"t{i}"], pruner="none")  # fmt: skip
+        prepare_study(s, dataset_path=s.dataset)
+        run_worker(url, s.name, seed=i)
+    with pytest.raises(InputError, match="not all validated on one set"):
+        write_report(url, tmp_path / "refused", generalisation_dataset=None)
+    assert not (tmp_path / "refused").exists()  # nothing written
+    tops = [validate_study(url, f"cv-r{i}", paths["val"], top_k=4)[0] for i in (0, 1)]
+    chosen = min(tops, key=lambda v: (v.validation_value, v.study, v.number))
+    r = write_report(url, tmp_path / "out", generalisation_dataset=None)
+    m = r["models"]["cv"]
+    assert r["training_dataset"]["role"] == "validation"
+    assert (m["study"], m["best_trial"], m["chosen_by"]) == (
+        chosen.study,
+        chosen.number,
+        "validation",
+    )
+    val = synthetic_dataset(seed=3, n_per_class=1, n_frames=40)
+    ev = evaluate_table(val, track_dataset(val, TrackerParams.from_dict(chosen.params)))
+    # Table I on the validation set is the chosen trial's validation L_t
+    assert m["training"]["loss_total"] == pytest.approx(ev.loss_total, rel=1e-12)
+    assert m["training"]["loss_total"] == pytest.approx(chosen.validation_paper_loss, rel=1e-12)
+    assert (
+        "validation set the studies chose their parameters on"
+        in (tmp_path / "out" / "report.md").read_text()
+    )
