@@ -20,8 +20,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--person-model",
         default=None,
-        help="person model of a paper:SEED generalisation set: point (default), blob "
-        "(former name extended) or walking",
+        help="person model of a paper:SEED generalisation set (default: the training set's): "
+        "walking, point (the paper's) or blob (former name extended)",
     )
     p.add_argument(
         "--test-sets",

@@ -53,9 +53,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--person-model",
         default=None,
-        help="person model of the paper data set: point (default), blob (former name "
-        "extended) or walking; same "
-        "trajectories and seeds (docs/report/extended-person.md)",
+        help="person model of the paper data sets: walking (default), point (the paper's), "
+        "blob (former name extended); same trajectories and seeds",
     )
     p.add_argument(
         "--objective", default="tracker", help="tracker, or quadratic (machinery tests only)"
@@ -130,13 +129,21 @@ def _training_sets(args: argparse.Namespace) -> list[str | None]:
     if seed is None:
         return [args.dataset] * args.repeats  # a file: repeats differ by sampler seed only
     check_training_seed(seed, args.repeats)
-    model = str(args.dataset).split(":")[2:] if args.dataset else []
-    return [":".join(["paper", str(seed + i), *model]) for i in range(args.repeats)]
+    model = _paper_model(args)
+    return [f"paper:{seed + i}:{model}" for i in range(args.repeats)]
+
+
+def _paper_model(args: argparse.Namespace) -> str:
+    """The person model of the run's paper data sets, spelled out so the studies record it."""
+    from core.scene.scene import DEFAULT_PERSON_MODEL
+
+    named = str(args.dataset).split(":")[2:] if args.dataset else []
+    return named[0] if named else (args.person_model or DEFAULT_PERSON_MODEL)
 
 
 def run(args: argparse.Namespace) -> int:
     from core.evaluation.robust import check_objective
-    from core.optimization.data import resolve_dataset
+    from core.optimization.data import like_training, resolve_dataset
     from core.optimization.study import StudySettings
     from core.optimization.validation import TOP_K, VALIDATION_SEED, check_same_radar
 
@@ -175,8 +182,7 @@ def run(args: argparse.Namespace) -> int:
             require_truth(train_path)
         val_arg = args.validation
         if val_arg is None and _paper_seed(args.dataset) is not None:
-            model = str(args.dataset).split(":")[2:] if args.dataset else []
-            val_arg = ":".join(["paper", str(VALIDATION_SEED), *model])
+            val_arg = f"paper:{VALIDATION_SEED}:{_paper_model(args)}"
         if val_arg is not None:
             val_seed = _paper_seed(val_arg)
             if val_seed is not None and val_seed < VALIDATION_SEED:
@@ -184,6 +190,8 @@ def run(args: argparse.Namespace) -> int:
                     f"--validation {val_arg!r}: paper seeds below {VALIDATION_SEED} are "
                     "training sets; use paper:SEED with SEED >= 1000"
                 )
+            if args.person_model is None:
+                val_arg = like_training(val_arg, paths[0])
             validation = resolve_dataset(val_arg, person_model=args.person_model)
             require_truth(validation)
             if validation in paths:

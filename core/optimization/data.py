@@ -8,6 +8,7 @@ an in-memory data set, and a trial never simulates: the paper's data set is simu
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 from core.errors import InputError
 
@@ -17,15 +18,18 @@ def resolve_dataset(
 ) -> str:
     """A data-set argument → an existing ``.npz`` path.
 
-    ``None`` or ``"paper"``: the paper's data set of seed 0; ``"paper:SEED"``: of another seed
-    (35 trajectories, 7 per class); ``"paper:SEED:MODEL"``: with the person model ``MODEL``
-    (``point``, ``blob`` (former name ``extended``) or ``walking``; same trajectories and
+    ``None`` or ``"paper"``: the paper's data set of seed 0 with the default person model
+    (:data:`core.scene.scene.DEFAULT_PERSON_MODEL`, the walking body); ``"paper:SEED"``: of
+    another seed (35 trajectories, 7 per class); ``"paper:SEED:MODEL"``: with the person model
+    ``MODEL`` (``point``, ``blob`` (former name ``extended``) or ``walking``; same trajectories and
     seeds); anything else: a path to a data-set file. ``person_model``, if given, applies to
     the ``paper`` forms without a model (and must agree with one given in the string).
     """
+    from core.scene.scene import DEFAULT_PERSON_MODEL
+
     if dataset in (None, "", "paper") or str(dataset).startswith("paper:"):
         seed = 0
-        model = person_model or "point"
+        model = person_model or DEFAULT_PERSON_MODEL
         parts = str(dataset).split(":") if dataset else ["paper"]
         if len(parts) > 3:
             raise InputError(f"data set {dataset!r}: expected paper:SEED or paper:SEED:MODEL")
@@ -54,7 +58,7 @@ def resolve_dataset(
                 f"got {model!r}"
             ) from None
         return str(paper_dataset_file(seed, n_trajectories, person_model=model))
-    if person_model not in (None, "point"):
+    if person_model is not None:
         raise InputError(
             f"--person-model {person_model!r} applies to the paper data sets only, "
             f"not to the file {dataset!r}"
@@ -63,3 +67,23 @@ def resolve_dataset(
     if not path.is_file():
         raise InputError(f"data set {dataset!r} does not exist")
     return str(path)
+
+
+def person_model_of(path: str) -> str:
+    """The person model a data set's (first) person was simulated with (``"point"`` when its
+    scenes name none: the paper's person, and data sets that were not simulated)."""
+    from core.dataset import Dataset
+
+    scenes = Dataset.load(path).scene()
+    first: Any = scenes[0] if isinstance(scenes, list) and scenes else {}
+    persons = first.get("persons", [{}]) if isinstance(first, dict) else [{}]
+    return str((persons[0] if persons else {}).get("model", "point"))
+
+
+def like_training(spec: str | None, training_path: str) -> str | None:
+    """A ``paper`` / ``paper:SEED`` spec without a person model gets the training set's, so a
+    validation or generalisation set is made like the set the parameters were tuned on."""
+    if spec is None or not (spec == "paper" or spec.startswith("paper:")) or spec.count(":") > 1:
+        return spec
+    seed = spec.split(":")[1] if ":" in spec else "0"
+    return f"paper:{seed}:{person_model_of(training_path)}"

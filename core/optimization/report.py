@@ -286,7 +286,7 @@ def write_report(
         Called with a line of progress while the test sets are made and tracked.
     """
     from core.dataset import Dataset
-    from core.optimization.data import resolve_dataset
+    from core.optimization.data import like_training, resolve_dataset
     from core.optimization.testsets import check_test_sets, chosen_params
     from core.tracking import TrackerParams
 
@@ -303,6 +303,7 @@ def write_report(
     out.mkdir(parents=True, exist_ok=True)
     train_file = resolve_dataset(train_path)
     train = Dataset.load(train_file)
+    generalisation_dataset = like_training(generalisation_dataset, train_file)
     other = (
         Dataset.load(resolve_dataset(generalisation_dataset)) if generalisation_dataset else None
     )

@@ -96,14 +96,12 @@ def default_test_paths(training_path: str, n_sets: int) -> list[str]:
     training set (its person model, trajectory count and persons per trajectory); simulated
     and cached on first use (minutes each)."""
     from core.dataset import Dataset
+    from core.optimization.data import person_model_of
     from core.pipeline import paper_dataset_file
 
     check_test_sets(n_sets)
     train = Dataset.load(training_path)
-    scenes = train.scene()
-    first: Any = scenes[0] if isinstance(scenes, list) and scenes else {}
-    persons = first.get("persons", [{}]) if isinstance(first, dict) else [{}]
-    model = str((persons[0] if persons else {}).get("model", "point"))
+    model = person_model_of(training_path)
     return [
         str(
             paper_dataset_file(

@@ -94,3 +94,31 @@ def test_person_point_spread_against_hand_numbers() -> None:
     assert s.rms_cross_range_m == pytest.approx(np.sqrt(0.16 / 2))
     assert s.rms_radial_velocity_mps == pytest.approx(0.5)
     assert s.median_position_m == pytest.approx(0.35)
+
+
+def test_paper_sets_of_the_cli_default_to_the_walking_body(monkeypatch, tmp_path) -> None:
+    """``paper`` / ``paper:SEED`` without a model is the walking body (the CLI default); a set
+    made like a training set takes the training set's model, read from its scenes."""
+    import core.pipeline
+    from core.optimization.data import like_training, person_model_of
+    from core.pipeline import build_dataset
+    from core.scene.scene import DEFAULT_PERSON_MODEL
+
+    asked = []
+    monkeypatch.setattr(
+        core.pipeline,
+        "paper_dataset_file",
+        lambda seed, n, *, person_model: asked.append((seed, n, person_model)) or "x.npz",
+    )
+    resolve_dataset(None)
+    resolve_dataset("paper:7")
+    resolve_dataset("paper:7", person_model="point")
+    assert DEFAULT_PERSON_MODEL == "walking"
+    assert asked == [(0, 35, "walking"), (7, 35, "walking"), (7, 35, "point")]
+    path = str(tmp_path / "point.npz")
+    build_dataset(paper_scenes(3, 1), fidelity="measurement", jobs=1, use_cache=False).save(path)
+    assert person_model_of(path) == "point"
+    assert like_training("paper:1000", path) == "paper:1000:point"
+    assert like_training("paper:1000:walking", path) == "paper:1000:walking"
+    assert like_training("other.npz", path) == "other.npz"
+    assert like_training(None, path) is None
