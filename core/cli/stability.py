@@ -7,8 +7,9 @@ NaN/Inf or non-SPD covariance makes the command exit 1.
 
 Consistency: NEES and NIS (:mod:`core.evaluation.consistency`) per trajectory class of the tuned
 parameters (``docs/report/best_*.json`` on the point person, ``docs/report/walking-person/
-best_*.json`` on the walking body) and of the defaults on the walking body, on the paper data set
-of each person model. An inconsistent filter is a finding, not a failure: it does not change the
+best_*.json`` on the walking body), and on the walking body of the defaults and of the defaults
+with R set to the measured spread of the person's points, on the paper data set of each person
+model. An inconsistent filter is a finding, not a failure: it does not change the
 exit code.
 """
 
@@ -22,11 +23,14 @@ from typing import Any
 #: The repository root (the tuned parameter files are in its docs/report/).
 ROOT = Path(__file__).resolve().parents[2]
 
-#: Consistency cases: (label, person model, parameter folder relative to ROOT or None: defaults).
-CONSISTENCY_CASES: tuple[tuple[str, str, str | None], ...] = (
+#: Consistency cases: (label, person model, parameters): a folder relative to ROOT holding
+#: best_cv.json and best_ca.json, ``"defaults"``, or ``"spread"`` (the defaults with R set to the
+#: person points' measured spread, :func:`core.evaluation.consistency.measurement_spread`).
+CONSISTENCY_CASES: tuple[tuple[str, str, str], ...] = (
     ("point, tuned", "point", "docs/report"),
     ("walking, tuned", "walking", "docs/report/walking-person"),
-    ("walking, defaults", "walking", None),
+    ("walking, defaults", "walking", "defaults"),
+    ("walking, R = spread", "walking", "spread"),
 )
 
 
@@ -148,7 +152,7 @@ def consistency_reports(paper_seed: int = 0) -> list:
     -------
     list of :class:`core.evaluation.consistency.ConsistencyReport`
     """
-    from core.evaluation.consistency import dataset_consistency
+    from core.evaluation.consistency import dataset_consistency, measurement_spread
     from core.pipeline import paper_dataset
     from core.tracking import TrackerParams
 
@@ -159,33 +163,43 @@ def consistency_reports(paper_seed: int = 0) -> list:
         f"{paper_seed}; mean eps [its 95 % band for N samples], % of samples inside the 95 % "
         "per-sample chi2 band, verdict of the mean (above: covariance too small)"
     )
-    for label, person, folder in CONSISTENCY_CASES:
+    for label, person, source in CONSISTENCY_CASES:
         if person not in datasets:
-            datasets[person] = paper_dataset(paper_seed, person_model=person)
-        for model in ("cv", "ca"):
-            source = "defaults" if folder is None else f"{folder}/best_{model}.json"
-            params = (
-                TrackerParams(model=model)
-                if folder is None
-                else TrackerParams.load(ROOT / folder / f"best_{model}.json")
+            ds = datasets[person] = paper_dataset(paper_seed, person_model=person)
+            sr, saz, svr = measurement_spread(ds)
+            print(
+                f"{person} person: its points around the truth h(x_gt), RMS: range {sr:.3g} m, "
+                f"azimuth {saz:.3g} rad, radial velocity {svr:.3g} m/s"
             )
+        ds = datasets[person]
+        for model in ("cv", "ca"):
+            if source == "defaults":
+                params = TrackerParams(model=model)
+            elif source == "spread":
+                sr, saz, svr = measurement_spread(ds)
+                params = TrackerParams(model=model, r11=sr, r22=saz, r33=svr)
+            else:
+                params = TrackerParams.load(ROOT / source / f"best_{model}.json")
+            where = source if source in ("defaults", "spread") else f"{source}/best_{model}.json"
             t0 = time.perf_counter()
             rep = dataset_consistency(
-                datasets[person],
+                ds,
                 params,
                 label=f"{model.upper()}, {label}",
                 extra={
+                    "case": label,
                     "person_model": person,
                     "model": model,
-                    "params": source,
+                    "params": where,
                     "paper_seed": paper_seed,
                     "r_std": [params.r11, params.r22, params.r33],
                     "q_coeff": params.q_coeff,
+                    "measurement_spread": [float(v) for v in measurement_spread(ds)],
                 },
             )
             dt = time.perf_counter() - t0
             print(
-                f"\n{model.upper()}, {person} person, {source} (q={params.q_coeff:.3g}, "
+                f"\n{model.upper()}, {person} person, {where} (q={params.q_coeff:.3g}, "
                 f"r=[{params.r11:.3g} m, {params.r22:.3g} rad, {params.r33:.3g} m/s]), "
                 f"{dt:.1f} s:"
             )

@@ -54,6 +54,7 @@ __all__ = [
     "consistency_report",
     "dataset_consistency",
     "plot_consistency",
+    "measurement_spread",
 ]
 
 #: Probability of the two-sided χ² bands (95 %).
@@ -451,13 +452,46 @@ def dataset_consistency(
     )
 
 
+def measurement_spread(dataset: Dataset) -> np.ndarray:
+    """RMS error of the person-labelled points against the person's true measurement h(x_gt).
+
+    What a measurement covariance R = diag(σ_r², σ_az², σ_vr²) should hold if every person point
+    were a noisy measurement of the person's centre (its body spread included).
+
+    Parameters
+    ----------
+    dataset
+        A simulated data set; a point with ``source = i >= 0`` came from person ``i``.
+
+    Returns
+    -------
+    numpy.ndarray
+        (3,) [σ_r (m), σ_az (rad), σ_vr (m/s)]; NaN without person points.
+    """
+    from core.tracking.ekf import measure, wrap_angle
+
+    sel = np.flatnonzero(dataset.source >= 0)
+    if sel.size == 0:
+        return np.full(3, np.nan)
+    f, person = dataset.frame[sel], dataset.source[sel]
+    states = np.concatenate(
+        (dataset.truth_xy_m[f, person], dataset.truth_v_mps[f, person]), axis=1
+    )  # (M, 4) [x, y, vx, vy]
+    z_true = np.array([measure(x) for x in states])  # (M, 3) h(x_gt)
+    e = dataset.measurements()[sel] - z_true
+    e[:, 1] = wrap_angle(e[:, 1])
+    return np.sqrt(np.mean(e * e, axis=0))
+
+
 def plot_consistency(
     reports: Sequence[ConsistencyReport], path: str | Path, *, title: str = "Filter consistency"
 ) -> Path:
     """One panel per statistic: the mean ε̄ per class (one marker series per report, log scale)
     against the per-sample χ² band (light grey), the band of the mean for the fewest samples of
     any row (dark grey, the widest) and the expected value n (dashed); the percentage of samples
-    inside the per-sample band is written beside each marker. Written atomically as PNG."""
+    inside the per-sample band is written beside each marker. A report's ``extra["case"]``
+    chooses its colour and ``extra["model"]`` its marker (circle CV, square CA). Written
+    atomically as PNG."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -467,8 +501,11 @@ def plot_consistency(
 
     probability = reports[0].probability if reports else BAND_PROBABILITY
     rows = [r for r in (reports[0].rows if reports else {}) if r != "total"] + ["total"]
-    fig, axes = plt.subplots(1, len(STATISTICS), figsize=(14, 5.2))
-    markers = "osD^v<>"
+    fig, axes = plt.subplots(1, len(STATISTICS), figsize=(14, 5.6))
+    # one colour per case (``extra["case"]``, else the label), a marker per motion model
+    cases = list(dict.fromkeys(str(r.extra.get("case", r.label)) for r in reports))
+    colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    markers = {"cv": "o", "ca": "s"}
     width = 0.8 / max(len(reports), 1)
     for ax, (name, dof) in zip(np.atleast_1d(axes), STATISTICS.items()):
         lo, hi = chi2_band(dof, probability)
@@ -489,7 +526,9 @@ def plot_consistency(
                 xs.append(i - 0.4 + width * (j + 0.5))
                 ys.append(s.mean)
                 fr.append(s.inside)
-            line = ax.plot(xs, ys, markers[j % len(markers)], ms=7, label=rep.label)[0]
+            colour = colours[cases.index(str(rep.extra.get("case", rep.label))) % len(colours)]
+            marker = markers.get(str(rep.extra.get("model", "")), "D")
+            line = ax.plot(xs, ys, marker, color=colour, ms=7, label=rep.label)[0]
             for x, y, f in zip(xs, ys, fr):
                 ax.annotate(
                     f"{100 * f:.0f}", (x, y), textcoords="offset points",
@@ -506,7 +545,7 @@ def plot_consistency(
     first = np.atleast_1d(axes)[0]
     first.set_ylabel("time-averaged ε̄ (log scale); numbers: % of samples in the band")
     handles, labels = first.get_legend_handles_labels()
-    fig.legend(handles, labels, loc="lower center", ncol=5, fontsize=8, frameon=False)
+    fig.legend(handles, labels, loc="lower center", ncol=6, fontsize=8, frameon=False)
     fig.suptitle(title)
     fig.tight_layout(rect=(0, 0.09, 1, 1))
     out = Path(path)
