@@ -18,6 +18,7 @@ from core.evaluation.consistency import (
     consistency_samples,
     consistency_stat,
     dataset_consistency,
+    measurement_spread,
     nees,
 )
 from core.tracking import TrackerParams, run_tracker
@@ -197,3 +198,12 @@ def test_report_rows_and_smaller_r_raises_nees_and_nis() -> None:
     s = consistency_samples(ds, _params())
     rep = consistency_report(s, ds.trajectory_class)
     assert sum(rep.rows[c]["nis"].n for c in "abcde") == rep.rows["total"]["nis"].n
+
+
+def test_measurement_spread_is_the_synthetic_noise() -> None:
+    """Synthetic person points are h(x_gt) + N(0, diag(σ²)): their RMS about h(x_gt) is σ
+    within its sampling error (relative sd 1/√(2M) for M points)."""
+    ds = synthetic_dataset(5, n_per_class=4, scene=SCENE, n_frames=150)
+    m = int(np.sum(ds.source >= 0))
+    assert m > 1500
+    np.testing.assert_allclose(measurement_spread(ds), SCENE.noise_std, rtol=4 / math.sqrt(2 * m))

@@ -2,6 +2,8 @@
 
 import json
 
+import numpy as np
+
 from core.cli import main
 from core.tracking import TrackerParams
 from core.tracking.synthetic import synthetic_dataset
@@ -61,9 +63,14 @@ def test_stability_quick(capsys, monkeypatch, tmp_path):
     assert doc["ok"] is True and len(doc["sweep"]) == 8
     cons = doc["consistency"]
     assert [(c["person_model"], c["model"]) for c in cons] == [
-        ("point", "cv"), ("point", "ca"), ("walking", "cv"), ("walking", "ca"),
-        ("walking", "cv"), ("walking", "ca"),
+        ("point", "cv"), ("point", "ca"), *[("walking", "cv"), ("walking", "ca")] * 3
     ]  # fmt: skip
+    # the last case tracks with R = the spread of the person's points
+    from core.evaluation.consistency import measurement_spread
+
+    spread = measurement_spread(synthetic_dataset(0, 1, n_frames=80))
+    assert cons[-1]["params"] == "spread"
+    np.testing.assert_allclose(cons[-1]["r_std"], spread, rtol=1e-12)
     for c in cons:
         assert list(c["rows"]) == ["a", "b", "c", "d", "e", "total"]
         total = c["rows"]["total"]
