@@ -32,13 +32,17 @@ import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from core.dataset import Dataset
+from core.errors import InputError
 from core.evaluation.assignment import IDENTITY_CUTOFF_M, assign_identities
 from core.evaluation.loss import CLASSES
+
+if TYPE_CHECKING:
+    from core.tracking.params import TrackerParams
 
 __all__ = [
     "BAND_PROBABILITY",
@@ -269,7 +273,7 @@ class ConsistencySamples:
 
 def consistency_samples(
     dataset: Dataset,
-    params,
+    params: TrackerParams,
     *,
     cutoff_m: float = IDENTITY_CUTOFF_M,
 ) -> ConsistencySamples:
@@ -292,6 +296,9 @@ def consistency_samples(
     t_off = dataset.trajectory_offsets
     sel = np.arange(dataset.n_trajectories, dtype=np.int64)
     z = dataset.measurements()
+    if not np.all(np.isfinite(z)):
+        bad = int(np.flatnonzero(~np.all(np.isfinite(z), axis=1))[0])
+        raise InputError(f"measurement of point {bad} (frame {dataset.frame[bad]}) is not finite")
     rec = track_frames(z, dataset.frame_offsets, t_off, sel, params, period, record=True)[-1]
     n_f, cap = rec.ids.shape
     live = np.arange(cap)[None, :] < rec.n_tracks[:, None]  # (F, S) slots holding a track
@@ -436,7 +443,7 @@ def consistency_report(
 
 def dataset_consistency(
     dataset: Dataset,
-    params,
+    params: TrackerParams,
     *,
     probability: float = BAND_PROBABILITY,
     label: str = "",
