@@ -10,6 +10,8 @@
 - :mod:`~core.evaluation.comparison` — two runs compared: loss breakdown by kind of frame,
   paired bootstrap ratio and Wilcoxon test
 - :mod:`~core.evaluation.spread` — spread of the person-labelled points around the truth
+- :mod:`~core.evaluation.consistency` — filter consistency: NEES and NIS of the track paired
+  with each person against their χ² bands, per class (Bar-Shalom's ANEES test)
 - :mod:`~core.evaluation.intervals` — runs over noise seeds compared: ratio of mean losses with a
   paired bootstrap interval and its verdict, rates of runs without a track and of tail events
 """
@@ -22,6 +24,14 @@ from core.evaluation.comparison import (
     loss_breakdown,
     paired_comparison,
     track_with_ids,
+)
+from core.evaluation.consistency import (
+    ConsistencyReport,
+    ConsistencyStat,
+    average_band,
+    chi2_band,
+    dataset_consistency,
+    nees,
 )
 from core.evaluation.loss import (
     CLASSES,
@@ -59,6 +69,8 @@ __all__ = [
     "OSPA_C_M",
     "OSPA_P",
     "ClassRow",
+    "ConsistencyReport",
+    "ConsistencyStat",
     "Evaluation",
     "FrameMetrics",
     "PeopleRun",
@@ -70,10 +82,14 @@ __all__ = [
     "PersonMetrics",
     "PointSpread",
     "assign_identities",
+    "average_band",
+    "chi2_band",
+    "dataset_consistency",
     "evaluate",
     "frame_metrics",
     "gospa",
     "loss_breakdown",
+    "nees",
     "ospa",
     "paired_comparison",
     "people_run",

@@ -2,6 +2,8 @@
 
 import json
 
+import numpy as np
+
 from core.cli import main
 from core.tracking import TrackerParams
 from core.tracking.synthetic import synthetic_dataset
@@ -33,11 +35,58 @@ def test_track_bad_params_exit_2_and_leave_nothing(tmp_path, capsys):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["bad.json", "d.npz"]
 
 
-def test_stability_quick(capsys):
-    assert main(["stability", "--quick", "--frames", "100"]) == 0
+def _synthetic_paper(monkeypatch):
+    """core.pipeline.paper_dataset replaced by a small synthetic set (no simulation here)."""
+    import core.pipeline
+
+    calls = []
+
+    def fake(seed=0, *args, person_model="point", **kwargs):
+        calls.append((seed, person_model))
+        return synthetic_dataset(seed, 1, n_frames=80)
+
+    monkeypatch.setattr(core.pipeline, "paper_dataset", fake)
+    return calls
+
+
+def test_stability_quick(capsys, monkeypatch, tmp_path):
+    calls = _synthetic_paper(monkeypatch)
+    out_json = tmp_path / "s.json"
+    assert main(["stability", "--quick", "--frames", "100", "--json", str(out_json)]) == 0
     out = capsys.readouterr().out
     assert "cv: 256 corners" in out and "stability: OK" in out
     assert "4 people circling, ca: 128 corners" in out
+    # the consistency section: tuned parameters of both person models and the defaults
+    assert calls == [(0, "point"), (0, "walking")]
+    assert "best_cv.json" in out and "walking-person/best_ca.json" in out and "defaults" in out
+    doc = json.loads(out_json.read_text())
+    assert doc["ok"] is True and len(doc["sweep"]) == 8
+    cons = doc["consistency"]
+    assert [(c["person_model"], c["model"]) for c in cons] == [
+        ("point", "cv"), ("point", "ca"), *[("walking", "cv"), ("walking", "ca")] * 3
+    ]  # fmt: skip
+    # the last case tracks with R = the spread of the person's points
+    from core.evaluation.consistency import measurement_spread
+
+    spread = measurement_spread(synthetic_dataset(0, 1, n_frames=80))
+    assert cons[-1]["params"] == "spread"
+    np.testing.assert_allclose(cons[-1]["r_std"], spread, rtol=1e-12)
+    for c in cons:
+        assert list(c["rows"]) == ["a", "b", "c", "d", "e", "total"]
+        total = c["rows"]["total"]
+        assert 0 < total["frames_paired"] <= total["frames_present"] <= 400
+        assert total["nees_position"]["n"] == total["frames_paired"]
+
+
+def test_stability_consistency_only_with_plot(capsys, monkeypatch, tmp_path):
+    _synthetic_paper(monkeypatch)
+    png = tmp_path / "c.png"
+    assert main(["stability", "--no-sweep", "--paper-seed", "3", "--plot", str(png)]) == 0
+    out = capsys.readouterr().out
+    assert "corners" not in out and "paper data set seed 3" in out
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert main(["stability", "--no-sweep", "--paper-seed", "-1"]) == 2
+    assert "--paper-seed must be >= 0" in capsys.readouterr().err
 
 
 def test_track_association_option(tmp_path, capsys):
