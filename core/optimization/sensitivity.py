@@ -155,7 +155,8 @@ class Sweep:
 
 def sweep_values(name: str, optimum: float, n_points: int = OAT_POINTS) -> np.ndarray:
     """``n_points`` values across the bounds of parameter ``name``, evenly spaced in its
-    sampling scale (log where the space is log), plus ``optimum``; ascending, unique."""
+    sampling scale (log where the space is log), plus ``optimum`` (which replaces a grid point
+    equal to it up to rounding); ascending, unique."""
     from core.tracking.space import parameter
 
     if n_points < 2:
@@ -166,7 +167,11 @@ def sweep_values(name: str, optimum: float, n_points: int = OAT_POINTS) -> np.nd
     else:
         grid = np.linspace(b.low, b.high, n_points)
     grid[0], grid[-1] = b.low, b.high  # the bounds exactly (geomspace may round)
-    return np.unique(np.append(grid, float(optimum)))
+    # a grid point that is the optimum up to rounding gives way to the optimum itself
+    scale = np.log if b.log else (lambda v: v)
+    width = scale(b.high) - scale(b.low)
+    near = np.abs(scale(grid) - scale(float(optimum))) <= 1e-9 * width
+    return np.unique(np.append(grid[~near], float(optimum)))
 
 
 def oat_sweep(
