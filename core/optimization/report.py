@@ -256,7 +256,7 @@ def write_report(
     test_sets: int = 0,
     test_paths: Sequence[str] | None = None,
     progress: Callable[[str], None] | None = None,
-    sensitivity: bool = True,
+    sensitivity: bool = False,
     sensitivity_points: int = 15,
     clutter_variants: bool = True,
 ) -> dict[str, Any]:
@@ -282,7 +282,8 @@ def write_report(
     progress
         Called with a line of progress while the test sets are made and tracked.
     sensitivity
-        Write the sensitivity sections (:mod:`core.optimization.report_sensitivity`):
+        Write the sensitivity sections (:mod:`core.optimization.report_sensitivity`; the CLI
+        writes them unless told not to):
         parameter importance, one-at-a-time sweeps on the training and the generalisation
         (held-out) set, clutter robustness.
     sensitivity_points
