@@ -393,7 +393,7 @@ def write_report(
         plot_test_sets(result["test_sets"], out / "test_sets.png")
         plots.append("test_sets.png")
     if sensitivity:
-        add_sensitivity(result, storage, studies, out, generalisation_dataset,
+        add_sensitivity(result, storage, studies, out, generalisation_dataset, train_file,
                         sensitivity_points, clutter_variants, progress)  # fmt: skip
     result["plots"] = plots
     if "cv" in result["models"] and "ca" in result["models"]:
@@ -414,6 +414,7 @@ def add_sensitivity(
     studies: Sequence[StudyRecord],
     out: Path,
     heldout: str | None,
+    training: str,
     points: int,
     clutter_variants: bool,
     progress: Callable[[str], None] | None,
@@ -430,6 +431,7 @@ def add_sensitivity(
         storage,
         studies,
         heldout_path=resolve_dataset(heldout) if heldout else None,
+        training_path=training,
         oat_points=points,
         clutter_variants=clutter_variants,
         progress=progress,

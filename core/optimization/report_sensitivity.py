@@ -46,6 +46,7 @@ def sensitivity_entry(
     studies: Sequence[Any],
     *,
     heldout_path: str | None,
+    training_path: str | None = None,
     oat_points: int = OAT_POINTS,
     clutter_variants: bool = True,
     progress: Callable[[str], None] | None = None,
@@ -60,6 +61,9 @@ def sensitivity_entry(
         The report's study records (``name``, ``model``, ``trials``, ``best``).
     heldout_path
         Data set no study trained on (the report's generalisation set); None: training only.
+    training_path
+        The report's training set, swept instead of the chosen study's own training set when
+        that file is absent here (a note says so).
     oat_points
         Grid points per parameter; 0: no one-at-a-time sweep.
     clutter_variants
@@ -101,6 +105,11 @@ def sensitivity_entry(
                   "value_in_study": value, "loss": attrs.get("loss", "paper")})  # fmt: skip
         tracker = attrs.get("objective") == "tracker"
         train_path = attrs.get("dataset") if tracker else None
+        if train_path and not Path(train_path).is_file() and training_path:
+            # the storage came from another machine: the report's own training set stands in
+            entry["notes"].append(f"{model.upper()}: study {name!r} trained on {train_path!r}, "
+                                  f"absent here; swept on {training_path!r} instead")  # fmt: skip
+            train_path = training_path
         train = Dataset.load(train_path) if train_path else None
         if oat_points:
             sources: dict[str, Any] = {

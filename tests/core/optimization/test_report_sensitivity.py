@@ -30,7 +30,7 @@ def test_report_sensitivity_sections(tmp_path: Path) -> None:
         run_worker(url, s.name, seed=0)
     out = tmp_path / "out"
     r = write_report(url, out, generalisation_dataset=str(tmp_path / "other.npz"),
-                     sensitivity_points=2)  # fmt: skip
+                     sensitivity=True, sensitivity_points=2)  # fmt: skip
     e = r["sensitivity"]
     assert e["evaluator"] == "PED-ANOVA"
     # CV has 12 completed trials: an importance; CA's 3 are too few, and the report says so
@@ -87,3 +87,16 @@ def test_paper_dataset_variant_refuses_a_set_that_is_not_a_paper_set(tmp_path: P
     synthetic_dataset(seed=1, n_per_class=1, n_frames=45).save(tmp_path / "s.npz")
     with pytest.raises(InputError, match="not a paper data set"):
         paper_dataset_variant(str(tmp_path / "s.npz"), clutter_factor=2.0)
+
+
+@pytest.mark.parametrize("points", ["1", "201", "-3"])
+def test_cli_refuses_a_bad_sweep_size_before_anything_is_written(
+    tmp_path: Path, capsys, points: str
+) -> None:
+    from core.cli import main
+
+    code = main(["report", "--storage", f"sqlite:///{tmp_path}/none.db", "--out",
+                 str(tmp_path / "out"), "--sensitivity-points", points])  # fmt: skip
+    err = capsys.readouterr().err
+    assert code == 2 and len(err.splitlines()) == 1 and "--sensitivity-points" in err
+    assert not (tmp_path / "out").exists() and not (tmp_path / "none.db").exists()
