@@ -65,6 +65,9 @@ class ClutterRow:
         Fraction of the frames with a confirmed track (:attr:`Evaluation.confirmed_fraction`).
     n_never_confirmed, n_trajectories
         Trajectories with ``N_c = 0``, and all trajectories.
+    losses, capped
+        Per trajectory (K,), in the data set's order: ``L(k)`` (eq. 13) and ``C(k)`` (m²), for
+        statistics of the caller's own (tails, bootstrap intervals).
     """
 
     dataset: str
@@ -77,10 +80,13 @@ class ClutterRow:
     confirmed_fraction: float
     n_never_confirmed: int
     n_trajectories: int
+    losses: tuple[float, ...]
+    capped: tuple[float, ...]
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready (NaN as None)."""
         d = dataclasses.asdict(self)
+        d["losses"], d["capped"] = list(self.losses), list(self.capped)
         return {k: None if isinstance(v, float) and not math.isfinite(v) else v
                 for k, v in d.items()}  # fmt: skip
 
@@ -181,6 +187,8 @@ def clutter_robustness(
                     confirmed_fraction=float(ev.confirmed_fraction),
                     n_never_confirmed=int(np.sum(ev.n_c == 0)),
                     n_trajectories=len(ev.loss),
+                    losses=tuple(float(v) for v in ev.loss),
+                    capped=tuple(float(v) for v in capped),
                 )
             )
     return ClutterRobustness(params=params.to_dict(), rho_factors=factors, rows=tuple(rows))

@@ -37,7 +37,9 @@ def test_rho_times_one_is_the_plain_evaluation_bit_for_bit(data) -> None:
         assert row.confirmed_fraction == ev.confirmed_fraction
         assert row.n_never_confirmed == int(np.sum(ev.n_c == 0))
         assert row.n_trajectories == ds.n_trajectories
-        assert row.capped_total == float(np.mean(trajectory_capped_losses(ds, est)))
+        capped = trajectory_capped_losses(ds, est)
+        assert row.capped_total == float(np.mean(capped))
+        assert row.losses == tuple(ev.loss) and row.capped == tuple(capped)
 
 
 def test_each_factor_tracks_with_its_scaled_density(data) -> None:
