@@ -83,6 +83,12 @@ def sensitivity_entry(
     store = open_storage(storage, create=False)
     entry: dict[str, Any] = {"evaluator": IMPORTANCE_EVALUATOR, "models": {}, "notes": []}
     heldout = Dataset.load(heldout_path) if heldout_path else None
+    if heldout_path:
+        trained = sorted({s.name for s in studies if _same_file(s.dataset, heldout_path)})
+        if trained:
+            entry["notes"].append(f"the held-out set {heldout_path!r} is the training set of "
+                                  f"{', '.join(trained)}: pass another --generalisation set "
+                                  "(e.g. paper:2000) for a held-out one")  # fmt: skip
     for model in ("cv", "ca"):
         mine = sorted((s for s in studies if s.model == model and s.best is not None),
                       key=lambda s: s.name)  # fmt: skip
@@ -111,7 +117,10 @@ def sensitivity_entry(
                                   f"absent here; swept on {training_path!r} instead")  # fmt: skip
             train_path = training_path
         train = Dataset.load(train_path) if train_path else None
-        if oat_points:
+        if tracker and train is None:
+            entry["notes"].append(f"{model.upper()}: study {name!r} records no training set; "
+                                  "no sweeps or clutter robustness")  # fmt: skip
+        elif oat_points:
             sources: dict[str, Any] = {
                 "training": make_losses(str(attrs.get("objective", "tracker")), model, train,
                                         capped=True,
@@ -147,6 +156,13 @@ def sensitivity_entry(
             m["clutter"] = cr.to_dict()
         entry["models"][model] = m
     return entry
+
+
+def _same_file(a: str, b: str) -> bool:
+    try:
+        return bool(a) and Path(a).resolve() == Path(b).resolve()
+    except OSError:
+        return False
 
 
 def _save(fig: Any, path: Path) -> None:

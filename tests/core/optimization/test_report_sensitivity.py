@@ -61,6 +61,11 @@ def test_report_sensitivity_sections(tmp_path: Path) -> None:
         assert heading in md
     assert "nan" not in md.lower()
     assert "sensitivity" in json.loads((out / "report.json").read_text())
+    # a "held-out" set some study trained on is named in a note
+    r = write_report(url, tmp_path / "out3", generalisation_dataset=str(tmp_path / "train.npz"),
+                     sensitivity=True, sensitivity_points=0, clutter_variants=False)  # fmt: skip
+    assert any("is the training set of ca-main, cv-main" in n for n in r["sensitivity"]["notes"])
+    assert "oat" not in r["sensitivity"]["models"]["cv"]
     r = write_report(url, tmp_path / "out2", generalisation_dataset=None, sensitivity=False)
     assert "sensitivity" not in r
     assert "## Sensitivity" not in (tmp_path / "out2" / "report.md").read_text()
