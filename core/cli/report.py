@@ -39,6 +39,26 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         metavar="PATH",
         help="a test data-set file instead of the paper ones (repeatable)",
     )
+    p.add_argument(
+        "--no-sensitivity",
+        action="store_true",
+        help="leave out the sensitivity sections (parameter importance, one-at-a-time sweeps, "
+        "clutter robustness)",
+    )
+    p.add_argument(
+        "--sensitivity-points",
+        type=int,
+        default=15,
+        metavar="N",
+        help="grid points per parameter of the one-at-a-time sweeps, 2-200 (default: "
+        "%(default)s; 0: no sweeps)",
+    )
+    p.add_argument(
+        "--no-clutter-variants",
+        action="store_true",
+        help="score the clutter robustness on the data sets as they are only, without their "
+        "variants with the scene clutter rate ×0.5 and ×2 (simulated on first use, cached)",
+    )
     p.set_defaults(func=run)
 
 
@@ -46,6 +66,10 @@ def run(args: argparse.Namespace) -> int:
     from core.errors import InputError
     from core.optimization.report import write_report
 
+    if args.sensitivity_points != 0 and not 2 <= args.sensitivity_points <= 200:
+        raise InputError(
+            f"--sensitivity-points must be 0 or in [2, 200], got {args.sensitivity_points}"
+        )
     gen = None if args.generalisation in ("none", "") else args.generalisation
     if args.person_model is not None:
         if gen is None or not gen.startswith("paper:"):
@@ -62,6 +86,9 @@ def run(args: argparse.Namespace) -> int:
         test_sets=args.test_sets,
         test_paths=args.test_set,
         progress=lambda line: print(line, file=sys.stderr, flush=True),
+        sensitivity=not args.no_sensitivity,
+        sensitivity_points=args.sensitivity_points,
+        clutter_variants=not args.no_clutter_variants,
     )
     for model, m in r["models"].items():
         line = f"{model.upper()}: L_t = {m['training']['loss_total_x1e3']:.4f} x1e-3"

@@ -7,6 +7,7 @@ an in-memory data set, and a trial never simulates: the paper's data set is simu
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -87,3 +88,71 @@ def like_training(spec: str | None, training_path: str) -> str | None:
         return spec
     seed = spec.split(":")[1] if ":" in spec else "0"
     return f"paper:{seed}:{person_model_of(training_path)}"
+
+
+def paper_dataset_variant(
+    path: str,
+    *,
+    seed: int | None = None,
+    clutter_factor: float = 1.0,
+    progress: Callable[[int, int], None] | None = None,
+) -> str:
+    """The paper data set made like the one at ``path``, of another seed and/or scene clutter.
+
+    ``path`` must hold a paper data set (:func:`core.pipeline.paper_dataset`): its scenes are
+    checked against :func:`core.scene.paper_scenes` of its seed, person model, trajectory count
+    and persons per trajectory. The variant has the same person model, counts, radar and
+    fidelity; ``seed`` (default: the set's own) and the scene clutter rate λ (Poisson clutter
+    reflectors per m² of the AOI per frame, :attr:`core.scene.Scene.clutter_density_per_m2`;
+    the paper's 0.02 m⁻²) multiplied by ``clutter_factor`` > 0. Only the clutter changes with
+    the factor: trajectories, persons and simulation seeds stay. Simulated on first use (cached
+    by content key, like every data set; ``progress(done, total)`` per trajectory); with factor
+    1 it is :func:`core.pipeline.paper_dataset_file` of that seed itself.
+
+    Returns
+    -------
+    str
+        Path of the cached ``.npz``.
+    """
+    import dataclasses
+    import json
+    import math
+
+    from core.dataset import Dataset
+    from core.pipeline import build_dataset, dataset_key, default_cache_dir, paper_dataset_file
+    from core.scene import paper_scenes
+
+    if not (math.isfinite(clutter_factor) and clutter_factor > 0):
+        raise InputError(f"clutter_factor must be a positive number, got {clutter_factor!r}")
+    ds = Dataset.load(path)
+    stored = ds.scene()
+    items = stored if isinstance(stored, list) else [stored]
+    model = person_model_of(path)
+    n_persons = max(int(ds.n_persons), 1)
+    try:
+        scenes = paper_scenes(
+            int(ds.seed), ds.n_trajectories, person_model=model, n_persons=n_persons
+        )
+    except InputError:
+        scenes = []
+    if json.loads(json.dumps([s.to_dict() for s in scenes])) != items:
+        raise InputError(f"data set {path!r} is not a paper data set (its scenes are not "
+                         "paper_scenes of its seed); its variants cannot be made")  # fmt: skip
+    seed = int(ds.seed) if seed is None else int(seed)
+    if clutter_factor == 1.0:
+        return str(paper_dataset_file(seed, ds.n_trajectories, fidelity=ds.fidelity,
+                                      person_model=model, n_persons=n_persons,
+                                      progress=progress))  # fmt: skip
+    scenes = [
+        # λ' = f · λ
+        dataclasses.replace(s, clutter_density_per_m2=s.clutter_density_per_m2 * clutter_factor)
+        for s in paper_scenes(seed, ds.n_trajectories, person_model=model, n_persons=n_persons)
+    ]
+    seeds = [s.seed for s in scenes]
+    root = default_cache_dir()
+    key = dataset_key(scenes, fidelity=ds.fidelity, seed=seed, seeds=seeds)
+    out = root / "datasets" / f"{key}.npz"
+    if not out.is_file():
+        build_dataset(scenes, seeds=seeds, fidelity=ds.fidelity, seed=seed, cache_dir=root,
+                      progress=progress)  # fmt: skip
+    return str(out)

@@ -17,6 +17,9 @@ second data set of another seed with the best parameters, and writes into one fo
   (:mod:`core.optimization.testsets`; chosen by validation when the studies were validated),
   a box and strip plot per model, beside a table per class of mean and median with 95 %
   intervals over the sets and the CV / CA ratios;
+- ``importance_<model>.png``, ``sensitivity_<model>.png`` and the "Sensitivity" section —
+  parameter importance per study, one-at-a-time sweeps around the chosen parameters and the
+  clutter-robustness table (:mod:`core.optimization.report_sensitivity`);
 - ``report.json`` — every number above.
 
 Every file is written to a temporary name and renamed.
@@ -38,6 +41,7 @@ import numpy as np
 from core.errors import InputError
 from core.files import write_json_atomic, write_text_atomic
 from core.optimization.progress import TrialSummary, study_progress
+from core.optimization.report_sensitivity import sensitivity_markdown
 from core.optimization.storage import open_storage, redact
 
 #: The paper's Table I, ×10⁻³.
@@ -262,6 +266,9 @@ def write_report(
     test_sets: int = 0,
     test_paths: Sequence[str] | None = None,
     progress: Callable[[str], None] | None = None,
+    sensitivity: bool = False,
+    sensitivity_points: int = 15,
+    clutter_variants: bool = True,
 ) -> dict[str, Any]:
     """Write the report folder (see the module docstring); return the JSON dict.
 
@@ -284,6 +291,16 @@ def write_report(
         Test data-set files instead of the paper ones (``test_sets`` is then ignored).
     progress
         Called with a line of progress while the test sets are made and tracked.
+    sensitivity
+        Write the sensitivity sections (:mod:`core.optimization.report_sensitivity`; the CLI
+        writes them unless told not to):
+        parameter importance, one-at-a-time sweeps on the training and the generalisation
+        (held-out) set, clutter robustness.
+    sensitivity_points
+        Grid points per parameter of the one-at-a-time sweeps; 0: no sweeps.
+    clutter_variants
+        Also score the clutter robustness on the training and held-out paper sets simulated
+        with the scene clutter rate λ ×0.5 and ×2 (simulated on first use, cached).
     """
     from core.dataset import Dataset
     from core.optimization.data import like_training, resolve_dataset
@@ -382,6 +399,9 @@ def write_report(
         result["test_sets"] = tests
         plot_test_sets(result["test_sets"], out / "test_sets.png")
         plots.append("test_sets.png")
+    if sensitivity:
+        add_sensitivity(result, storage, studies, out, generalisation_dataset, train_file,
+                        sensitivity_points, clutter_variants, progress)  # fmt: skip
     result["plots"] = plots
     if "cv" in result["models"] and "ca" in result["models"]:
         cv = result["models"]["cv"]["training"]["loss_total"]
@@ -419,6 +439,42 @@ def table_dataset(
             "is re-made on (the chosen parameters are compared on one data set)"
         )
     raise InputError("the studies record no data set; pass --dataset")
+
+
+def add_sensitivity(
+    result: dict[str, Any],
+    storage: str,
+    studies: Sequence[StudyRecord],
+    out: Path,
+    heldout: str | None,
+    training: str,
+    points: int,
+    clutter_variants: bool,
+    progress: Callable[[str], None] | None,
+) -> None:
+    """Put the ``sensitivity`` entry into ``result`` and draw its plots into ``out``."""
+    from core.optimization.data import resolve_dataset
+    from core.optimization.report_sensitivity import (
+        plot_importance,
+        plot_oat,
+        sensitivity_entry,
+    )
+
+    entry = sensitivity_entry(
+        storage,
+        studies,
+        heldout_path=resolve_dataset(heldout) if heldout else None,
+        training_path=training,
+        oat_points=points,
+        clutter_variants=clutter_variants,
+        progress=progress,
+    )
+    entry["plots"] = []
+    for model in ("cv", "ca"):
+        for name, plot in (("importance", plot_importance), ("sensitivity", plot_oat)):
+            if plot(entry, model, out / f"{name}_{model}.png"):
+                entry["plots"].append(f"{name}_{model}.png")
+    result["sensitivity"] = entry
 
 
 def score_chosen(
@@ -662,6 +718,7 @@ def render_markdown(r: dict[str, Any]) -> str:
             )
     lines += _people_section(r)
     lines += _test_section(r)
+    lines += sensitivity_markdown(r)
     lines += ["", "## Chosen parameters", ""]
     for model in ("cv", "ca"):
         if model not in models:
