@@ -36,6 +36,17 @@ from core.limits import MAX_INPUT_BYTES, MAX_JSON_DEPTH, MAX_NPZ_ELEMENTS, MAX_N
 # ---- writing -------------------------------------------------------------------------------------
 
 
+def _read_umask() -> int:
+    """The process's umask (read by setting it and putting it back: once, at import)."""
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
+
+
+#: Mode of a file written by :func:`atomic_open`: what a plain ``open()`` would give.
+FILE_MODE = 0o666 & ~_read_umask()
+
+
 @contextmanager
 def atomic_open(path: str | os.PathLike, mode: str = "w") -> Iterator[IO[Any]]:
     """Open a temporary file next to ``path``; on success it replaces ``path`` atomically.
@@ -57,6 +68,8 @@ def atomic_open(path: str | os.PathLike, mode: str = "w") -> Iterator[IO[Any]]:
             yield fh
             fh.flush()
             os.fsync(fh.fileno())
+        # mkstemp creates 0600; the file gets the mode a plain open() would (0666 less the umask)
+        os.chmod(tmp, FILE_MODE)
         os.replace(tmp, path)
     except BaseException as exc:
         Path(tmp).unlink(missing_ok=True)

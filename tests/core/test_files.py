@@ -215,3 +215,18 @@ def test_key_with_line_breaks_stays_one_line() -> None:
         parse_json('{"a\\n\\u2028b\\r": {"c": "\\u0000"}}', "x.json")
     assert len(str(err.value).splitlines()) == 1
     assert "a\\x0a\\u2028b\\x0d.c: string holds a NUL" in str(err.value)
+
+
+def test_atomic_write_gets_the_mode_a_plain_open_gives(tmp_path: Path) -> None:
+    """mkstemp makes 0600 files; a written report or data set must be readable as a plain
+    open() would leave it (0666 less the umask), like the files written without atomic_open."""
+    import os
+    import stat
+
+    from core.files import write_text_atomic
+
+    plain = tmp_path / "plain.txt"
+    plain.write_text("x")
+    write_text_atomic(tmp_path / "atomic.txt", "x")
+    mode = stat.S_IMODE(os.stat(tmp_path / "atomic.txt").st_mode)
+    assert mode == stat.S_IMODE(os.stat(plain).st_mode)
