@@ -30,6 +30,7 @@ out); its plot goes to ``bench/results/samplers-quick/``.
 
 from __future__ import annotations
 
+import importlib.metadata
 import importlib.util
 import itertools
 import math
@@ -121,7 +122,7 @@ def timed_objective(log: list[tuple[float, float]]) -> Iterator[None]:
         finally:
             log.append((time.perf_counter() - t0, time.process_time() - c0))
 
-    study_module.evaluate = evaluate  # type: ignore[assignment]
+    study_module.evaluate = evaluate
     try:
         yield
     finally:
@@ -153,10 +154,7 @@ def run_study(
     model: str, sampler: str, pruner: str, seed: int, s: Settings, train: str, heldout: HeldOut
 ) -> dict[str, Any]:
     """One study, timed per trial; its incumbents with their held-out losses."""
-    import optuna
-
-    from core.optimization.space import tracker_params_dict
-    from core.optimization.storage import open_storage
+    from core.optimization.progress import study_progress
     from core.optimization.study import StudySettings, prepare_study, run_worker
 
     name = f"{model}-{sampler}-{pruner}-s{seed}"
@@ -181,8 +179,7 @@ def run_study(
     prepare_study(settings, dataset_path=train)
     with timed_objective(objective):
         run_worker(settings.storage, name, seed=seed, dataset_path=train, stop=stop)
-    study = optuna.load_study(study_name=name, storage=open_storage(settings.storage))
-    trials = sorted(study.get_trials(deepcopy=False), key=lambda t: t.number)
+    trials = sorted(study_progress(settings.storage, name)[0], key=lambda t: t.number)
     # one worker: trial i runs between the (i+1)-th and (i+2)-th call of stop()
     if len(marks) != len(trials) + 1:
         raise RuntimeError(f"{name}: {len(marks)} clock marks for {len(trials)} trials")
@@ -192,10 +189,10 @@ def run_study(
     incumbents: list[dict[str, Any]] = []
     best = math.inf
     for i, t in enumerate(trials):
-        if t.state.name != "COMPLETE" or t.value is None or not t.value < best:
+        if t.state != "COMPLETE" or t.value is None or not t.value < best:
             continue
         best = float(t.value)
-        params = tracker_params_dict({k: float(v) for k, v in t.params.items()}, model)
+        params = t.tracker_params(model)
         held = heldout.score(params)
         incumbents.append(
             {
@@ -210,7 +207,7 @@ def run_study(
                 "params": params,
             }
         )
-    states = [t.state.name for t in trials]
+    states = [t.state for t in trials]
     return {
         "model": model,
         "sampler": sampler,
@@ -290,8 +287,6 @@ def run(quick: bool = False, settings: Settings | None = None) -> dict:
     seeds first); the plot and table."""
     import multiprocessing
 
-    import optuna
-
     from core.files import write_json_atomic
 
     s = settings or (QUICK if quick else Settings())
@@ -332,10 +327,10 @@ def run(quick: bool = False, settings: Settings | None = None) -> dict:
         if pool is not None:
             pool.close()
             pool.join()
-    versions = {"optuna": optuna.__version__}
-    for package in ("cmaes", "torch"):
+    versions = {}
+    for package in ("optuna", "cmaes", "torch"):
         if importlib.util.find_spec(package) is not None:
-            versions[package] = __import__(package).__version__
+            versions[package] = importlib.metadata.version(package)
     result = {
         "settings": {k: list(v) if isinstance(v, tuple) else v for k, v in asdict(s).items()},
         "samplers": list(samplers),
@@ -500,7 +495,14 @@ def _plot(result: dict, path: Path) -> Path:
         row[0].set_ylabel(f"{model.upper()}: held-out L_t of the incumbent (m²)")
         row[0].legend(fontsize=8, loc="upper right")
     axes[-1][0].set_xlabel("trials (pruned ones included)")
-    axes[-1][1].set_xlabel("wall-clock seconds since the first trial (one worker, in memory)")
+    load = float(np.mean([result["load_average_start"][1], result["load_average_end"][1]]))
+    wall_per_cpu = float(np.median([r["wall_s"] / max(r["cpu_s"], 1e-9) for r in studies_all]))
+    axes[-1][1].set_xlabel(
+        "wall-clock seconds since the first trial (one worker, in memory)\n"
+        f"load {load:.0f} on 2 cores: wall clock {wall_per_cpu:.1f}× the study's CPU time"
+    )
+    for row in axes:
+        row[1].set_xlim(left=0.1)
     fig.suptitle(
         f"Studies on {result['training_set'].split(' ')[0]}, incumbent re-tracked on "
         f"{len(result['heldout_sets'])} held-out sets: median and interquartile band over "
