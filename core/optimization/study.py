@@ -159,9 +159,9 @@ def make_sampler(kind: str, seed: int | None) -> Any:
     sample the same point while trials run. (Prior, magic clip and endpoints keep their
     defaults: their arguments are deprecated in Optuna 5.)
 
-    CMA-ES (``cmaes``, needs the ``cmaes`` package): starts at the centre of the box (in log
-    space for log parameters) with σ₀ a sixth of the narrowest range, one random start-up
-    trial, the default population 4 + ⌊3 ln d⌋; pruned trials are not told to it. Its state
+    CMA-ES (``cmaes``, needs the ``cmaes`` package): every parameter scaled to [0, 1] (log ones
+    in log space), starting at the centre with σ₀ = 1/6, after one random start-up trial, with
+    the default population 4 + ⌊3 ln d⌋; pruned trials are not told to it. Its state
     lives in the study's trials, so the fresh sampler a worker makes per trial resumes it.
     GP (``gp``, needs ``torch``): Optuna's Gaussian-process sampler, 10 random start-up trials.
     A trial without a relative sample (the start-up) is drawn by a random sampler of the seed.
