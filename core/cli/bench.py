@@ -20,14 +20,16 @@ BENCHMARKS = ("sim", "track", "tune", "fidelity", "dataset", "false_alarms", "cv
 #: benchmark name -> module in core.benchmarks, where the name is a Python keyword
 MODULES = {"import": "import_"}
 #: not part of ``all``: hours of studies (16 x 1000 trials); person clouds (a calibration, not
-#: a speed figure); the desktop app (needs Qt)
-LONG = ("cvca_seeds", "clouds", "gui")
+#: a speed figure); the desktop app (needs Qt); held-out loss against run time per sampler
+#: (30 studies)
+LONG = ("cvca_seeds", "clouds", "gui", "samplers")
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "bench",
         help="measure speed (and error against run time); cvca, cvca_seeds: CV against CA; "
+        "samplers: held-out loss against trials and seconds per sampler and pruner; "
         "import: reading real recordings; gui: the desktop app (offscreen and under Xvfb)",
     )
     p.add_argument("name", choices=(*BENCHMARKS, *LONG, "all"))
@@ -38,7 +40,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--render-only",
         action="store_true",
-        help="fidelity, clouds: re-write the tables and plots from <out-dir>/<name>.json, no run",
+        help="fidelity, clouds, samplers: re-write the tables and plots from "
+        "<out-dir>/<name>.json, no run",
     )
     for model in ("cv", "ca"):
         p.add_argument(
@@ -88,12 +91,16 @@ def _render_only(args: argparse.Namespace) -> int:
 
     from core.errors import InputError
 
-    if args.name not in ("fidelity", "clouds"):
-        raise InputError(f"--render-only is for fidelity and clouds only, not {args.name!r}")
+    if args.name not in ("fidelity", "clouds", "samplers"):
+        raise InputError(
+            f"--render-only is for fidelity, clouds and samplers only, not {args.name!r}"
+        )
     if args.name == "fidelity":
         from core.benchmarks.fidelity_report import render, summary
-    else:
+    elif args.name == "clouds":
         from core.benchmarks.clouds import render, summary  # type: ignore[assignment]
+    else:
+        from core.benchmarks.samplers import render, summary  # type: ignore[assignment]
 
     path = Path(args.out_dir) / f"{args.name}{'-quick' if args.quick else ''}.json"
     if not path.exists():

@@ -43,7 +43,12 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--storage", default=DEFAULT_STORAGE, help="storage URL (default: %(default)s)")
     p.add_argument("--study", default=None, help="study name (default: radartune-<model>)")
     p.add_argument("--seed", type=int, default=0, help="base seed (default: %(default)s)")
-    p.add_argument("--sampler", default="tpe", help="tpe or random (default: %(default)s)")
+    p.add_argument(
+        "--sampler",
+        default="tpe",
+        help="tpe, random, cmaes (needs the cmaes package) or gp (needs torch) "
+        "(default: %(default)s)",
+    )
     p.add_argument("--pruner", default="asha", help="asha, wilcoxon or none (default: %(default)s)")
     p.add_argument(
         "--dataset",

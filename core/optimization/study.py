@@ -54,7 +54,9 @@ from core.optimization.storage import (
     redact,
 )
 
-SAMPLERS = ("tpe", "random")
+SAMPLERS = ("tpe", "random", "cmaes", "gp")
+#: samplers that need a package Optuna does not install itself: sampler -> module
+SAMPLER_PACKAGES = {"cmaes": "cmaes", "gp": "torch"}
 PRUNERS = ("asha", "wilcoxon", "none")
 OBJECTIVES = ("tracker", "quadratic")
 #: states that occupy a slot of the total
@@ -84,7 +86,7 @@ class StudySettings:
     seed
         Base seed: trial n samples with :func:`trial_seed` (seed, n).
     sampler
-        ``"tpe"`` or ``"random"`` (baseline).
+        ``"tpe"``, ``"random"`` (baseline), ``"cmaes"`` or ``"gp"`` (:func:`make_sampler`).
     pruner
         ``"asha"`` (successive halving), ``"wilcoxon"`` or ``"none"``.
     dataset
@@ -118,8 +120,7 @@ class StudySettings:
             raise InputError(f"n_trials must be >= 1, got {self.n_trials}")
         if int(self.n_jobs) < 1:
             raise InputError(f"n_jobs must be >= 1, got {self.n_jobs}")
-        if self.sampler not in SAMPLERS:
-            raise InputError(f"sampler must be one of {', '.join(SAMPLERS)}, got {self.sampler!r}")
+        check_sampler(self.sampler)
         if self.pruner not in PRUNERS:
             raise InputError(f"pruner must be one of {', '.join(PRUNERS)}, got {self.pruner!r}")
         if self.objective not in OBJECTIVES:
@@ -136,6 +137,18 @@ class StudySettings:
 
 
 # ---- samplers and pruners ---------------------------------------------------------------------
+def check_sampler(kind: str) -> str:
+    """``kind`` if it names a sampler whose package is installed; else one :class:`InputError`."""
+    import importlib.util
+
+    if kind not in SAMPLERS:
+        raise InputError(f"sampler must be one of {', '.join(SAMPLERS)}, got {kind!r}")
+    package = SAMPLER_PACKAGES.get(kind)
+    if package is not None and importlib.util.find_spec(package) is None:
+        raise InputError(f"sampler {kind!r} needs the Python package {package!r} (not installed)")
+    return kind
+
+
 def make_sampler(kind: str, seed: int | None) -> Any:
     """Optuna sampler with every argument set explicitly (Optuna 5 changed the defaults).
 
@@ -145,13 +158,38 @@ def make_sampler(kind: str, seed: int | None) -> Any:
     start-up trials, 24 EI candidates, and the constant liar so that parallel workers do not
     sample the same point while trials run. (Prior, magic clip and endpoints keep their
     defaults: their arguments are deprecated in Optuna 5.)
+
+    CMA-ES (``cmaes``, needs the ``cmaes`` package): every parameter scaled to [0, 1] (log ones
+    in log space), starting at the centre with σ₀ = 1/6, after one random start-up trial, with
+    the default population 4 + ⌊3 ln d⌋; pruned trials are not told to it. Its state
+    lives in the study's trials, so the fresh sampler a worker makes per trial resumes it.
+    GP (``gp``, needs ``torch``): Optuna's Gaussian-process sampler, 10 random start-up trials.
+    A trial without a relative sample (the start-up) is drawn by a random sampler of the seed.
     """
     import optuna
 
+    check_sampler(kind)
     if kind == "random":
         return optuna.samplers.RandomSampler(seed=seed)
-    if kind != "tpe":
-        raise InputError(f"sampler must be one of {', '.join(SAMPLERS)}, got {kind!r}")
+    if kind == "cmaes":
+        return optuna.samplers.CmaEsSampler(
+            n_startup_trials=1,
+            independent_sampler=optuna.samplers.RandomSampler(seed=seed),
+            warn_independent_sampling=False,
+            seed=seed,
+            consider_pruned_trials=False,
+            use_separable_cma=False,
+            with_margin=False,
+            lr_adapt=False,
+        )
+    if kind == "gp":
+        return optuna.samplers.GPSampler(
+            seed=seed,
+            independent_sampler=optuna.samplers.RandomSampler(seed=seed),
+            n_startup_trials=10,
+            deterministic_objective=False,
+            warn_independent_sampling=False,
+        )
     return optuna.samplers.TPESampler(
         n_startup_trials=10,
         n_ei_candidates=24,
