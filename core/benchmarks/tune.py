@@ -8,13 +8,17 @@ installed; left out otherwise). References measured in the same run, in this pro
 - the bare objective: the IPDA tracker on the 35 trajectories with random parameters, no
   Optuna, no storage (the work of a trial that is not pruned);
 - the same study in Optuna's in-memory storage (``run_worker`` on ``memory://``): Optuna's
-  sampler and pruner without any storage round trip.
+  sampler and pruner without any storage round trip;
+- the study with one worker in this process on each storage: CPU a trial of the storage's
+  round trips without process start-up.
 
 Per study: the steady rate (trials finished between the first trial's start and the last
 trial's end), the end-to-end rate (from the ``tune`` call to the last worker's exit, process
 start-up included), the workers' CPU seconds per trial, and the ratios to both references. The
-machine is shared: the load average before and after each study is recorded beside it, and CPU
-time per trial is the figure that load disturbs least. The point-person data set's SQLite
+machine is shared: the load average before and after each study and the share of a core a busy
+loop got just before it (``cpu_share``; with the kernel's per-session scheduling, two workers of
+one command share one session's slice) are recorded beside it, and CPU time per trial is the
+figure that load disturbs least. The point-person data set's SQLite
 2-job study and references are measured too, for comparison with earlier figures.
 Goal (issue 15): at least 20 trials/s with 2 jobs on SQLite.
 """
@@ -91,22 +95,33 @@ def _rates(storage: str, name: str) -> dict[str, Any]:
     }
 
 
-def _in_memory(dataset_path: str, n_trials: int) -> dict[str, Any]:
-    """The study in Optuna's in-memory storage, one worker in this process."""
+def cpu_share(seconds: float = 0.5) -> float:
+    """Share of one core a busy loop in this process gets now (1.0 on an idle machine)."""
+    t0, c0 = time.perf_counter(), time.process_time()
+    x = 0
+    while time.perf_counter() - t0 < seconds:
+        x += 1
+    return (time.process_time() - c0) / (time.perf_counter() - t0)
+
+
+def _in_process(dataset_path: str, storage: str, n_trials: int) -> dict[str, Any]:
+    """The study with one worker in this process (no process start-up): Optuna's in-memory
+    storage (``memory://``) for the reference, or a file or server storage."""
     from core.optimization.study import prepare_study, run_worker
 
-    s = _settings(dataset_path, f"memory://bench-{time.time_ns()}", 1, n_trials)
+    s = _settings(dataset_path, storage, 1, n_trials)
     prepare_study(s, dataset_path=dataset_path)
+    share = cpu_share()
     t0, c0 = time.perf_counter(), time.process_time()
     run_worker(s.storage, s.name, seed=s.seed, dataset_path=dataset_path)
     wall, cpu = time.perf_counter() - t0, time.process_time() - c0
     r = _rates(s.storage, s.name)
     r.update(
-        storage="memory",
         jobs=1,
         wall_s=wall,
         trials_per_s_end_to_end=r["trials"] / wall,
         cpu_s_per_trial=cpu / r["trials"],
+        cpu_share=share,
     )
     return r
 
@@ -115,6 +130,7 @@ def _study(dataset_path: str, storage: str, n_jobs: int, n_trials: int) -> dict[
     from core.optimization.study import start_study
 
     s = _settings(dataset_path, storage, n_jobs, n_trials)
+    share = cpu_share()
     load0 = os.getloadavg()[0]
     cpu0 = resource.getrusage(resource.RUSAGE_CHILDREN)
     t0 = time.perf_counter()
@@ -130,6 +146,7 @@ def _study(dataset_path: str, storage: str, n_jobs: int, n_trials: int) -> dict[
         trials_per_s_end_to_end=r["trials"] / wall,
         # the workers' CPU, process start-up (imports, loading the compiled tracker) included
         cpu_s_per_trial=cpu / r["trials"],
+        cpu_share=share,
         load_before=load0,
         load_after=os.getloadavg()[0],
         returncodes=handle.returncodes(),
@@ -138,12 +155,24 @@ def _study(dataset_path: str, storage: str, n_jobs: int, n_trials: int) -> dict[
 
 
 def _dataset_runs(
-    dataset_path: str, n_trials: int, n_ref: int, storages: list[tuple[str, str]], jobs: tuple
+    dataset_path: str,
+    n_trials: int,
+    n_ref: int,
+    storages: list[tuple[str, str]],
+    jobs: tuple[int, ...],
+    *,
+    in_process: bool = True,
 ) -> dict[str, Any]:
     ref = _reference(dataset_path, n_ref)
-    memory = _in_memory(dataset_path, n_trials)
-    runs = []
+    memory = _in_process(dataset_path, f"memory://bench-{time.time_ns()}", n_trials)
+    memory["storage"] = "memory"
+    one_process, runs = [], []
     for kind, url in storages:
+        if in_process:
+            r = _in_process(dataset_path, url.format(jobs="in-process"), n_trials)
+            r["storage"] = kind
+            r["cpu_ratio_to_in_memory"] = r["cpu_s_per_trial"] / memory["cpu_s_per_trial"]
+            one_process.append(r)
         for n_jobs in jobs:
             r = _study(dataset_path, url.format(jobs=n_jobs), n_jobs, n_trials)
             r["storage"] = kind
@@ -154,6 +183,7 @@ def _dataset_runs(
         "dataset": Path(dataset_path).name,
         "objective_in_process": ref,
         "in_memory_study": memory,
+        "in_process_studies": one_process,
         "studies": runs,
     }
 
@@ -175,7 +205,12 @@ def run(quick: bool = False) -> dict:
             storages.append(("postgresql", pg))
         result_walking = _dataset_runs(walking, n_trials, n_ref, storages, (1, 2))
         result_point = _dataset_runs(
-            point, n_trials, n_ref, [("sqlite", f"sqlite:///{tmp}/p{{jobs}}.db")], (2,)
+            point,
+            n_trials,
+            n_ref,
+            [("sqlite", f"sqlite:///{tmp}/p{{jobs}}.db")],
+            (2,),
+            in_process=False,
         )
     return {
         "n_trials": n_trials,
@@ -198,16 +233,24 @@ def summary(result: dict) -> str:
             f"  {person} person ({part['dataset']}):",
             f"    objective in process (35 trajectories, no Optuna): "
             f"{ref['trials_per_s']:.1f} trials/s, {1e3 * ref['cpu_s_per_trial']:.1f} ms CPU",
-            f"    in-memory study, 1 job in process: {mem['trials_per_s_steady']:.1f} trials/s,"
-            f" {1e3 * mem['cpu_s_per_trial']:.1f} ms CPU a trial ({mem['pruned']} pruned)",
+            f"    in process, 1 worker: memory {mem['trials_per_s_steady']:.1f} trials/s, "
+            f"{1e3 * mem['cpu_s_per_trial']:.1f} ms CPU a trial ({mem['pruned']} pruned; "
+            f"CPU share {mem['cpu_share']:.2f})",
         ]
+        for r in part["in_process_studies"]:
+            lines.append(
+                f"    in process, 1 worker: {r['storage']} {r['trials_per_s_steady']:.1f} "
+                f"trials/s, {1e3 * r['cpu_s_per_trial']:.1f} ms CPU a trial "
+                f"(x{r['cpu_ratio_to_in_memory']:.2f} of memory's CPU; CPU share "
+                f"{r['cpu_share']:.2f})"
+            )
         for r in part["studies"]:
             lines.append(
                 f"    {r['storage']:<10} jobs={r['jobs']}: {r['trials_per_s_steady']:5.1f} "
                 f"trials/s steady, {r['trials_per_s_end_to_end']:5.1f} end to end, "
-                f"{1e3 * r['cpu_s_per_trial']:.1f} ms CPU a trial; x{r['ratio_to_objective']:.2f}"
-                f" of the objective, x{r['ratio_to_in_memory']:.2f} of in-memory "
-                f"({r['trials']} trials, {r['pruned']} pruned, load "
-                f"{r['load_before']:.1f}->{r['load_after']:.1f})"
+                f"{1e3 * r['cpu_s_per_trial']:.1f} ms CPU a trial with start-up; "
+                f"x{r['ratio_to_objective']:.2f} of the objective, x{r['ratio_to_in_memory']:.2f}"
+                f" of in-memory ({r['trials']} trials, {r['pruned']} pruned, CPU share "
+                f"{r['cpu_share']:.2f}, load {r['load_before']:.1f}->{r['load_after']:.1f})"
             )
     return "\n".join(lines)
