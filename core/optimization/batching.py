@@ -31,6 +31,7 @@ from __future__ import annotations
 
 import copy
 import datetime as dt
+import threading
 from collections.abc import Iterator
 from contextlib import contextmanager
 from typing import Any
@@ -80,15 +81,32 @@ class _Phase:
 class BatchingRDBStorage(RDBStorage):
     """:class:`optuna.storages.RDBStorage` (SQLite, PostgreSQL) with fewer round trips.
 
-    Same constructor and database as ``RDBStorage``; see the module docstring. One object is
-    used by one thread (a worker process), like every RadarTune worker.
+    Same constructor and database as ``RDBStorage``; see the module docstring. A phase belongs
+    to the thread that opened it; other threads' reads and writes go to the database as usual.
     """
 
     def __init__(self, *args: Any, **kwargs: Any) -> None:
         super().__init__(*args, **kwargs)
         self._own: dict[int, FrozenTrial] = {}  # trials this process created, while they run
         self._finished: set[int] = set()  # own trials finished since the last read
-        self._phase: _Phase | None = None
+        self._local = threading.local()  # the phase belongs to the thread that opened it
+
+    def __getstate__(self) -> dict[str, Any]:
+        state = dict(super().__getstate__())
+        state.pop("_local", None)  # a copy in another process starts with no phase
+        return state
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        super().__setstate__(state)
+        self._local = threading.local()
+
+    @property
+    def _phase(self) -> _Phase | None:
+        return getattr(self._local, "phase", None)
+
+    @_phase.setter
+    def _phase(self, phase: _Phase | None) -> None:
+        self._local.phase = phase
 
     # -- phases --------------------------------------------------------------------------------
     @contextmanager

@@ -143,3 +143,23 @@ def test_a_write_to_a_trial_failed_by_another_process_is_refused(tmp_path: Path)
     with pytest.raises(optuna.exceptions.UpdateFinishedTrialError), batched(store):
         study._storage.set_trial_param(trial_id, "x", 0.25, FloatDistribution(0.0, 1.0))
     assert optuna.storages.RDBStorage(url).get_trial(trial_id).params == {}
+
+
+def test_a_phase_belongs_to_its_thread(tmp_path: Path) -> None:
+    # inside a phase that does not read, this thread sees the study as last read; another
+    # thread using the same storage (a progress poll) still reads the database
+    import threading
+
+    url = f"sqlite:///{tmp_path}/p.db"
+    store = open_storage(url)
+    study = optuna.create_study(storage=store, study_name="t")
+    elsewhere = optuna.load_study(study_name="t", storage=optuna.storages.RDBStorage(url))
+    seen: list[int] = []
+    with batched(store, read=False):
+        elsewhere.ask()  # a trial made by another process
+        assert study.get_trials() == []
+        poll = threading.Thread(target=lambda: seen.append(len(study.get_trials())))
+        poll.start()
+        poll.join()
+    assert seen == [1]
+    assert len(study.get_trials()) == 1
