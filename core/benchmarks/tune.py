@@ -1,16 +1,32 @@
-"""``radartune bench tune``: completed trials per second of a CV study on the cached data set.
+"""``radartune bench tune``: completed trials per second of a CV study on every storage.
 
-Measured with 1 and 2 worker processes, on the SQLite file (default storage) and the journal
-file, TPE + ASHA as ``radartune tune`` runs it. Two rates per run: end to end (wall clock from
-the ``tune`` call to the last worker's exit, process start-up included) and steady state
-(trials finished between the first trial's start and the last trial's end). The reference, in
-the same run, is the bare objective in this process — the IPDA tracker on the 35 trajectories
-with random parameters, no Optuna, no storage — so the ratio shows what Optuna and the storage
-cost. Goal: at least 10 trials/s with 2 jobs on the 2-core machine.
+A CV study (TPE + ASHA, as ``radartune tune`` runs it) on the walking-body paper data set, with
+1 and 2 worker processes on the SQLite file (the default storage), the journal file and
+PostgreSQL (``$RADARTUNE_BENCH_POSTGRES`` or a throwaway server where the server binaries are
+installed; left out otherwise). References measured in the same run, in this process:
+
+- the bare objective: the IPDA tracker on the 35 trajectories with random parameters, no
+  Optuna, no storage (the work of a trial that is not pruned);
+- the same study in Optuna's in-memory storage (``run_worker`` on ``memory://``): Optuna's
+  sampler and pruner without any storage round trip;
+- the study with one worker in this process on each storage: CPU a trial of the storage's
+  round trips without process start-up.
+
+Per study: the steady rate (trials finished between the first trial's start and the last
+trial's end), the end-to-end rate (from the ``tune`` call to the last worker's exit, process
+start-up included), the workers' CPU seconds per trial, and the ratios to both references. The
+machine is shared: the load average before and after each study and the share of a core a busy
+loop got just before it (``cpu_share``; with the kernel's per-session scheduling, two workers of
+one command share one session's slice) are recorded beside it, and CPU time per trial is the
+figure that load disturbs least. The point-person data set's SQLite
+2-job study and references are measured too, for comparison with earlier figures.
+Goal (issue 15): at least 20 trials/s with 2 jobs on SQLite.
 """
 
 from __future__ import annotations
 
+import os
+import resource
 import tempfile
 import time
 from pathlib import Path
@@ -18,8 +34,11 @@ from typing import Any
 
 import numpy as np
 
+GOAL_TRIALS_PER_S_2_JOBS = 20.0
+
 
 def _reference(dataset_path: str, n: int) -> dict[str, float]:
+    """The bare objective in this process: a full (unpruned) trial's work, no Optuna."""
     from core.dataset import Dataset
     from core.optimization.objective import TrackerLosses, evaluate
     from core.optimization.space import search_space, tracker_params_dict
@@ -38,77 +57,200 @@ def _reference(dataset_path: str, n: int) -> dict[str, float]:
         return tracker_params_dict(flat, "cv")
 
     evaluate(losses, draw())  # compile / warm caches
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     for _ in range(n):
         evaluate(losses, draw())
-    dt = time.perf_counter() - t0
-    return {"trials": n, "seconds": dt, "trials_per_s": n / dt}
+    dt, dc = time.perf_counter() - t0, time.process_time() - c0
+    return {"trials": n, "seconds": dt, "trials_per_s": n / dt, "cpu_s_per_trial": dc / n}
 
 
-def _study(dataset_path: str, storage: str, n_jobs: int, n_trials: int) -> dict[str, Any]:
-    from core.optimization.progress import counted, study_progress
-    from core.optimization.study import StudySettings, start_study
+def _settings(dataset_path: str, storage: str, n_jobs: int, n_trials: int) -> Any:
+    from core.optimization.study import StudySettings
 
-    s = StudySettings(
-        model="cv", n_trials=n_trials, n_jobs=n_jobs, storage=storage, dataset=dataset_path
+    return StudySettings(
+        model="cv",
+        n_trials=n_trials,
+        n_jobs=n_jobs,
+        storage=storage,
+        dataset=dataset_path,
+        study_name=f"bench-cv-{n_jobs}-{time.time_ns()}",  # one storage may hold several
     )
-    t0 = time.perf_counter()
-    handle = start_study(s, dataset_path=dataset_path)
-    handle.wait()
-    wall = time.perf_counter() - t0
-    summaries, best = study_progress(storage, s.name)
+
+
+def _rates(storage: str, name: str) -> dict[str, Any]:
+    from core.optimization.progress import counted, study_progress
+
+    summaries, best = study_progress(storage, name)
     done = [t for t in summaries if t.state in ("COMPLETE", "PRUNED")]
     first = min(t.datetime_start for t in done)
     last = max(t.datetime_complete for t in done)
     steady = (last - first).total_seconds()
     return {
-        "storage": storage.split(":", 1)[0],
-        "jobs": n_jobs,
         "trials": counted(summaries),
         "pruned": sum(1 for t in done if t.state == "PRUNED"),
-        "wall_s": wall,
-        "trials_per_s_end_to_end": counted(summaries) / wall,
+        "failed": sum(1 for t in summaries if t.state == "FAIL"),
         "steady_s": steady,
         "trials_per_s_steady": (len(done) - 1) / steady if steady > 0 else float("nan"),
         "best_loss": None if best is None else best.value,
-        "returncodes": handle.returncodes(),
     }
 
 
-def run(quick: bool = False) -> dict:
-    from core.optimization.data import resolve_dataset
+def cpu_share(seconds: float = 0.5) -> float:
+    """Share of one core a busy loop in this process gets now (1.0 on an idle machine)."""
+    t0, c0 = time.perf_counter(), time.process_time()
+    x = 0
+    while time.perf_counter() - t0 < seconds:
+        x += 1
+    return (time.process_time() - c0) / (time.perf_counter() - t0)
 
-    dataset_path = resolve_dataset(None)
-    n_trials = 20 if quick else 200
-    ref = _reference(dataset_path, 5 if quick else 30)
-    runs = []
-    with tempfile.TemporaryDirectory(prefix="radartune-bench-") as tmp:
-        for kind, url in (("sqlite", "sqlite:///{}/b{}.db"), ("journal", "journal:///{}/b{}.log")):
-            for jobs in (1, 2):
-                r = _study(dataset_path, url.format(tmp, jobs), jobs, n_trials)
-                r["storage"] = kind
-                r["ratio_to_reference"] = r["trials_per_s_steady"] / ref["trials_per_s"]
-                runs.append(r)
+
+def _in_process(dataset_path: str, storage: str, n_trials: int) -> dict[str, Any]:
+    """The study with one worker in this process (no process start-up): Optuna's in-memory
+    storage (``memory://``) for the reference, or a file or server storage."""
+    from core.optimization.study import prepare_study, run_worker
+
+    s = _settings(dataset_path, storage, 1, n_trials)
+    prepare_study(s, dataset_path=dataset_path)
+    share = cpu_share()
+    t0, c0 = time.perf_counter(), time.process_time()
+    run_worker(s.storage, s.name, seed=s.seed, dataset_path=dataset_path)
+    wall, cpu = time.perf_counter() - t0, time.process_time() - c0
+    r = _rates(s.storage, s.name)
+    r.update(
+        jobs=1,
+        wall_s=wall,
+        trials_per_s_end_to_end=r["trials"] / wall,
+        cpu_s_per_trial=cpu / r["trials"],
+        cpu_share=share,
+    )
+    return r
+
+
+def _study(dataset_path: str, storage: str, n_jobs: int, n_trials: int) -> dict[str, Any]:
+    from core.optimization.study import start_study
+
+    s = _settings(dataset_path, storage, n_jobs, n_trials)
+    share = cpu_share()
+    load0 = os.getloadavg()[0]
+    cpu0 = resource.getrusage(resource.RUSAGE_CHILDREN)
+    t0 = time.perf_counter()
+    handle = start_study(s, dataset_path=dataset_path)
+    handle.wait()
+    wall = time.perf_counter() - t0
+    cpu1 = resource.getrusage(resource.RUSAGE_CHILDREN)
+    r = _rates(storage, s.name)
+    cpu = (cpu1.ru_utime - cpu0.ru_utime) + (cpu1.ru_stime - cpu0.ru_stime)
+    r.update(
+        jobs=n_jobs,
+        wall_s=wall,
+        trials_per_s_end_to_end=r["trials"] / wall,
+        # the workers' CPU, process start-up (imports, loading the compiled tracker) included
+        cpu_s_per_trial=cpu / r["trials"],
+        cpu_share=share,
+        load_before=load0,
+        load_after=os.getloadavg()[0],
+        returncodes=handle.returncodes(),
+    )
+    return r
+
+
+def _dataset_runs(
+    dataset_path: str,
+    n_trials: int,
+    n_ref: int,
+    storages: list[tuple[str, str]],
+    jobs: tuple[int, ...],
+    *,
+    in_process: bool = True,
+) -> dict[str, Any]:
+    ref = _reference(dataset_path, n_ref)
+    memory = _in_process(dataset_path, f"memory://bench-{time.time_ns()}", n_trials)
+    memory["storage"] = "memory"
+    one_process, runs = [], []
+    for kind, url in storages:
+        if in_process:
+            r = _in_process(dataset_path, url.format(jobs="in-process"), n_trials)
+            r["storage"] = kind
+            r["cpu_ratio_to_in_memory"] = r["cpu_s_per_trial"] / memory["cpu_s_per_trial"]
+            one_process.append(r)
+        for n_jobs in jobs:
+            r = _study(dataset_path, url.format(jobs=n_jobs), n_jobs, n_trials)
+            r["storage"] = kind
+            r["ratio_to_objective"] = r["trials_per_s_steady"] / ref["trials_per_s"]
+            r["ratio_to_in_memory"] = r["trials_per_s_steady"] / memory["trials_per_s_steady"]
+            runs.append(r)
     return {
         "dataset": Path(dataset_path).name,
-        "n_trials": n_trials,
-        "goal_trials_per_s_2_jobs": 10.0,
-        "reference_objective_in_process": ref,
+        "objective_in_process": ref,
+        "in_memory_study": memory,
+        "in_process_studies": one_process,
         "studies": runs,
     }
 
 
-def summary(result: dict) -> str:
-    ref = result["reference_objective_in_process"]
-    lines = [
-        f"bench tune: CV study, TPE + ASHA, {result['n_trials']} trials on {result['dataset']}",
-        f"  reference (bare objective, no Optuna, full 35 trajectories): "
-        f"{ref['trials_per_s']:.2f} trials/s",
-    ]
-    for r in result["studies"]:
-        lines.append(
-            f"  {r['storage']:<8} jobs={r['jobs']}: {r['trials_per_s_steady']:.2f} trials/s steady,"
-            f" {r['trials_per_s_end_to_end']:.2f} end to end ({r['trials']} trials,"
-            f" {r['pruned']} pruned, {r['wall_s']:.1f} s), x{r['ratio_to_reference']:.2f} of ref"
+def run(quick: bool = False) -> dict:
+    from core.benchmarks.postgres import postgres_server
+    from core.optimization.data import resolve_dataset
+
+    n_trials = 20 if quick else 200
+    n_ref = 5 if quick else 30
+    walking = resolve_dataset("paper:0:walking")
+    point = resolve_dataset("paper:0")
+    with tempfile.TemporaryDirectory(prefix="radartune-bench-") as tmp, postgres_server() as pg:
+        storages = [
+            ("sqlite", f"sqlite:///{tmp}/b{{jobs}}.db"),
+            ("journal", f"journal:///{tmp}/b{{jobs}}.log"),
+        ]
+        if pg:
+            storages.append(("postgresql", pg))
+        result_walking = _dataset_runs(walking, n_trials, n_ref, storages, (1, 2))
+        result_point = _dataset_runs(
+            point,
+            n_trials,
+            n_ref,
+            [("sqlite", f"sqlite:///{tmp}/p{{jobs}}.db")],
+            (2,),
+            in_process=False,
         )
+    return {
+        "n_trials": n_trials,
+        "goal_trials_per_s_2_jobs": GOAL_TRIALS_PER_S_2_JOBS,
+        "postgresql": bool(pg),
+        "walking": result_walking,
+        "point": result_point,
+    }
+
+
+def summary(result: dict) -> str:
+    lines = [
+        f"bench tune: CV study, TPE + ASHA, {result['n_trials']} trials; goal "
+        f"{result['goal_trials_per_s_2_jobs']:.0f} trials/s with 2 jobs on SQLite",
+    ]
+    for person in ("walking", "point"):
+        part = result[person]
+        ref, mem = part["objective_in_process"], part["in_memory_study"]
+        lines += [
+            f"  {person} person ({part['dataset']}):",
+            f"    objective in process (35 trajectories, no Optuna): "
+            f"{ref['trials_per_s']:.1f} trials/s, {1e3 * ref['cpu_s_per_trial']:.1f} ms CPU",
+            f"    in process, 1 worker: memory {mem['trials_per_s_steady']:.1f} trials/s, "
+            f"{1e3 * mem['cpu_s_per_trial']:.1f} ms CPU a trial ({mem['pruned']} pruned; "
+            f"CPU share {mem['cpu_share']:.2f})",
+        ]
+        for r in part["in_process_studies"]:
+            lines.append(
+                f"    in process, 1 worker: {r['storage']} {r['trials_per_s_steady']:.1f} "
+                f"trials/s, {1e3 * r['cpu_s_per_trial']:.1f} ms CPU a trial "
+                f"(x{r['cpu_ratio_to_in_memory']:.2f} of memory's CPU; CPU share "
+                f"{r['cpu_share']:.2f})"
+            )
+        for r in part["studies"]:
+            lines.append(
+                f"    {r['storage']:<10} jobs={r['jobs']}: {r['trials_per_s_steady']:5.1f} "
+                f"trials/s steady, {r['trials_per_s_end_to_end']:5.1f} end to end, "
+                f"{1e3 * r['cpu_s_per_trial']:.1f} ms CPU a trial with start-up; "
+                f"x{r['ratio_to_objective']:.2f} of the objective, x{r['ratio_to_in_memory']:.2f}"
+                f" of in-memory ({r['trials']} trials, {r['pruned']} pruned, CPU share "
+                f"{r['cpu_share']:.2f}, load {r['load_before']:.1f}->{r['load_after']:.1f})"
+            )
     return "\n".join(lines)

@@ -27,7 +27,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import linear_sum_assignment
 
 __all__ = ["IDENTITY_CUTOFF_M", "IdentityAssignment", "assign_identities"]
 
@@ -131,6 +130,8 @@ def assign_identities(
             if len(ta) and len(pb):
                 sub = d[np.ix_(ta, pb)]
                 cost = np.where(sub <= cutoff_m, sub, 2.0 * cutoff_m * (len(ta) + len(pb)))
+                from scipy.optimize import linear_sum_assignment  # 0.5 s to import: on use
+
                 rows, cs = linear_sum_assignment(cost)
                 for a, b in zip(ta[rows], pb[cs]):
                     if d[a, b] <= cutoff_m:

@@ -16,7 +16,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import linear_sum_assignment
 
 __all__ = [
     "FAR_DISTANCE_M",
@@ -61,6 +60,8 @@ def ospa(tracks_xy: np.ndarray, truth_xy: np.ndarray, c: float = OSPA_C_M, p: in
     if m == 1:
         cost = float(d.min())
     else:
+        from scipy.optimize import linear_sum_assignment  # 0.5 s to import: on use
+
         rows, cols = linear_sum_assignment(d)
         cost = float(d[rows, cols].sum())
     return float(((cost + c**p * (n - m)) / n) ** (1.0 / p))
@@ -129,6 +130,8 @@ def gospa(
         d = np.linalg.norm(a[:, None, :] - b[None, :, :], axis=2)
         # a pair at or beyond c costs what leaving both unassigned costs: c^p/2 + c^p/2
         cost = np.minimum(d, c) ** p
+        from scipy.optimize import linear_sum_assignment  # 0.5 s to import: on use
+
         ia, ib = linear_sum_assignment(cost)
         ok = d[ia, ib] < c
         loc = float(np.sum(d[ia[ok], ib[ok]] ** p))

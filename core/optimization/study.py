@@ -275,7 +275,13 @@ def trial_seed(seed: int, number: int) -> int:
     return (base + int(number)) % 2**32
 
 
-def _ask_as(study: Any, worker: str, sampler: Callable[[int], Any] | None = None) -> Any:
+def _ask_as(
+    study: Any,
+    worker: str,
+    sampler: Callable[[int], Any] | None = None,
+    *,
+    waiting: bool | None = None,
+) -> Any:
     """``study.ask()`` with the worker recorded in the same storage write that creates the trial.
 
     ``sampler(number)``, if given, becomes ``study.sampler`` for the new trial once its number
@@ -286,11 +292,16 @@ def _ask_as(study: Any, worker: str, sampler: Callable[[int], Any] | None = None
     trial without a worker, which resume could not tell from a live one on another host (seen
     in the SIGKILL test under load). ``create_new_trial`` with a template is the storage API that
     ``ask`` uses itself; ``optuna.Trial`` then runs the sampler's ``before_trial`` as ``ask`` does.
+
+    ``waiting``: whether enqueued (WAITING) trials exist, if the caller read the study just
+    before; None: read it here.
     """
     import optuna
     from optuna.trial import FrozenTrial, TrialState
 
-    if study.get_trials(deepcopy=False, states=(TrialState.WAITING,)):
+    if waiting is None:
+        waiting = bool(study.get_trials(deepcopy=False, states=(TrialState.WAITING,)))
+    if waiting:
         # an enqueued trial runs first (ask pops it); only these keep the two writes
         trial = study.ask()
         trial.set_user_attr("worker", worker)
@@ -389,6 +400,39 @@ def count_trials(study: Any, *, below: int | None = None) -> int:
     return sum(1 for t in trials if t.number < below)
 
 
+class _RungReports:
+    """A trial's reports to the pruner, sent to the storage with the pruner's question.
+
+    ``evaluate`` reports a value and then, at a pruning point, asks ``should_prune``: the
+    report and the pruner's own record (ASHA's rung value) are then written in one phase
+    (:func:`core.optimization.batching.batched`). The pruner judges against the study as read
+    when the trial started (no read per rung): with one worker nothing else changes it in
+    between, so the decisions are the same; with several, other workers' rung values of the
+    last trial's duration (tens of milliseconds) are seen at the next trial.
+    """
+
+    def __init__(self, trial: Any, store: Any) -> None:
+        self.trial = trial
+        self.store = store
+        self.pending: list[tuple[float, int]] = []
+
+    def report(self, value: float, step: int) -> None:
+        self.pending.append((value, step))
+
+    def flush(self) -> None:
+        """Send the pending reports (inside the caller's phase, if any)."""
+        for value, step in self.pending:
+            self.trial.report(value, step)
+        self.pending.clear()
+
+    def should_prune(self) -> bool:
+        from core.optimization.batching import batched
+
+        with batched(self.store, read=False):
+            self.flush()
+            return bool(self.trial.should_prune())
+
+
 def load_dataset_for(attrs: dict[str, Any], dataset_path: str | None) -> Any:
     """The data set a worker tracks: ``dataset_path`` or the study's recorded path."""
     if attrs.get("objective") != "tracker":
@@ -436,6 +480,8 @@ def run_worker(
     import optuna
     from optuna.trial import TrialState
 
+    from core.optimization.batching import batched
+
     optuna.logging.set_verbosity(optuna.logging.WARNING)
     store = open_storage(storage, create=False)
     probe = load_existing_study(store, study_name)
@@ -472,26 +518,43 @@ def run_worker(
     me = worker_id()
     finished = 0
     failures = 0
+    # what the last read of the study showed: occupied slots and enqueued trials
+    occupied = count_trials(study)
+    waiting = bool(study.get_trials(deepcopy=False, states=(TrialState.WAITING,)))
     while not stop():
-        if count_trials(study) >= n_total:
-            # slots held by RUNNING trials of dead workers are freed, then counted again
-            if not fail_stale_trials(study) or count_trials(study) >= n_total:
+        if occupied >= n_total:
+            # near the end: count afresh; slots held by RUNNING trials of dead workers are
+            # freed, then counted again
+            if count_trials(study) >= n_total and (
+                not fail_stale_trials(study) or count_trials(study) >= n_total
+            ):
                 break
-        trial = _ask_as(study, me, sampler_for)
+        trial = _ask_as(study, me, sampler_for, waiting=waiting)
         try:
-            if count_trials(study, below=trial.number) >= n_total:
+            # one read of the study (right after this trial got its number) serves the count
+            # and the sampler; the parameters are written in one transaction
+            with batched(store):
+                trials = study.get_trials(deepcopy=False)
+                occupied = sum(1 for t in trials if t.state.name in _OCCUPYING)
+                waiting = any(t.state == TrialState.WAITING for t in trials)
+                surplus = count_trials(study, below=trial.number) >= n_total
+                if not surplus:
+                    params = tracker_params_dict(suggest_params(trial, model), model)
+            if surplus:
                 trial.set_user_attr("surplus", True)
                 study.tell(trial, state=TrialState.FAIL)
                 break
-            params = tracker_params_dict(suggest_params(trial, model), model)
+            reports = _RungReports(trial, store)
             result = evaluate(
                 losses,
                 params,
-                trial=trial,
+                trial=reports,
                 pruner=attrs["pruner"],
                 prune_steps=prune_steps,
                 loss=str(attrs.get("loss", "paper")),
             )
+            with batched(store, read=False):
+                reports.flush()
         except KeyboardInterrupt:
             study.tell(trial, state=TrialState.FAIL)
             raise
