@@ -246,9 +246,9 @@ def noise_map(s, rd, s2, n_use, n_v):  # pragma: no cover
 
 
 @numba.njit(cache=True, nogil=True)
-def _fft_pow2(a, tw):  # pragma: no cover
-    """In-place radix-2 FFT of ``a`` (length a power of 2); ``tw[k] = exp(-j 2 pi k / n)``."""
-    n = a.shape[0]
+def _bit_reversal(n):  # pragma: no cover
+    """Bit-reversed index of ``0 .. n - 1`` (``n`` a power of 2): the radix-2 FFT's input order."""
+    rev = np.zeros(n, dtype=np.int64)
     j = 0
     for i in range(1, n):
         bit = n >> 1
@@ -256,19 +256,34 @@ def _fft_pow2(a, tw):  # pragma: no cover
             j ^= bit
             bit >>= 1
         j |= bit
-        if i < j:
-            a[i], a[j] = a[j], a[i]
+        rev[i] = j
+    return rev
+
+
+@numba.njit(cache=True, nogil=True)
+def _fft2_pow2(x, x1, w, rev, tw, a, a1):  # pragma: no cover
+    """Radix-2 FFTs of ``w x`` into ``a`` and of ``w x1`` into ``a1`` (length a power of 2, both
+    at once: same order, same twiddles ``tw[k] = exp(-j 2 pi k / n)``)."""
+    n = a.shape[0]
+    for t in range(n):
+        a[rev[t]] = w[t] * x[t]
+        a1[rev[t]] = w[t] * x1[t]
     size = 2
     while size <= n:
         half = size // 2
         step = n // size
         for first in range(0, n, size):
             for k in range(half):
+                tk = tw[k * step]
                 # butterfly: (u, v w) -> (u + v w, u - v w)
-                v = a[first + k + half] * tw[k * step]
+                v = a[first + k + half] * tk
                 u = a[first + k]
                 a[first + k] = u + v
                 a[first + k + half] = u - v
+                v1 = a1[first + k + half] * tk
+                u1 = a1[first + k]
+                a1[first + k] = u1 + v1
+                a1[first + k + half] = u1 - v1
         size *= 2
 
 
@@ -377,18 +392,15 @@ def patches_kernel(
     ws = np.empty(m, dtype=np.complex128)
     ws1 = np.empty(m, dtype=np.complex128)
     radix2 = tw_d.shape[0] == 1
+    rev = _bit_reversal(m) if radix2 else np.zeros(0, dtype=np.int64)
     for i in range(n_s):
         for sl in range(n_tx):
-            for t in range(m):
-                ws[t] = wd[t] * slow[i, sl, t]
-                ws1[t] = wd[t] * slow1[i, sl, t]
             if radix2:
-                _fft_pow2(ws, tw_d[0])
-                _fft_pow2(ws1, tw_d[0])
-                for d in range(m):
-                    dd[i, sl, d] = ws[d]
-                    dd1[i, sl, d] = ws1[d]
+                _fft2_pow2(slow[i, sl], slow1[i, sl], wd, rev, tw_d[0], dd[i, sl], dd1[i, sl])
             else:
+                for t in range(m):
+                    ws[t] = wd[t] * slow[i, sl, t]
+                    ws1[t] = wd[t] * slow1[i, sl, t]
                 for d in range(m):
                     acc = 0.0 + 0.0j
                     acc1 = 0.0 + 0.0j
@@ -410,50 +422,78 @@ def patches_kernel(
         s2_min = min(s2_min, s2[d])
     lim_min = threshold * s2_min
     floor_min = 1e-6 * s2_min
-    # per range bin, the scatterers that can reach -60 dB of the noise in some Doppler bin
-    # (pr pd[d] + pr1 pd1[d] <= pr max pd + pr1 max pd1): a list per bin, cand[cand_at[k]:...]
-    cand_at = np.zeros(k_max + 1, dtype=np.int64)
-    cand = np.empty(k_max * n_s, dtype=np.int64)
-    n_cand = 0
-    for k in range(k_max):
-        for i in range(n_s):
-            if pr[i, k] * pd_max[i] + pr1[i, k] * pd1_max[i] >= floor_min:
-                cand[n_cand] = i
-                n_cand += 1
-        cand_at[k + 1] = n_cand
+    lim = np.empty(m)
+    for d in range(m):
+        lim[d] = threshold * s2[d]
+    # patch cells: (k, d) where some scatterer's pr pd[d] + pr1 pd1[d] > lim[d]; a scatterer is
+    # looked at in the range bins where its bound over Doppler (pr max pd + pr1 max pd1) is above
+    # the smallest limit
+    mask = np.zeros((k_max, m), dtype=np.bool_)
+    row = np.zeros(k_max, dtype=np.bool_)
+    bound = np.empty(k_max)
+    for i in range(n_s):
+        for k in range(k_max):
+            bound[k] = pr[i, k] * pd_max[i] + pr1[i, k] * pd1_max[i]
+        for k in range(k_max):
+            if bound[k] <= lim_min:
+                continue
+            a0 = pr[i, k]
+            a1 = pr1[i, k]
+            hit = False
+            for d in range(m):
+                h = a0 * pd[i, d] + a1 * pd1[i, d] > lim[d]
+                mask[k, d] |= h
+                hit |= h
+            row[k] |= hit
     cells_k = np.empty(k_max * m, dtype=np.int64)
     cells_d = np.empty(k_max * m, dtype=np.int64)
     n_c = 0
     for k in range(k_max):
-        # skip the range bin when no scatterer can reach the smallest limit in any Doppler bin
-        maybe = False
-        for j in range(cand_at[k], cand_at[k + 1]):
-            i = cand[j]
-            if pr[i, k] * pd_max[i] + pr1[i, k] * pd1_max[i] > lim_min:
-                maybe = True
-                break
-        if not maybe:
+        if not row[k]:
             continue
         for d in range(m):
-            lim = threshold * s2[d]
-            for j in range(cand_at[k], cand_at[k + 1]):
-                i = cand[j]
-                if pr[i, k] * pd[i, d] + pr1[i, k] * pd1[i, d] > lim:
-                    cells_k[n_c] = k
-                    cells_d[n_c] = d
-                    n_c += 1
-                    break
-    x = np.zeros((n_c, n_v), dtype=np.complex128)
+            if mask[k, d]:
+                cells_k[n_c] = k
+                cells_d[n_c] = d
+                n_c += 1
+    x = np.empty((n_c, n_v), dtype=np.complex128)
     along = np.zeros(n_c, dtype=np.complex128)
     ortho = np.zeros(n_c)
-    st_re = np.empty((n_s, n_v))
-    st_im = np.empty((n_s, n_v))
+    # the patch cells of range bin k are cells row_at[k]:row_at[k + 1] (sorted by range bin)
+    row_at = np.zeros(k_max + 1, dtype=np.int64)
+    for c in range(n_c):
+        row_at[cells_k[c] + 1] += 1
+    for k in range(k_max):
+        row_at[k + 1] += row_at[k]
+    # the sums, scatterer by scatterer (each cell still adds its scatterers in index order), over
+    # the range bins where its bound reaches -60 dB of the noise
+    x_re = np.zeros((n_c, n_v))
+    x_im = np.zeros((n_c, n_v))
+    a_re = np.empty(n_v)
+    a_im = np.empty(n_v)
     for i in range(n_s):
         for v in range(n_v):
-            st_re[i, v] = steer[i, v].real
-            st_im[i, v] = steer[i, v].imag
-    x_re = np.empty(n_v)
-    x_im = np.empty(n_v)
+            a_re[v] = steer[i, v].real
+            a_im[v] = steer[i, v].imag
+        for k in range(k_max):
+            if row_at[k] == row_at[k + 1]:
+                continue
+            if pr[i, k] * pd_max[i] + pr1[i, k] * pd1_max[i] < floor_min:
+                continue
+            r0 = rr[i, k]
+            r1 = rr1[i, k]
+            for c in range(row_at[k], row_at[k + 1]):
+                d = cells_d[c]
+                if pr[i, k] * pd[i, d] + pr1[i, k] * pd1[i, d] < 1e-6 * s2[d]:
+                    continue  # below -60 dB of the noise: nothing to add
+                for sl in range(n_tx):
+                    # first order in the beat tone's drift: g = R D + R1 D1
+                    g = r0 * dd[i, sl, d] + r1 * dd1[i, sl, d]
+                    for r in range(n_rx):
+                        # X[c, v] = sum_i A_i R_i[k] D_i[slot(v), d] a_i[v],  v = slot n_rx + rx
+                        v = sl * n_rx + r
+                        x_re[c, v] += g.real * a_re[v] - g.imag * a_im[v]
+                        x_im[c, v] += g.real * a_im[v] + g.imag * a_re[v]
     # Marsaglia-Tsang constants of Gamma(L - 1)
     dk = n_v - 1.0 - 1.0 / 3.0
     ck = 1.0 / np.sqrt(9.0 * dk)
@@ -461,26 +501,10 @@ def patches_kernel(
     for c in range(n_c):
         k = cells_k[c]
         d = cells_d[c]
-        x_re[:] = 0.0
-        x_im[:] = 0.0
-        for j in range(cand_at[k], cand_at[k + 1]):
-            i = cand[j]
-            if pr[i, k] * pd[i, d] + pr1[i, k] * pd1[i, d] < 1e-6 * s2[d]:
-                continue  # below -60 dB of the noise: nothing to add
-            r0 = rr[i, k]
-            r1 = rr1[i, k]
-            for sl in range(n_tx):
-                # first order in the beat tone's drift: g = R D + R1 D1
-                g = r0 * dd[i, sl, d] + r1 * dd1[i, sl, d]
-                for r in range(n_rx):
-                    # X[c, v] = sum_i A_i R_i[k] D_i[slot(v), d] a_i[v],  v = slot n_rx + rx
-                    v = sl * n_rx + r
-                    x_re[v] += g.real * st_re[i, v] - g.imag * st_im[i, v]
-                    x_im[v] += g.real * st_im[i, v] + g.imag * st_re[i, v]
         norm2 = 0.0
         for v in range(n_v):
-            x[c, v] = complex(x_re[v], x_im[v])
-            norm2 += x_re[v] * x_re[v] + x_im[v] * x_im[v]
+            x[c, v] = complex(x_re[c, v], x_im[c, v])
+            norm2 += x_re[c, v] * x_re[c, v] + x_im[c, v] * x_im[c, v]
         if noise:
             sd = np.sqrt(s2[d] / 2)
             re, s0, s1, s2_, s3 = normal_l(s0, s1, s2_, s3)
