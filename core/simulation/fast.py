@@ -118,7 +118,7 @@ from core.simulation.fast_model import (
     slow_time_sequences,
     twiddles,
 )
-from core.simulation.frame import FrameOutput, needs_elevation
+from core.simulation.frame import FrameOutput
 from core.simulation.link import received_power_w, signal_amplitude_v
 from core.simulation.rng_kernels import (
     fill_normal,
@@ -694,7 +694,10 @@ def _frames_fast(
     elif not radar.has_elevation:
         elev = np.zeros(n_f, dtype=bool)
     else:
-        elev = np.fromiter((needs_elevation(radar, s) for s in frames), dtype=bool, count=n_f)
+        # needs_elevation per frame: some scatterer of the frame off the plane z = 0
+        off = (every.position_m[:, 2] != 0) | (every.velocity_mps[:, 2] != 0)
+        n_off = np.concatenate(([0], np.cumsum(off)))
+        elev = n_off[start[1:]] > n_off[start[:-1]]
     cfar = cfar_arguments(radar, settings, n_v, n_r, n_d, True)
     has_cfar = cfar is not None  # None: no range bin inside the limits, nothing is tested
     states = np.zeros((n_f, 6), dtype=np.uint64)  # core.simulation.gaussian's six words

@@ -466,9 +466,9 @@ def patches_kernel(
     for k in range(k_max):
         row_at[k + 1] += row_at[k]
     # the sums, scatterer by scatterer (each cell still adds its scatterers in index order), over
-    # the range bins where its bound reaches -60 dB of the noise
-    x_re = np.zeros((n_c, n_v))
-    x_im = np.zeros((n_c, n_v))
+    # the range bins where its bound reaches -60 dB of the noise; x_re[c n_v + v]
+    x_re = np.zeros(n_c * n_v)
+    x_im = np.zeros(n_c * n_v)
     a_re = np.empty(n_v)
     a_im = np.empty(n_v)
     for i in range(n_s):
@@ -476,24 +476,34 @@ def patches_kernel(
             a_re[v] = steer[i, v].real
             a_im[v] = steer[i, v].imag
         for k in range(k_max):
-            if row_at[k] == row_at[k + 1]:
+            c_lo = row_at[k]
+            c_hi = row_at[k + 1]
+            if c_lo == c_hi:
                 continue
-            if pr[i, k] * pd_max[i] + pr1[i, k] * pd1_max[i] < floor_min:
+            p0 = pr[i, k]
+            p1 = pr1[i, k]
+            if p0 * pd_max[i] + p1 * pd1_max[i] < floor_min:
                 continue
-            r0 = rr[i, k]
-            r1 = rr1[i, k]
-            for c in range(row_at[k], row_at[k + 1]):
+            r0r = rr[i, k].real
+            r0i = rr[i, k].imag
+            r1r = rr1[i, k].real
+            r1i = rr1[i, k].imag
+            for c in range(c_lo, c_hi):
                 d = cells_d[c]
-                if pr[i, k] * pd[i, d] + pr1[i, k] * pd1[i, d] < 1e-6 * s2[d]:
+                if p0 * pd[i, d] + p1 * pd1[i, d] < 1e-6 * s2[d]:
                     continue  # below -60 dB of the noise: nothing to add
+                base = c * n_v
                 for sl in range(n_tx):
                     # first order in the beat tone's drift: g = R D + R1 D1
-                    g = r0 * dd[i, sl, d] + r1 * dd1[i, sl, d]
+                    u0 = dd[i, sl, d]
+                    u1 = dd1[i, sl, d]
+                    gr = (r0r * u0.real - r0i * u0.imag) + (r1r * u1.real - r1i * u1.imag)
+                    gi = (r0r * u0.imag + r0i * u0.real) + (r1r * u1.imag + r1i * u1.real)
+                    v0 = sl * n_rx
                     for r in range(n_rx):
                         # X[c, v] = sum_i A_i R_i[k] D_i[slot(v), d] a_i[v],  v = slot n_rx + rx
-                        v = sl * n_rx + r
-                        x_re[c, v] += g.real * a_re[v] - g.imag * a_im[v]
-                        x_im[c, v] += g.real * a_im[v] + g.imag * a_re[v]
+                        x_re[base + v0 + r] += gr * a_re[v0 + r] - gi * a_im[v0 + r]
+                        x_im[base + v0 + r] += gr * a_im[v0 + r] + gi * a_re[v0 + r]
     # Marsaglia-Tsang constants of Gamma(L - 1)
     dk = n_v - 1.0 - 1.0 / 3.0
     ck = 1.0 / np.sqrt(9.0 * dk)
@@ -503,8 +513,8 @@ def patches_kernel(
         d = cells_d[c]
         norm2 = 0.0
         for v in range(n_v):
-            x[c, v] = complex(x_re[c, v], x_im[c, v])
-            norm2 += x_re[c, v] * x_re[c, v] + x_im[c, v] * x_im[c, v]
+            x[c, v] = complex(x_re[c * n_v + v], x_im[c * n_v + v])
+            norm2 += x_re[c * n_v + v] ** 2 + x_im[c * n_v + v] ** 2
         if noise:
             sd = np.sqrt(s2[d] / 2)
             re, s0, s1, s2_, s3 = normal_l(s0, s1, s2_, s3)
