@@ -195,7 +195,7 @@ def _slow_time_kernel(
         z = np.cos(phi) + 1j * np.sin(phi)
         y[i, 0, 0] = z
         y1[i, 0, 0] = delta * z
-        step = (r_c[n_ch - 1] - r_c[0]) / (n_ch - 1)
+        step = (r_c[n_ch - 1] - r_c[0]) / max(n_ch - 1, 1)  # one chirp: no step
         rot = np.cos(k_all * step) + 1j * np.sin(k_all * step)
         for c in range(1, n_ch):
             # phi_c - phi_(c-1) = K step + eps_c
