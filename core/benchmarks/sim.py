@@ -19,7 +19,8 @@ The walking-body case (:func:`walking_case`): the same class-a walk with the pap
 (0.02 m^-2), once with the walking body (17 segments at their heights, elevation processed) and
 once with the point person, the frames built by the pipeline's reflector stage; the exact
 chain runs both interleaved in blocks (frames/s and their ratio in the same run), and the fast
-level runs the walking frames in one batch (its frames/s against the exact chain's).
+level runs the walking frames in one batch before each of the exact chain's passes (its frames/s
+against the exact chain's, the same load for both).
 """
 
 from __future__ import annotations
@@ -302,7 +303,13 @@ def walking_case(quick: bool = False) -> dict:
     block = 10
     spent = {"walking": [0.0, 0.0, 0], "point": [0.0, 0.0, 0]}
     pts = {"walking": [], "point": []}
+    rngs = [np.random.default_rng(100 + i) for i in range(n)]
+    t_fast = c_fast = 0.0
     for _ in range(reps):
+        # the fast level's batch between the exact chain's passes (the same load for both)
+        t0, c0 = time.perf_counter(), time.process_time()
+        simulate_frames_fast(radar, walk[:n], rngs, antenna=antenna, settings=settings)
+        t_fast, c_fast = t_fast + time.perf_counter() - t0, c_fast + time.process_time() - c0
         for b in range(0, n, block):
             for name, frames, rng in (("walking", walk, rng_w), ("point", point, rng_p)):
                 t, c, out = _time_frames(
@@ -315,11 +322,6 @@ def walking_case(quick: bool = False) -> dict:
                 spent[name][1] += c
                 spent[name][2] += len(out)
                 pts[name] += [int(np.sum(o.point_cloud.source == 0)) for o in out]
-    rngs = [np.random.default_rng(100 + i) for i in range(n)]
-    t0, c0 = time.perf_counter(), time.process_time()
-    for _ in range(reps):
-        simulate_frames_fast(radar, walk[:n], rngs, antenna=antenna, settings=settings)
-    t_fast, c_fast = time.perf_counter() - t0, time.process_time() - c0
     fps = {k: v[2] / v[0] for k, v in spent.items()}
     fps_cpu = {k: v[2] / v[1] for k, v in spent.items()}
     fast_fps = reps * n / t_fast
@@ -407,7 +409,7 @@ def _fast_stage_profile(
             a, b = start[f], start[f + 1]
             patches_kernel(
                 states[f], rd, amp[a:b], theta[a:b], slow[a:b], slow1[a:b], spec.wd, spec.b,
-                spec.s2, steer[a:b], spec.slot, spec.threshold, spec.tw_r, spec.tw_d, True,
+                spec.s2, steer[a:b], spec.slot, spec.threshold, spec.half_r, spec.tw_d, True,
                 spec.n_use,
             )  # fmt: skip
         c4 = time.process_time()
@@ -470,6 +472,13 @@ def _load() -> float | None:
 
 
 def _time_dataset(quick: bool) -> dict | None:
+    """Generation time of the paper data set (seed 0), uncached, one process.
+
+    The point person at the exact level first (the top-level figures, as before), then both
+    person models (``point``, ``walking``) at the ``exact`` and ``fast`` levels, each once in
+    this process (wall clock and process CPU time): issue 13's "data-set generation time for the
+    35 trajectories reported for both models". ``quick``: 2 trajectories.
+    """
     try:
         from core.pipeline import paper_dataset
     except ImportError:
@@ -477,16 +486,42 @@ def _time_dataset(quick: bool) -> dict | None:
     import tempfile
 
     n_traj = 2 if quick else 35
-    with tempfile.TemporaryDirectory() as tmp:
-        t0 = time.perf_counter()
-        ds = paper_dataset(0, n_traj, cache_dir=tmp, jobs=1)
-        seconds = time.perf_counter() - t0
-    n_frames = len(ds.trajectory) if hasattr(ds, "trajectory") else None
-    out = {"trajectories": n_traj, "seconds": seconds, "jobs": 1}
-    if n_frames:
-        out["frames"] = int(n_frames)
-        out["frames_per_s"] = n_frames / seconds
-    return out
+    paper_dataset(0, 1, cache_dir=None, jobs=1, use_cache=False)  # warm up
+    runs = {}
+    for model in ("point", "walking"):
+        for fidelity in ("exact", "fast"):
+            with tempfile.TemporaryDirectory() as tmp:
+                t0, c0 = time.perf_counter(), time.process_time()
+                ds = paper_dataset(
+                    0,
+                    n_traj,
+                    fidelity=fidelity,
+                    person_model=model,
+                    cache_dir=tmp,
+                    jobs=1,
+                    use_cache=False,
+                )
+                seconds, cpu = time.perf_counter() - t0, time.process_time() - c0
+            n_frames = int(ds.n_frames)
+            runs.setdefault(model, {})[fidelity] = {
+                "seconds": seconds,
+                "cpu_s": cpu,
+                "frames": n_frames,
+                "frames_per_s": n_frames / seconds,
+                "frames_per_s_cpu": n_frames / cpu,
+            }
+    for levels in runs.values():
+        levels["fast_over_exact_cpu"] = levels["exact"]["cpu_s"] / levels["fast"]["cpu_s"]
+    first = runs["point"]["exact"]
+    return {
+        "trajectories": n_traj,
+        "seconds": first["seconds"],
+        "jobs": 1,
+        "frames": first["frames"],
+        "frames_per_s": first["frames_per_s"],
+        "models": runs,
+        "load_average_1min": _load(),
+    }
 
 
 def summary(result: dict) -> str:
@@ -532,6 +567,15 @@ def summary(result: dict) -> str:
             f"{ds['seconds']:.1f} s"
             + (f", {ds['frames_per_s']:.0f} frames/s" if "frames_per_s" in ds else "")
         )
+        for model, levels in ds.get("models", {}).items():
+            lines.append(
+                f"    {model:8s}: "
+                + ", ".join(
+                    f"{lv} {levels[lv]['seconds']:.1f} s (CPU {levels[lv]['cpu_s']:.1f} s)"
+                    for lv in ("exact", "fast")
+                )
+                + f"; fast/exact by CPU {levels['fast_over_exact_cpu']:.1f}x"
+            )
     elif ds is None:
         lines.append("  paper data set: core.pipeline.paper_dataset not importable, skipped")
     return "\n".join(lines)

@@ -118,7 +118,7 @@ from core.simulation.fast_model import (
     slow_time_sequences,
     twiddles,
 )
-from core.simulation.frame import FrameOutput, needs_elevation
+from core.simulation.frame import FrameOutput
 from core.simulation.link import received_power_w, signal_amplitude_v
 from core.simulation.rng_kernels import (
     fill_normal,
@@ -493,7 +493,7 @@ class SpectrumTables(NamedTuple):
     s2: np.ndarray  # (n_d,) per-channel cell noise power, V²
     slot: np.ndarray  # (L,) TX slot of each virtual channel
     threshold: float  # patch threshold relative to s2 (PATCH_THRESHOLD)
-    tw_r: np.ndarray  # (n_r,) range twiddles
+    half_r: np.ndarray  # (2 n_r,) exp(j pi u / n_r): the range responses' half angles
     tw_d: np.ndarray  # Doppler twiddles (see twiddles)
 
 
@@ -518,7 +518,7 @@ def spectrum_tables(
 ) -> SpectrumTables:
     """The :class:`SpectrumTables` of a radar and settings."""
     n_r, n_d, n_v = radar.n_samples, radar.n_loops, radar.n_virtual
-    tw_r, tw_d = twiddles(n_r, n_d)
+    half_r, tw_d = twiddles(n_r, n_d)
     return SpectrumTables(
         n_use=n_r if keep_rd_map else max(0, min(n_r, cfar_range_bins(radar, settings))),
         n_v=n_v,
@@ -527,7 +527,7 @@ def spectrum_tables(
         s2=cell_noise_power_v2(radar, settings),
         slot=np.arange(n_v) // radar.n_rx,
         threshold=PATCH_THRESHOLD,
-        tw_r=tw_r,
+        half_r=half_r,
         tw_d=tw_d,
     )
 
@@ -579,7 +579,7 @@ def _frame_kernel(
     """
     cells_k, cells_d, x, along, ortho = patches_kernel(
         s, rd, amp, theta, slow, slow1, spec.wd, spec.b, spec.s2, steer, spec.slot,
-        spec.threshold, spec.tw_r, spec.tw_d, noise, spec.n_use,
+        spec.threshold, spec.half_r, spec.tw_d, noise, spec.n_use,
     )  # fmt: skip
     if has_cfar:
         r, d, nz = two_stage_kernel(rd, cfar)
@@ -694,7 +694,10 @@ def _frames_fast(
     elif not radar.has_elevation:
         elev = np.zeros(n_f, dtype=bool)
     else:
-        elev = np.fromiter((needs_elevation(radar, s) for s in frames), dtype=bool, count=n_f)
+        # needs_elevation per frame: some scatterer of the frame off the plane z = 0
+        off = (every.position_m[:, 2] != 0) | (every.velocity_mps[:, 2] != 0)
+        n_off = np.concatenate(([0], np.cumsum(off)))
+        elev = n_off[start[1:]] > n_off[start[:-1]]
     cfar = cfar_arguments(radar, settings, n_v, n_r, n_d, True)
     has_cfar = cfar is not None  # None: no range bin inside the limits, nothing is tested
     states = np.zeros((n_f, 6), dtype=np.uint64)  # core.simulation.gaussian's six words
