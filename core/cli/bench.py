@@ -21,7 +21,7 @@ BENCHMARKS = ("sim", "track", "tune", "fidelity", "dataset", "false_alarms", "cv
 MODULES = {"import": "import_"}
 #: not part of ``all``: hours of studies (16 x 1000 trials); person clouds (a calibration, not
 #: a speed figure); the desktop app (needs Qt)
-LONG = ("cvca_seeds", "clouds", "gui")
+LONG = ("cvca_seeds", "clouds", "gui", "campaign")
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
@@ -38,7 +38,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--render-only",
         action="store_true",
-        help="fidelity, clouds: re-write the tables and plots from <out-dir>/<name>.json, no run",
+        help="fidelity, clouds, campaign: re-write the tables and plots from "
+        "<out-dir>/<name>.json, no run",
     )
     for model in ("cv", "ca"):
         p.add_argument(
@@ -88,10 +89,14 @@ def _render_only(args: argparse.Namespace) -> int:
 
     from core.errors import InputError
 
-    if args.name not in ("fidelity", "clouds"):
-        raise InputError(f"--render-only is for fidelity and clouds only, not {args.name!r}")
+    if args.name not in ("fidelity", "clouds", "campaign"):
+        raise InputError(
+            f"--render-only is for fidelity, clouds and campaign only, not {args.name!r}"
+        )
     if args.name == "fidelity":
         from core.benchmarks.fidelity_report import render, summary
+    elif args.name == "campaign":
+        from core.benchmarks.campaign import render, summary  # type: ignore[assignment]
     else:
         from core.benchmarks.clouds import render, summary  # type: ignore[assignment]
 
