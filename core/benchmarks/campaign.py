@@ -561,9 +561,10 @@ def _plots(result: dict[str, Any], out: Path) -> list[Path]:
             ps = np.array(t[o][m]["per_study_median"]) * 1e3
             a1.scatter(np.full(len(ps), k + dx + 0.08), ps, s=8, color=colours[m], alpha=0.5)
         fs = sorted((*RHO_FACTORS, 1.0))
-        for o, ls in zip(objs, ("-", "--", ":", "-.", "-"), strict=False):
-            a2.plot(fs, [t[o][m]["rho"][str(v)]["median"] * 1e3 for v in fs], ls,
-                    color=colours[m], marker=".", label=f"{m.upper()} {o}")  # fmt: skip
+        for k, o in enumerate(objs):
+            a2.plot(fs, [t[o][m]["rho"][str(v)]["median"] * 1e3 for v in fs],
+                    "-" if m == "cv" else "--", color=f"C{k + 2}", marker=".",
+                    label=f"{m.upper()} {o}")  # fmt: skip
     a1.set_xticks(xo, objs)
     a1.set_yscale("log")
     a1.set_ylabel("held-out median L_t (m² ×10⁻³)")
@@ -572,6 +573,8 @@ def _plots(result: dict[str, Any], out: Path) -> list[Path]:
     a1.legend(fontsize=7)
     a2.set_xscale("log")
     a2.set_yscale("log")
+    a2.set_xticks(sorted((*RHO_FACTORS, 1.0)), [f"×{v:g}" for v in sorted((*RHO_FACTORS, 1.0))])
+    a2.minorticks_off()
     a2.set_xlabel("tracker clutter density ρ / tuned ρ")
     a2.set_ylabel("median L_t (m² ×10⁻³)")
     a2.set_title("Robustness to ρ (test sets, each study's choice)", fontsize=9)
