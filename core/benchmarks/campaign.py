@@ -465,7 +465,11 @@ def render(result: dict[str, Any], quick: bool = False) -> list[Path]:
     text = (
         "<!-- written by `radartune bench campaign` (core/benchmarks/campaign.py); "
         "do not edit -->\n"
-        "Design: [evaluation-07](../decisions/evaluation-07-cv-ca-design.md). L in m² ×10⁻³.\n\n"
+        "Design: [evaluation-07](../decisions/evaluation-07-cv-ca-design.md). L in m² ×10⁻³. "
+        f"Objectives: {len(result['settings']['compare_seeds'])} studies of "
+        f"{result['settings']['compare_trials']} trials per objective and model; Table I: "
+        f"{len(result['settings']['final_seeds'])} studies of "
+        f"{result['settings']['final_trials']} trials per model.\n\n"
         "## Objectives on the test sets\n\n" + objective_table(result) + "\n\n"
         f"Winner by the rule: **{result['objectives']['choice']['winner']}**.\n\n"
         "## Table I\n\n" + table_one(result) + "\n\n"
@@ -514,8 +518,10 @@ def _plots(result: dict[str, Any], out: Path) -> list[Path]:
     ax.set_ylabel("L_t (m² ×10⁻³)")
     r = f["ratios"]["total"]
     ax.set_title(
-        f"Each study's choice on each test set (dots; bar: median over studies); band: two-level "
-        f"95 % interval of the median\nCV/CA ratio of medians {r['median_ratio']:.3f} "
+        f"Each study's choice on each test set ({len(result['settings']['final_seeds'])} studies "
+        f"of {result['settings']['final_trials']} trials per model; dots; bar: median over "
+        f"studies)\nband: two-level 95 % interval of the median; CV/CA ratio of medians "
+        f"{r['median_ratio']:.3f} "
         f"[{r['median_ratio_lo']:.3f}, {r['median_ratio_hi']:.3f}]: {f['verdict']}",
         fontsize=9,
     )
@@ -538,8 +544,12 @@ def _plots(result: dict[str, Any], out: Path) -> list[Path]:
                     ecolor="k", capsize=3, lw=1)  # fmt: skip
     ax.set_xticks(xc, [c if c == "total" else f"class {c}" for c in cols])
     ax.set_ylabel("median L (m² ×10⁻³)")
-    ax.set_title("Table I on the walking-body test sets: median over (study, test set) cells, "
-                 "two-level 95 % interval", fontsize=9)  # fmt: skip
+    ax.set_title(
+        "Table I on the walking-body test sets: median over (study, test set) cells, two-level "
+        f"95 % interval\n({len(result['settings']['final_seeds'])} studies of "
+        f"{result['settings']['final_trials']} trials per model)",
+        fontsize=9,
+    )
     ax.legend(fontsize=8)
     p = out / "table1.png"
     fig.savefig(p, dpi=110)
