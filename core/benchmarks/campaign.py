@@ -63,8 +63,7 @@ class Settings:
     compare_seeds: tuple[int, ...] = (0, 1, 2, 3)
     compare_trials: int = 300
     final_seeds: tuple[int, ...] = tuple(range(8))
-    # evaluation-07 pre-registered 1000; its "Departures" section says why 500 (machine load)
-    final_trials: int = 500
+    final_trials: int = 1000  # evaluation-07 (a 500-trial run: bench/results/campaign-500trials)
     n_test: int = 20
     n_trajectories: int = 35
     parallel: int = 2  # studies at a time
