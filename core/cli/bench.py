@@ -21,8 +21,10 @@ BENCHMARKS = ("sim", "track", "tune", "fidelity", "dataset", "false_alarms", "cv
 MODULES = {"import": "import_"}
 #: not part of ``all``: hours of studies (16 x 1000 trials); person clouds (a calibration, not
 #: a speed figure); the desktop app (needs Qt); held-out loss against run time per sampler
-#: (30 studies)
-LONG = ("cvca_seeds", "clouds", "gui", "samplers")
+#: (60 studies); the objective comparison and the CV-against-CA design (hours of studies)
+LONG = ("cvca_seeds", "clouds", "gui", "samplers", "campaign")
+#: benchmarks whose tables and plots ``--render-only`` re-writes from their stored JSON
+RENDERABLE = ("fidelity", "clouds", "samplers", "campaign")
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
@@ -40,7 +42,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--render-only",
         action="store_true",
-        help="fidelity, clouds, samplers: re-write the tables and plots from "
+        help="fidelity, clouds, samplers, campaign: re-write the tables and plots from "
         "<out-dir>/<name>.json, no run",
     )
     for model in ("cv", "ca"):
@@ -86,17 +88,17 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _render_only(args: argparse.Namespace) -> int:
-    """``--render-only``: the fidelity or clouds report re-rendered from a stored result."""
+    """``--render-only``: a benchmark's tables and plots re-rendered from its stored result."""
     import json
 
     from core.errors import InputError
 
-    if args.name not in ("fidelity", "clouds", "samplers"):
-        raise InputError(
-            f"--render-only is for fidelity, clouds and samplers only, not {args.name!r}"
-        )
+    if args.name not in RENDERABLE:
+        raise InputError(f"--render-only is for {', '.join(RENDERABLE)} only, not {args.name!r}")
     if args.name == "fidelity":
         from core.benchmarks.fidelity_report import render, summary
+    elif args.name == "campaign":
+        from core.benchmarks.campaign import render, summary  # type: ignore[assignment]
     elif args.name == "clouds":
         from core.benchmarks.clouds import render, summary  # type: ignore[assignment]
     else:

@@ -73,9 +73,10 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     )
     p.add_argument(
         "--loss",
-        default="paper",
-        help="what trials minimise: paper (L_t, eq. 14), capped, median or trimmed "
-        "(docs/tuning.md; the paper's L_t is always recorded; default: %(default)s)",
+        default=None,
+        help="what trials minimise: trimmed (default for a new study: L_t without the largest "
+        "10 %% of the trajectory losses), paper (L_t, eq. 14), capped or median (docs/tuning.md; "
+        "the paper's L_t is always recorded; a resumed study keeps its own)",
     )
     p.add_argument(
         "--validation",
@@ -157,6 +158,8 @@ def run(args: argparse.Namespace) -> int:
     top_k = TOP_K if args.top_k is None else args.top_k
     if top_k < 1:
         raise InputError(f"--top-k must be >= 1, got {top_k}")
+    if args.loss is None:
+        args.loss = _default_loss(args)
     check_objective(args.loss)
     base = StudySettings(
         model=args.model,
@@ -244,6 +247,26 @@ def run(args: argparse.Namespace) -> int:
             out["validation_value"] = win["validation_value"]
     print(json.dumps(out))
     return EXIT_OK
+
+
+def _default_loss(args: argparse.Namespace) -> str:
+    """The objective when ``--loss`` is not given: a study being resumed keeps its own (one made
+    before robust objectives existed: the paper's); a new study gets
+    :data:`core.evaluation.robust.DEFAULT_OBJECTIVE`."""
+    from core.evaluation.robust import DEFAULT_OBJECTIVE
+    from core.optimization.storage import load_existing_study, open_storage
+
+    name = args.study or f"radartune-{args.model}"
+    if args.repeats > 1:
+        name = f"{name}-r0"
+    try:
+        store = open_storage(args.storage, create=False)
+    except InputError:
+        return DEFAULT_OBJECTIVE  # no storage yet: a new study
+    study = load_existing_study(store, name)
+    if study is None:
+        return DEFAULT_OBJECTIVE
+    return str(study.user_attrs.get("loss", "paper"))
 
 
 def _repeat(base: StudySettings, i: int, n: int, *, dataset: str | None) -> StudySettings:

@@ -37,6 +37,7 @@ __all__ = [
     "rate_ratio_interval",
     "regular_loss",
     "split_tail",
+    "two_level_bootstrap",
     "verdict",
 ]
 
@@ -113,6 +114,54 @@ def bootstrap_interval(
     with np.errstate(invalid="ignore", divide="ignore"):
         value = float(statistic(*xs))
         boot = np.asarray(statistic(*(x[idx] for x in xs)), float)
+    boot = boot[np.isfinite(boot)]
+    lo, hi = np.percentile(boot, [2.5, 97.5]) if len(boot) else (np.nan, np.nan)
+    return value, float(lo), float(hi)
+
+
+def two_level_bootstrap(
+    statistic: Callable[..., np.ndarray],
+    *samples: np.ndarray,
+    n_boot: int = N_BOOTSTRAP,
+    seed: int = 0,
+) -> tuple[float, float, float]:
+    """A statistic of paired (study, test set) matrices with a two-level bootstrap interval.
+
+    Each resample draws the test sets with replacement (T of T), then the studies with
+    replacement (S of S), and takes every matrix at those rows and columns: the spread between
+    studies (e.g. optimiser seeds) and between data sets both enter the interval
+    (docs/decisions/evaluation-07). The test-set draw comes first from the same generator as
+    :func:`bootstrap_interval`, so with one study (S = 1) both give the same interval.
+
+    Parameters
+    ----------
+    statistic
+        ``statistic(*arrays)`` → value; called once on the ``(S, T)`` matrices and once on the
+        ``(n_boot, S, T)`` resamples, where it must reduce the last two axes (``(n_boot,)``), as
+        ``lambda x: np.median(x, axis=(-2, -1))`` does.
+    samples
+        ``(S, T)`` each (studies, test sets), paired: the same rows are the same study index and
+        the same columns the same test set in every sample (e.g. CV's and CA's per-set L_t).
+
+    Returns
+    -------
+    value, lo, hi
+        The statistic and its 2.5 / 97.5 % percentiles over the resamples (non-finite values
+        left out; NaN when none is finite).
+    """
+    xs = [np.asarray(x, float) for x in samples]
+    if not xs or xs[0].ndim != 2 or xs[0].size == 0 or any(x.shape != xs[0].shape for x in xs):
+        raise ValueError(
+            f"samples must be non-empty (S, T) matrices of one shape, got {[x.shape for x in xs]}"
+        )
+    n_s, n_t = xs[0].shape
+    rng = np.random.default_rng(seed)
+    idx_t = rng.integers(0, n_t, (n_boot, n_t))  # first: as bootstrap_interval draws
+    idx_s = rng.integers(0, n_s, (n_boot, n_s))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        value = float(statistic(*xs))
+        # x*[b, i, j] = x[s_b,i, t_b,j]
+        boot = np.asarray(statistic(*(x[idx_s[:, :, None], idx_t[:, None, :]] for x in xs)), float)
     boot = boot[np.isfinite(boot)]
     lo, hi = np.percentile(boot, [2.5, 97.5]) if len(boot) else (np.nan, np.nan)
     return value, float(lo), float(hi)

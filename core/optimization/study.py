@@ -42,7 +42,7 @@ from typing import Any
 import numpy as np
 
 from core.errors import InputError
-from core.evaluation.robust import check_objective
+from core.evaluation.robust import DEFAULT_OBJECTIVE, check_objective
 from core.optimization.objective import evaluate, make_losses, uses_capped
 from core.optimization.space import check_model, suggest_params, tracker_params_dict
 from core.optimization.storage import (
@@ -94,8 +94,9 @@ class StudySettings:
     objective
         ``"tracker"`` (the IPDA tracker on the data set) or ``"quadratic"`` (test objective).
     loss
-        What a trial minimises (:data:`core.evaluation.robust.OBJECTIVES`): ``"paper"`` (the
-        paper's L_t, eq. 14), ``"capped"``, ``"median"`` or ``"trimmed"``. The paper's L_t is
+        What a trial minimises (:data:`core.evaluation.robust.OBJECTIVES`): ``"trimmed"`` (the
+        default, :data:`core.evaluation.robust.DEFAULT_OBJECTIVE`), ``"paper"`` (the paper's
+        L_t, eq. 14), ``"capped"`` or ``"median"``. The paper's L_t is
         recorded beside it on every trial (user attribute ``paper_loss``).
     objective_options
         Options of the quadratic objective (``n_trajectories``, ``delay_s``).
@@ -112,7 +113,7 @@ class StudySettings:
     dataset: str | None = None
     objective: str = "tracker"
     objective_options: dict[str, float] = field(default_factory=dict)
-    loss: str = "paper"
+    loss: str = DEFAULT_OBJECTIVE
 
     def __post_init__(self) -> None:
         check_model(self.model)

@@ -84,3 +84,24 @@ def test_bad_input_is_one_line_and_touches_no_study(sets, tmp_path: Path, extra,
     lines = r.stderr.strip().splitlines()
     assert len(lines) == 1 and message in lines[0], r.stderr
     assert not db.exists()  # no study was created
+
+
+def test_default_objective_is_trimmed_and_a_resumed_study_keeps_its_own(sets, tmp_path) -> None:
+    """Without --loss a new study minimises the trimmed mean (docs/decisions/tuning-08); a
+    study made with --loss paper resumes with it, not refused for the new default."""
+    from core.optimization.storage import load_existing_study, open_storage
+
+    db = f"sqlite:///{tmp_path}/s.db"
+    base = ("tune", "--model", "cv", "--pruner", "none", "--no-progress", "--storage", db)
+    data = ("--dataset", sets["train"], "--validation", sets["val"], "--top-k", "1")
+    r = cli(*base, *data, "--trials", "2", "--study", "new")
+    assert r.returncode == 0, r.stderr
+    assert json.loads(r.stdout)["loss"] == "trimmed"
+    r = cli(*base, *data, "--trials", "2", "--study", "old", "--loss", "paper")
+    assert r.returncode == 0, r.stderr
+    r = cli(*base, *data, "--trials", "3", "--study", "old")
+    assert r.returncode == 0, r.stderr
+    assert json.loads(r.stdout)["loss"] == "paper"
+    store = open_storage(db, create=False)
+    assert load_existing_study(store, "new").user_attrs["loss"] == "trimmed"
+    assert len(load_existing_study(store, "old").trials) == 3

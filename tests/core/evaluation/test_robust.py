@@ -106,3 +106,15 @@ def test_capped_loss_of_several_people_is_the_mean_over_the_people_present() -> 
     # person 0: 0.1² a frame; person 1: c²/2 = 0.125 a frame; person 2 never present
     (value,) = trajectory_capped_losses(SimpleNamespace(truth_xy_m=truth), est)
     assert value == pytest.approx((0.01 + 0.125) / 2)
+
+
+def test_far_frames_counts_confirmed_estimates_beyond_the_distance() -> None:
+    """Frames: on the person (0.1 m), 1.5 m away, no estimate while 3 m away in the array,
+    exactly 1 m away (not beyond), 2 m away with the person absent (not scored)."""
+    from core.evaluation.robust import far_frames
+
+    truth = np.array([[0.0, 0.0], [0.0, 0.0], [0.0, 0.0], [0.0, 0.0], [np.nan, np.nan]])
+    est = np.array([[0.1, 0.0], [1.5, 0.0], [3.0, 0.0], [0.0, 1.0], [2.0, 0.0]])
+    has = np.array([True, True, False, True, True])
+    assert far_frames(est, has, truth) == 1
+    assert far_frames(est, has, truth, distance_m=0.05) == 3

@@ -1,4 +1,4 @@
-"""The batching storages (decision tuning-06): same studies as Optuna's own storages, fewer
+"""The batching storages (decision tuning-07): same studies as Optuna's own storages, fewer
 round trips, held writes all or nothing, own-trial answers equal to the database's."""
 
 from __future__ import annotations

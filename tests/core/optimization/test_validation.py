@@ -68,7 +68,7 @@ def test_validation_chooses_the_best_held_out_trial(sets, tmp_path: Path, monkey
 
     losses = TrackerLosses(Dataset.load(val))
     for v in validated:
-        assert evaluate(losses, v.params).value == v.validation_value
+        assert evaluate(losses, v.params, loss=s.loss).value == v.validation_value
     # the four validated trials are the four best by training loss
     summaries, _ = study_progress(s.storage, s.name)
     best4 = sorted(t.value for t in summaries if t.state == "COMPLETE")[:4]

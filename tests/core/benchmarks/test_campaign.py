@@ -1,0 +1,106 @@
+"""``radartune bench campaign`` (core.benchmarks.campaign): pre-registered rules, a quick run.
+
+The verdict and the objective rule are checked on numbers whose answer is known; the quick run
+(two objectives, one or two tiny studies per model, three five-trajectory test sets) checks
+that each study's test scores are the paper's L_t the objective itself computes, that the tables
+are the statistics of those cells, and that the files are written.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from core.benchmarks import campaign
+
+
+def test_verdict_is_decided_on_the_upper_and_lower_bound() -> None:
+    assert campaign.verdict(0.90, 1.05) == "CV not worse than CA by more than 5 %"
+    assert campaign.verdict(0.99, 1.0501) == "not settled by this design"
+    assert campaign.verdict(1.0501, 1.30) == "CV worse than CA by more than 5 %"
+    assert campaign.verdict(1.05, 1.30) == "not settled by this design"
+
+
+def _row(median: float, cat: int, iqr: float) -> dict:
+    return {"median": median, "catastrophic": cat, "seed_iqr_rel": iqr}
+
+
+def test_objective_rule_ties_within_five_percent_then_catastrophic_then_spread() -> None:
+    # R: paper 1, capped 0.97, median 0.99, trimmed 1.2 → capped lowest; paper and median tied
+    table = {
+        "paper": {"cv": _row(1.0, 5, 0.1), "ca": _row(2.0, 5, 0.1)},
+        "capped": {"cv": _row(0.97, 6, 0.1), "ca": _row(1.94, 6, 0.1)},
+        "median": {"cv": _row(0.99, 3, 0.5), "ca": _row(1.98, 3, 0.5)},
+        "trimmed": {"cv": _row(1.2, 0, 0.0), "ca": _row(2.4, 0, 0.0)},
+    }
+    c = campaign.choose_objective(table)
+    assert c["relative_median"]["capped"] == pytest.approx(0.97)
+    assert set(c["tied"]) == {"paper", "capped", "median"}
+    assert c["winner"] == "median"  # fewest catastrophic among the tied (6 of trimmed not tied)
+    table["median"]["cv"]["catastrophic"] = 5
+    table["median"]["ca"]["catastrophic"] = 5
+    assert campaign.choose_objective(table)["winner"] == "paper"  # tie on 10: smaller spread
+
+
+@pytest.fixture(scope="module")
+def quick(tmp_path_factory: pytest.TempPathFactory) -> tuple[dict, Path]:
+    root = tmp_path_factory.mktemp("campaign")
+    mp = pytest.MonkeyPatch()
+    mp.setenv("RADARTUNE_CAMPAIGN_DIR", str(root / "work"))
+    mp.chdir(root)
+    try:
+        result = campaign.run(quick=True)
+    finally:
+        mp.undo()
+    return result, root
+
+
+@pytest.mark.slow
+def test_quick_run_scores_are_the_objectives_paper_loss(quick: tuple[dict, Path]) -> None:
+    from core.dataset import Dataset
+    from core.optimization.objective import TrackerLosses, evaluate
+
+    result, _ = quick
+    s = campaign.QUICK
+    recs = result["objectives"]["records"]
+    assert len(recs) == len(s.objectives) * 2 * len(s.compare_seeds)
+    test0 = Dataset.load(result["data"]["test"][0])
+    val = Dataset.load(result["data"]["validation"])
+    for r in recs:
+        assert len(r["loss"]["total"]) == s.n_test
+        # the test score at ρ × 1 is L_t (eq. 14) as the study objective computes it
+        assert r["loss"]["total"][0] == pytest.approx(
+            evaluate(TrackerLosses(test0), r["params"]).paper_value, rel=1e-12
+        )
+        assert r["validation_paper_loss"] == pytest.approx(
+            evaluate(TrackerLosses(val), r["params"]).paper_value, rel=1e-12
+        )
+        assert 0 <= r["never"][0] + r["clutter"][0] <= s.n_trajectories
+
+
+@pytest.mark.slow
+def test_quick_run_tables_are_the_statistics_of_the_cells(quick: tuple[dict, Path]) -> None:
+    result, root = quick
+    f = result["final"]
+    assert result["objectives"]["choice"]["winner"] in campaign.QUICK.objectives
+    for m in campaign.MODELS:
+        recs = sorted((r for r in f["records"] if r["model"] == m), key=lambda r: r["seed"])
+        cells = np.array([r["loss"]["total"] for r in recs])
+        assert f["table"][m]["total"]["median"] == pytest.approx(np.median(cells))
+        assert f["table"][m]["total"]["mean"] == pytest.approx(np.mean(cells))
+        t = f["table"][m]["total"]
+        assert t["median_lo"] <= t["median"] <= t["median_hi"]
+        best = json.loads(
+            (root / "bench/results/campaign-quick/params" / f"best_{m}.json").read_text()
+        )
+        assert best == f["chosen"][m]["params"]
+    cv = np.array([r["loss"]["total"] for r in f["records"] if r["model"] == "cv"])
+    ca = np.array([r["loss"]["total"] for r in f["records"] if r["model"] == "ca"])
+    r = f["ratios"]["total"]
+    assert r["median_ratio"] == pytest.approx(np.median(cv) / np.median(ca))
+    assert f["verdict"] == campaign.verdict(r["median_ratio_lo"], r["median_ratio_hi"])
+    for name in ("campaign.md", "test_sets.png", "table1.png", "objectives.png"):
+        assert (root / "bench/results/campaign-quick" / name).stat().st_size > 0
