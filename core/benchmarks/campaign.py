@@ -116,10 +116,10 @@ def score_choice(params: dict[str, Any], test_sets: list[Any]) -> dict[str, Any]
     """
     from core.evaluation import trajectory_loss_terms
     from core.evaluation.robust import trajectory_capped_losses, trajectory_far_frames
+    from core.evaluation.robustness import clutter_robustness
     from core.tracking import TrackerParams, track_dataset
 
     base = TrackerParams.from_dict(params)
-    rho0 = float(base.clutter_density)
     out: dict[str, Any] = {
         "loss": {c: [] for c in (*CLASSES, "total")},
         "capped": [],
@@ -129,27 +129,24 @@ def score_choice(params: dict[str, Any], test_sets: list[Any]) -> dict[str, Any]
     }
     for ds in test_sets:
         classes = np.array([str(c).upper() for c in ds.trajectory_class])
-        for f in (1.0, *RHO_FACTORS):
-            tp = TrackerParams.from_dict({**params, "clutter_density": rho0 * f})
-            est = track_dataset(ds, tp)
-            terms = trajectory_loss_terms(ds, est)
-            loss = np.array([t[0] for t in terms])
-            n_c = np.array([t[2] for t in terms])
-            far = np.array(trajectory_far_frames(ds, est))
-            never = int(np.sum(n_c == 0))
-            clutter = int(np.sum((n_c > 0) & (far >= FAR_FRAMES)))
-            if f == 1.0:
-                cls = classes[np.asarray(est.trajectories)]
-                for c in CLASSES:
-                    if np.any(cls == c):
-                        out["loss"][c].append(float(loss[cls == c].mean()))
-                out["loss"]["total"].append(float(loss.mean()))
-                out["capped"].append(float(np.mean(trajectory_capped_losses(ds, est))))
-                out["never"].append(never)
-                out["clutter"].append(clutter)
-            else:
-                out["rho"][str(f)]["total"].append(float(loss.mean()))
-                out["rho"][str(f)]["catastrophic"].append(never + clutter)
+        est = track_dataset(ds, base)
+        terms = trajectory_loss_terms(ds, est)
+        loss = np.array([t[0] for t in terms])
+        n_c = np.array([t[2] for t in terms])
+        far = np.array(trajectory_far_frames(ds, est))
+        cls = classes[np.asarray(est.trajectories)]
+        for c in CLASSES:
+            if np.any(cls == c):
+                out["loss"][c].append(float(loss[cls == c].mean()))
+        out["loss"]["total"].append(float(loss.mean()))
+        out["capped"].append(float(np.mean(trajectory_capped_losses(ds, est))))
+        out["never"].append(int(np.sum(n_c == 0)))
+        out["clutter"].append(int(np.sum((n_c > 0) & (far >= FAR_FRAMES))))
+        for row in clutter_robustness(base, {"test": ds}, RHO_FACTORS).rows:
+            rn_c, rfar = np.array(row.n_c), np.array(row.far_frames)
+            catastrophic = int(np.sum(rn_c == 0) + np.sum((rn_c > 0) & (rfar >= FAR_FRAMES)))
+            out["rho"][str(row.rho_factor)]["total"].append(float(np.mean(row.losses)))
+            out["rho"][str(row.rho_factor)]["catastrophic"].append(catastrophic)
     return out
 
 

@@ -32,7 +32,7 @@ import numpy as np
 
 from core.dataset import Dataset
 from core.errors import InputError
-from core.evaluation.robust import trajectory_capped_losses
+from core.evaluation.robust import trajectory_capped_losses, trajectory_far_frames
 from core.evaluation.table import evaluate
 from core.tracking import TrackerParams, track_dataset
 
@@ -65,9 +65,11 @@ class ClutterRow:
         Fraction of the frames with a confirmed track (:attr:`Evaluation.confirmed_fraction`).
     n_never_confirmed, n_trajectories
         Trajectories with ``N_c = 0``, and all trajectories.
-    losses, capped
-        Per trajectory (K,), in the data set's order: ``L(k)`` (eq. 13) and ``C(k)`` (m²), for
-        statistics of the caller's own (tails, bootstrap intervals).
+    losses, capped, n_c, far_frames
+        Per trajectory (K,), in the data set's order: ``L(k)`` (eq. 13) and ``C(k)`` (m²), the
+        confirmed frames ``N_c(k)`` and the frames whose estimate is more than 1 m off
+        (:func:`core.evaluation.robust.trajectory_far_frames`), for statistics of the caller's
+        own (tails, catastrophic runs, bootstrap intervals).
     """
 
     dataset: str
@@ -82,11 +84,14 @@ class ClutterRow:
     n_trajectories: int
     losses: tuple[float, ...]
     capped: tuple[float, ...]
+    n_c: tuple[int, ...]
+    far_frames: tuple[int, ...]
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready (NaN as None)."""
         d = dataclasses.asdict(self)
-        d["losses"], d["capped"] = list(self.losses), list(self.capped)
+        for key in ("losses", "capped", "n_c", "far_frames"):
+            d[key] = list(d[key])
         return {k: None if isinstance(v, float) and not math.isfinite(v) else v
                 for k, v in d.items()}  # fmt: skip
 
@@ -189,6 +194,8 @@ def clutter_robustness(
                     n_trajectories=len(ev.loss),
                     losses=tuple(float(v) for v in ev.loss),
                     capped=tuple(float(v) for v in capped),
+                    n_c=tuple(int(v) for v in ev.n_c),
+                    far_frames=tuple(int(v) for v in trajectory_far_frames(ds, est)),
                 )
             )
     return ClutterRobustness(params=params.to_dict(), rho_factors=factors, rows=tuple(rows))
