@@ -6,7 +6,7 @@ synthetic paper-like scene and three multi-person scenes with crossings for 300 
 NaN/Inf or non-SPD covariance makes the command exit 1.
 
 Consistency: NEES and NIS (:mod:`core.evaluation.consistency`) per trajectory class of the tuned
-parameters (``docs/report/best_*.json`` on the point person, ``docs/report/walking-person/
+parameters (``docs/report/best_*.json`` on the point person, ``docs/report/walking-campaign/
 best_*.json`` on the walking body), and on the walking body of the defaults and of the defaults
 with R set to the measured spread of the person's points, on the paper data set of each person
 model. An inconsistent filter is a finding, not a failure: it does not change the
@@ -28,7 +28,7 @@ ROOT = Path(__file__).resolve().parents[2]
 #: person points' measured spread, :func:`core.evaluation.consistency.measurement_spread`).
 CONSISTENCY_CASES: tuple[tuple[str, str, str], ...] = (
     ("point, tuned", "point", "docs/report"),
-    ("walking, tuned", "walking", "docs/report/walking-person"),
+    ("walking, tuned", "walking", "docs/report/walking-campaign"),
     ("walking, defaults", "walking", "defaults"),
     ("walking, R = spread", "walking", "spread"),
 )
