@@ -28,7 +28,8 @@ def server_binaries() -> Path | None:
     return Path(initdb).parent if initdb else None
 
 
-def _free_port() -> int:
+def free_port() -> int:
+    """A TCP port on 127.0.0.1 that nothing listens on now."""
     with socket.socket() as s:
         s.bind(("127.0.0.1", 0))
         return int(s.getsockname()[1])
@@ -68,7 +69,7 @@ def postgres_server() -> Iterator[str | None]:
             preexec_fn=preexec,
             cwd=tmp,
         )
-        port = _free_port()
+        port = free_port()
         server = subprocess.Popen(
             [str(bindir / "postgres"), "-D", str(data), "-p", str(port), "-k", str(tmp),
              "-c", "listen_addresses=127.0.0.1"],

@@ -24,7 +24,7 @@ The paper's ``L_t`` is always computed beside whichever objective a study minimi
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import Any
 
 import numpy as np
@@ -97,35 +97,44 @@ def capped_loss(
     return float(np.sum(d) / n)
 
 
-def trajectory_capped_losses(dataset: Any, estimates: Any) -> list[float]:
-    """``C(k)`` of every tracked trajectory, in the order tracked (m²).
+def per_trajectory(
+    dataset: Any,
+    estimates: Any,
+    score: Callable[[np.ndarray, np.ndarray, np.ndarray], float],
+    combine: Callable[[list[float]], float],
+) -> list[float]:
+    """``score(estimate_xy, has_estimate, truth_xy)`` of every tracked trajectory, in order.
 
-    One person (or none): :func:`capped_loss` of the single-person estimate against person 0.
-    Several: each person's :func:`capped_loss` against the estimate the paper's multi-person
-    loss gives them (:func:`core.evaluation.loss.person_estimates`), averaged over the persons
-    present in the trajectory (0 when nobody is).
+    One person (or none): the single-person estimate against person 0. Several: each person
+    present in the trajectory against the estimate the paper's multi-person loss gives them
+    (:func:`core.evaluation.loss.person_estimates`), the persons' scores ``combine``d (called
+    with an empty list when nobody is present).
     """
     from core.evaluation.loss import person_estimates, tracked_person_xy
 
     truth_all = dataset.truth_xy_m[estimates.frame_index]  # (F_sel, P, 2) m
     off = estimates.offsets
-    out: list[float] = []
+    spans = [slice(off[i], off[i + 1]) for i in range(len(estimates.trajectories))]
     if truth_all.shape[1] <= 1:
         truth = tracked_person_xy(truth_all)  # (F_sel, 2) m
-        for i in range(len(estimates.trajectories)):
-            s = slice(off[i], off[i + 1])
-            out.append(capped_loss(estimates.estimate_xy[s], estimates.has_estimate[s], truth[s]))
-        return out
+        return [score(estimates.estimate_xy[s], estimates.has_estimate[s], truth[s]) for s in spans]
     est = person_estimates(estimates.tracks.xy, truth_all)  # (F_sel, P, 2) m, NaN: none
-    for i in range(len(estimates.trajectories)):
-        s = slice(off[i], off[i + 1])
-        per_person = [
-            capped_loss(est[s, p], np.all(np.isfinite(est[s, p]), axis=1), truth_all[s, p])
+    return [
+        combine([
+            score(est[s, p], np.all(np.isfinite(est[s, p]), axis=1), truth_all[s, p])
             for p in range(truth_all.shape[1])
             if np.isfinite(truth_all[s, p]).all(axis=1).any()
-        ]
-        out.append(float(np.mean(per_person)) if per_person else 0.0)
-    return out
+        ])
+        for s in spans
+    ]  # fmt: skip
+
+
+def trajectory_capped_losses(dataset: Any, estimates: Any) -> list[float]:
+    """``C(k)`` of every tracked trajectory, in the order tracked (m²): :func:`capped_loss` per
+    :func:`per_trajectory`, averaged over the persons present (0 when nobody is)."""
+    return per_trajectory(
+        dataset, estimates, capped_loss, lambda v: float(np.mean(v)) if v else 0.0
+    )
 
 
 def far_frames(
@@ -147,33 +156,9 @@ def far_frames(
 
 
 def trajectory_far_frames(dataset: Any, estimates: Any) -> list[int]:
-    """:func:`far_frames` of every tracked trajectory, in the order tracked.
-
-    One person: the single-person estimate against person 0. Several: summed over the persons,
-    each against the estimate the multi-person loss gives them, as
-    :func:`trajectory_capped_losses` does.
-    """
-    from core.evaluation.loss import person_estimates, tracked_person_xy
-
-    truth_all = dataset.truth_xy_m[estimates.frame_index]  # (F_sel, P, 2) m
-    off = estimates.offsets
-    out: list[int] = []
-    if truth_all.shape[1] <= 1:
-        truth = tracked_person_xy(truth_all)  # (F_sel, 2) m
-        for i in range(len(estimates.trajectories)):
-            s = slice(off[i], off[i + 1])
-            out.append(far_frames(estimates.estimate_xy[s], estimates.has_estimate[s], truth[s]))
-        return out
-    est = person_estimates(estimates.tracks.xy, truth_all)  # (F_sel, P, 2) m, NaN: none
-    for i in range(len(estimates.trajectories)):
-        s = slice(off[i], off[i + 1])
-        out.append(
-            sum(
-                far_frames(est[s, p], np.all(np.isfinite(est[s, p]), axis=1), truth_all[s, p])
-                for p in range(truth_all.shape[1])
-            )
-        )
-    return out
+    """:func:`far_frames` of every tracked trajectory, in the order tracked: per
+    :func:`per_trajectory`, summed over the persons."""
+    return [int(v) for v in per_trajectory(dataset, estimates, far_frames, sum)]
 
 
 def trimmed_mean(values: Sequence[float], fraction: float = TRIM_FRACTION) -> float:

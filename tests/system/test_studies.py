@@ -7,13 +7,11 @@ server binaries are missing the test fails; elsewhere it is skipped with the rea
 
 from __future__ import annotations
 
-import glob
 import json
 import os
 import pwd
 import shutil
 import signal
-import socket
 import subprocess
 import sys
 import tempfile
@@ -23,6 +21,7 @@ from pathlib import Path
 
 import pytest
 
+from core.benchmarks.postgres import free_port, server_binaries
 from core.optimization import study_progress
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -40,23 +39,9 @@ def cli(*args: str, timeout: float = 300) -> subprocess.CompletedProcess:
 
 
 # ---- PostgreSQL ---------------------------------------------------------------------------------
-def _pg_bin() -> Path | None:
-    found = sorted(glob.glob("/usr/lib/postgresql/*/bin/initdb"))
-    if found:
-        return Path(found[-1]).parent
-    initdb = shutil.which("initdb")
-    return Path(initdb).parent if initdb else None
-
-
-def _free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
-
-
 @pytest.fixture(scope="session")
 def postgres_url() -> Iterator[str]:
-    bindir = _pg_bin()
+    bindir = server_binaries()
     if bindir is None:
         if os.environ.get("CI"):
             pytest.fail("CI is set but PostgreSQL server binaries (initdb) are missing")
@@ -79,7 +64,7 @@ def postgres_url() -> Iterator[str]:
         preexec_fn=preexec,
         cwd=tmp,
     )
-    port = _free_port()
+    port = free_port()
     server = subprocess.Popen(
         [
             str(bindir / "postgres"),
@@ -237,7 +222,7 @@ def test_bad_input_is_one_line_exit_2_and_damages_nothing(tmp_path: Path) -> Non
 
 
 def test_unreachable_database_is_one_line_exit_2() -> None:
-    port = _free_port()  # nothing listens there
+    port = free_port()  # nothing listens there
     out = cli("tune", "--model", "cv", "--storage", f"postgresql://u:pw@127.0.0.1:{port}/x", *QUAD)
     _one_line_exit_2(out, "cannot open")
     assert "pw" not in out.stderr
