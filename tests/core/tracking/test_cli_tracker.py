@@ -58,7 +58,7 @@ def test_stability_quick(capsys, monkeypatch, tmp_path):
     assert "4 people circling, ca: 128 corners" in out
     # the consistency section: tuned parameters of both person models and the defaults
     assert calls == [(0, "point"), (0, "walking")]
-    assert "best_cv.json" in out and "walking-person/best_ca.json" in out and "defaults" in out
+    assert "best_cv.json" in out and "walking-campaign/best_ca.json" in out and "defaults" in out
     doc = json.loads(out_json.read_text())
     assert doc["ok"] is True and len(doc["sweep"]) == 8
     cons = doc["consistency"]
