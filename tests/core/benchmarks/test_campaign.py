@@ -164,3 +164,17 @@ def test_add_lambda_adds_the_same_scores_and_changes_nothing_else(
     added = campaign.add_lambda(stripped, quick=True)
     assert added == json.loads(json.dumps(result))
     assert "λ×2" in campaign.lambda_table(added)
+
+
+def test_lambda_only_bad_input_is_one_line_and_exit_2(tmp_path: Path, capsys) -> None:
+    from core.cli import main
+
+    out = ["--out-dir", str(tmp_path)]
+    assert main(["bench", "track", "--lambda-only", *out]) == 2
+    assert main(["bench", "campaign", "--lambda-only", *out]) == 2  # no campaign.json
+    (tmp_path / "campaign.json").write_text('{"settings": {}}')
+    before = (tmp_path / "campaign.json").read_text()
+    assert main(["bench", "campaign", "--lambda-only", *out]) == 2  # not a campaign result
+    assert (tmp_path / "campaign.json").read_text() == before  # nothing half-written
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 3 and "Traceback" not in "".join(err)
