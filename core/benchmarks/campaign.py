@@ -8,8 +8,10 @@ A. **Objective comparison.** Every objective of :data:`core.evaluation.robust.OB
    ``paper:i:walking``, one worker, journal storage), its choice by validation on
    ``paper:1000:walking`` among its 10 best trials (:func:`validate_study`), that choice scored
    on the 20 test sets ``paper:2000 … 2019:walking`` (:func:`score_choice`) — also with the
-   tracker's clutter density ρ scaled by :data:`RHO_FACTORS`. The winner by the pre-registered
-   rule (:func:`choose_objective`).
+   tracker's clutter density ρ scaled by :data:`RHO_FACTORS`, and on the first
+   :attr:`Settings.n_lambda` test sets simulated with the scene clutter rate λ scaled by
+   :data:`LAMBDA_FACTORS` (:func:`score_lambda`). The winner by the pre-registered rule
+   (:func:`choose_objective`; the λ scores are reported beside it, not part of it).
 B. **Final design.** The winner × CV, CA × study indices 0–7, 1000 trials, scored the same way;
    per class and total the median and mean of L over the (study, test set) cells with two-level
    bootstrap intervals (:func:`core.evaluation.intervals.two_level_bootstrap`), the CV / CA ratios
@@ -17,11 +19,13 @@ B. **Final design.** The winner × CV, CA × study indices 0–7, 1000 trials, s
 
 Each finished study's record is kept in a work folder (``$RADARTUNE_CAMPAIGN_DIR``, default
 ``<tmp>/radartune-campaign``) with its journal, so an interrupted campaign resumes where it
-stopped. The ρ-scaling evaluation here is minimal; ``core/evaluation/robustness.py`` (branch
-sensitivity) is meant to replace it.
+stopped; a finished record without λ scores (made before they existed) gets them from its
+stored parameters on the next run, and :func:`add_lambda` adds them to a stored result
+(``radartune bench campaign --lambda-only``) without running any study. Both clutter checks go
+through :func:`core.evaluation.robustness.clutter_robustness`.
 
 ``--quick``: 5 trajectories per data set, two objectives, one study per model in phase A and
-two in phase B, 6 trials, 3 test sets, in this process.
+two in phase B, 6 trials, 3 test sets (the λ check on the first), in this process.
 """
 
 from __future__ import annotations
@@ -43,6 +47,8 @@ MODELS = ("cv", "ca")
 CLASSES = ("A", "B", "C", "D", "E")
 #: clutter-density factors of the robustness check (×1 is the test score itself)
 RHO_FACTORS = (0.2, 0.5, 2.0, 5.0)
+#: scene clutter-rate factors of the λ check (×1 is the test score itself)
+LAMBDA_FACTORS = (0.5, 2.0)
 #: objectives within this fraction of the lowest relative median are tied (evaluation-07)
 TIE = 0.05
 #: the verdict's margin: CV not worse than CA by more than 5 %
@@ -65,6 +71,7 @@ class Settings:
     final_seeds: tuple[int, ...] = tuple(range(8))
     final_trials: int = 1000  # evaluation-07 (a 500-trial run: bench/results/campaign-500trials)
     n_test: int = 20
+    n_lambda: int = 5  # test sets simulated again with λ × each of LAMBDA_FACTORS
     n_trajectories: int = 35
     parallel: int = 2  # studies at a time
     in_process: bool = False
@@ -72,7 +79,7 @@ class Settings:
 
 QUICK = Settings(
     objectives=("paper", "capped"), compare_seeds=(0,), compare_trials=6, final_seeds=(0, 1),
-    final_trials=6, n_test=3, n_trajectories=5, parallel=1, in_process=True,
+    final_trials=6, n_test=3, n_lambda=1, n_trajectories=5, parallel=1, in_process=True,
 )  # fmt: skip
 
 
@@ -86,8 +93,21 @@ def work_dir(quick: bool) -> Path:
     return out
 
 
+def lambda_paths(test: list[str], n_lambda: int) -> dict[str, list[str]]:
+    """Factor → paths of the first ``n_lambda`` test sets simulated with the scene clutter rate
+    λ × that factor (:func:`core.optimization.data.paper_dataset_variant`: simulated on first
+    use, cached; everything but the clutter as in the test set)."""
+    from core.optimization.data import paper_dataset_variant
+
+    return {
+        str(f): [paper_dataset_variant(p, clutter_factor=f) for p in test[:n_lambda]]
+        for f in LAMBDA_FACTORS
+    }
+
+
 def data_paths(s: Settings) -> dict[str, Any]:
-    """Training (per seed), validation and test data-set paths (walking paper sets, cached)."""
+    """Training (per seed), validation, test and λ-variant data-set paths (walking paper sets,
+    cached)."""
     from core.optimization.validation import TEST_SEEDS, VALIDATION_SEED
     from core.pipeline import paper_dataset_file
 
@@ -95,11 +115,51 @@ def data_paths(s: Settings) -> dict[str, Any]:
         return str(paper_dataset_file(seed, s.n_trajectories, person_model=PERSON))
 
     seeds = sorted(set(s.compare_seeds) | set(s.final_seeds))
+    test = [path(t) for t in TEST_SEEDS[: s.n_test]]
     return {
         "train": {i: path(i) for i in seeds},
         "validation": path(VALIDATION_SEED),
-        "test": [path(t) for t in TEST_SEEDS[: s.n_test]],
+        "test": test,
+        "lambda": lambda_paths(test, s.n_lambda),
     }
+
+
+def catastrophic_runs(n_c: Any, far_frames: Any) -> int:
+    """Trajectories never confirmed (``N_c = 0``) or confirmed but more than 1 m off in
+    ≥ :data:`FAR_FRAMES` frames, from per-trajectory ``N_c`` and far-frame counts."""
+    n_c, far = np.asarray(n_c), np.asarray(far_frames)
+    return int(np.sum(n_c == 0) + np.sum((n_c > 0) & (far >= FAR_FRAMES)))
+
+
+def score_lambda(params: dict[str, Any], sets: dict[str, list[Any]]) -> dict[str, Any]:
+    """Scores of TrackerParams JSON ``params`` on data sets of another scene clutter rate λ.
+
+    Parameters
+    ----------
+    params
+        The choice under test; the tracker's ρ stays as given.
+    sets
+        λ factor (str) → data sets simulated with λ × that factor (:func:`lambda_paths`).
+
+    Returns
+    -------
+    dict
+        factor → ``{"total": [...], "catastrophic": [...]}`` over the sets: L_t (eq. 14, m²)
+        and the catastrophic runs (:func:`catastrophic_runs`), as for the ρ factors of
+        :func:`score_choice`.
+    """
+    from core.evaluation.robustness import clutter_robustness
+    from core.tracking import TrackerParams
+
+    base = TrackerParams.from_dict(params)
+    out: dict[str, Any] = {}
+    for f, datasets in sets.items():
+        rows = clutter_robustness(base, {str(i): ds for i, ds in enumerate(datasets)}, (1.0,))
+        out[str(f)] = {
+            "total": [float(np.mean(row.losses)) for row in rows.rows],
+            "catastrophic": [catastrophic_runs(row.n_c, row.far_frames) for row in rows.rows],
+        }
+    return out
 
 
 def score_choice(params: dict[str, Any], test_sets: list[Any]) -> dict[str, Any]:
@@ -143,8 +203,7 @@ def score_choice(params: dict[str, Any], test_sets: list[Any]) -> dict[str, Any]
         out["never"].append(int(np.sum(n_c == 0)))
         out["clutter"].append(int(np.sum((n_c > 0) & (far >= FAR_FRAMES))))
         for row in clutter_robustness(base, {"test": ds}, RHO_FACTORS).rows:
-            rn_c, rfar = np.array(row.n_c), np.array(row.far_frames)
-            catastrophic = int(np.sum(rn_c == 0) + np.sum((rn_c > 0) & (rfar >= FAR_FRAMES)))
+            catastrophic = catastrophic_runs(row.n_c, row.far_frames)
             out["rho"][str(row.rho_factor)]["total"].append(float(np.mean(row.losses)))
             out["rho"][str(row.rho_factor)]["catastrophic"].append(catastrophic)
     return out
@@ -163,10 +222,12 @@ def run_studies(
     run at a time (one worker process each); validation and scoring run here meanwhile.
     """
     from core.dataset import Dataset
+    from core.files import write_json_atomic
     from core.optimization.study import StudySettings, prepare_study, run_worker, start_study
     from core.optimization.validation import validate_study
 
     tests = [Dataset.load(p) for p in paths["test"]]
+    lam = {f: [Dataset.load(p) for p in ps] for f, ps in paths["lambda"].items()}
     records: dict[str, dict[str, Any]] = {}
     todo = []
     for job in jobs:
@@ -174,6 +235,9 @@ def run_studies(
         rec = folder / f"{name}.json"
         if rec.exists():
             records[name] = json.loads(rec.read_text())
+            if "lambda" not in records[name]:  # a record made before the λ check: add it
+                records[name]["lambda"] = score_lambda(records[name]["params"], lam)
+                write_json_atomic(rec, records[name])
         else:
             todo.append(job)
 
@@ -194,10 +258,8 @@ def run_studies(
             "study_seconds": seconds, "trial": top.number, "train_value": top.train_value,
             "validation_value": top.validation_value,
             "validation_paper_loss": top.validation_paper_loss, "params": top.params,
-            **score_choice(top.params, tests),
+            **score_choice(top.params, tests), "lambda": score_lambda(top.params, lam),
         }  # fmt: skip
-        from core.files import write_json_atomic
-
         write_json_atomic(folder / f"{st.name}.json", rec)
         records[st.name] = rec
         print(f"  {st.name}: {seconds:.0f} s, test median L_t "
@@ -281,6 +343,7 @@ def summarise(records: list[dict[str, Any]]) -> dict[str, Any]:
                        "catastrophic": cat}  # fmt: skip
     rho["1.0"] = {"median": float(np.median(cells)), "mean": float(np.mean(cells)),
                   "catastrophic": never + clutter}  # fmt: skip
+    extra = {"lambda": summarise_lambda(records)} if all("lambda" in r for r in records) else {}
     return {
         **spread(cells),
         "n_studies": len(records),
@@ -292,7 +355,57 @@ def summarise(records: list[dict[str, Any]]) -> dict[str, Any]:
         "seed_iqr_rel": float((q3 - q1) / np.median(cells)),
         "capped_median": float(np.median([r["capped"] for r in records])),
         "rho": rho,
+        **extra,
     }
+
+
+def summarise_lambda(records: list[dict[str, Any]]) -> dict[str, Any]:
+    """The λ check of one model's (or objective's) studies: per factor (×1: the same first test
+    sets as scored plainly) the median and mean of L_t over the (study, set) cells, the ratio of
+    the median to the one at ×1, and the catastrophic runs of all cells."""
+    rs = sorted(records, key=lambda r: r["seed"])
+    n = len(rs[0]["lambda"][str(LAMBDA_FACTORS[0])]["total"])
+    base = _cells(rs)[:, :n]
+    # the catastrophic runs at λ × 1 are the plain scores' on those sets
+    cat1 = int(sum(sum(r["never"][:n]) + sum(r["clutter"][:n]) for r in rs))
+    out = {"1.0": {"median": float(np.median(base)), "mean": float(np.mean(base)),
+                   "ratio": 1.0, "catastrophic": cat1}}  # fmt: skip
+    for f in LAMBDA_FACTORS:
+        x = np.array([r["lambda"][str(f)]["total"] for r in rs], dtype=float)
+        out[str(f)] = {
+            "median": float(np.median(x)),
+            "mean": float(np.mean(x)),
+            # median L_t at λ × f over median L_t at λ × 1, on the same sets and studies
+            "ratio": float(np.median(x) / np.median(base)),
+            "catastrophic": int(sum(sum(r["lambda"][str(f)]["catastrophic"]) for r in rs)),
+        }
+    return {"n_sets": n, "n_runs": int(base.size), "factors": out}
+
+
+def add_lambda(result: dict[str, Any], quick: bool = False) -> dict[str, Any]:
+    """A stored campaign result with the λ check added: every record (phase A and B) scored on
+    the λ variants from its stored parameters, and the λ summaries beside the others; nothing
+    else changes and no study runs. Records that already have λ scores keep them."""
+    s = result["settings"]
+    n_lambda = int(s.get("n_lambda", (QUICK if quick else Settings()).n_lambda))
+    from core.dataset import Dataset
+
+    paths = lambda_paths(result["data"]["test"], n_lambda)
+    lam = {f: [Dataset.load(p) for p in ps] for f, ps in paths.items()}
+    out = json.loads(json.dumps(result))
+    out["settings"]["n_lambda"] = n_lambda
+    out["data"]["lambda"] = paths
+    for rec in (*out["objectives"]["records"], *out["final"]["records"]):
+        if "lambda" not in rec:
+            rec["lambda"] = score_lambda(rec["params"], lam)
+    a = out["objectives"]["records"]
+    for o, per in out["objectives"]["table"].items():
+        for m in per:
+            per[m]["lambda"] = summarise_lambda([r for r in a if r["objective"] == o
+                                                 and r["model"] == m])  # fmt: skip
+    for m, per in out["final"]["models"].items():
+        per["lambda"] = summarise_lambda([r for r in out["final"]["records"] if r["model"] == m])
+    return out
 
 
 def choose_objective(table: dict[str, dict[str, dict[str, Any]]]) -> dict[str, Any]:
@@ -360,6 +473,7 @@ def run(quick: bool = False, settings: Settings | None = None) -> dict[str, Any]
             "train": {str(k): v for k, v in paths["train"].items()},
             "validation": paths["validation"],
             "test": paths["test"],
+            "lambda": paths["lambda"],
         },  # fmt: skip
         "objectives": {
             "table": table,
@@ -412,6 +526,44 @@ def objective_table(result: dict[str, Any]) -> str:
                 f"{x['seed_iqr_rel']:.2f} | {ch['relative_median'][o]:.3f} | "
                 + " | ".join(_fmt(x["rho"][f]["median"]) for f in fs) + " |"
             )  # fmt: skip
+    return "\n".join(rows)
+
+
+def lambda_table(result: dict[str, Any]) -> str:
+    """Markdown: per objective and model (then per model of the final design) the median L_t
+    (×10⁻³) on the first test sets simulated at λ × 0.5, × 1 and × 2, the ratios to × 1 and the
+    catastrophic runs; empty when the result has no λ check."""
+    t = result["objectives"]["table"]
+    finals = result["final"]["models"]
+    if not all("lambda" in t[o][m] for o in t for m in MODELS) or not all(
+        "lambda" in finals[m] for m in MODELS
+    ):
+        return ""
+    ch = result["objectives"]["choice"]
+    fs = [str(f) for f in sorted((*LAMBDA_FACTORS, 1.0))]
+    others = [str(f) for f in sorted(LAMBDA_FACTORS)]
+    rows = [
+        "| objective | model | " + " | ".join(f"median L_t at λ×{float(f):g}" for f in fs)
+        + " | " + " | ".join(f"ratio λ×{float(f):g} / ×1" for f in others)
+        + " | catastrophic at " + " / ".join(f"×{float(f):g}" for f in fs) + " of runs |",
+        "|---|---|" + "---|" * (len(fs) + len(others) + 1),
+    ]  # fmt: skip
+    n_traj = result["settings"]["n_trajectories"]
+
+    def row(label: str, m: str, lam: dict[str, Any]) -> str:
+        x = lam["factors"]
+        return (
+            f"| {label} | {m.upper()} | " + " | ".join(_fmt(x[f]["median"]) for f in fs) + " | "
+            + " | ".join(f"{x[f]['ratio']:.2f}" for f in others) + " | "
+            + " / ".join(str(x[f]["catastrophic"]) for f in fs)
+            + f" of {lam['n_runs'] * n_traj} |"
+        )  # fmt: skip
+
+    for o in t:
+        for m in MODELS:
+            rows.append(row(f"{o}{' (winner)' if o == ch['winner'] else ''}", m, t[o][m]["lambda"]))
+    for m in MODELS:
+        rows.append(row(f"final design ({ch['winner']})", m, finals[m]["lambda"]))
     return "\n".join(rows)
 
 
@@ -468,7 +620,10 @@ def render(result: dict[str, Any], quick: bool = False) -> list[Path]:
         f"{result['settings']['final_trials']} trials per model.\n\n"
         "## Objectives on the test sets\n\n" + objective_table(result) + "\n\n"
         f"Winner by the rule: **{result['objectives']['choice']['winner']}**.\n\n"
-        "## Table I\n\n" + table_one(result) + "\n\n"
+        + _lambda_section(result)
+        + "## Table I\n\n"
+        + table_one(result)
+        + "\n\n"
         f"Primary (ratio of medians) {r['median_ratio']:.3f} [{r['median_ratio_lo']:.3f}, "
         f"{r['median_ratio_hi']:.3f}]: **{f['verdict']}**. Secondary (ratio of means) "
         f"{r['mean_ratio']:.3f} [{r['mean_ratio_lo']:.3f}, {r['mean_ratio_hi']:.3f}]: "
@@ -482,6 +637,21 @@ def render(result: dict[str, Any], quick: bool = False) -> list[Path]:
         write_json_atomic(path, f["chosen"][m]["params"])
         written.append(path)
     return [*written, *_plots(result, out)]
+
+
+def _lambda_section(result: dict[str, Any]) -> str:
+    table = lambda_table(result)
+    if not table:
+        return ""
+    n = result["settings"].get("n_lambda")
+    return (
+        "## Objectives when the scene clutter λ changes\n\n"
+        f"Each study's choice (tracker ρ as tuned) on the first {n} test sets simulated again "
+        "with the scene clutter rate λ (0.02 m⁻² in the paper) × 0.5 and × 2, everything else "
+        "the same; × 1 is the plain score on those sets. Median over (study, set) cells; ratio: "
+        "that median over the one at × 1; catastrophic: never confirmed, or more than 1 m off "
+        f"in ≥ {FAR_FRAMES} frames. Not part of the pre-registered rule.\n\n" + table + "\n\n"
+    )
 
 
 def _plots(result: dict[str, Any], out: Path) -> list[Path]:
@@ -554,7 +724,11 @@ def _plots(result: dict[str, Any], out: Path) -> list[Path]:
     # 3. objectives: held-out median per objective, and against the clutter density
     t = result["objectives"]["table"]
     objs = list(t)
-    fig, (a1, a2) = plt.subplots(1, 2, figsize=(10, 3.8), layout="constrained")
+    has_lambda = bool(lambda_table(result))
+    if has_lambda:
+        fig, (a1, a2, a3) = plt.subplots(1, 3, figsize=(14, 3.9), layout="constrained")
+    else:
+        fig, (a1, a2) = plt.subplots(1, 2, figsize=(10, 3.8), layout="constrained")
     xo = np.arange(len(objs))
     for j, m in enumerate(MODELS):
         dx = (j - 0.5) * 0.3
@@ -571,6 +745,12 @@ def _plots(result: dict[str, Any], out: Path) -> list[Path]:
             a2.plot(fs, [t[o][m]["rho"][str(v)]["median"] * 1e3 for v in fs],
                     "-" if m == "cv" else "--", color=f"C{k + 2}", marker=".",
                     label=f"{m.upper()} {o}")  # fmt: skip
+            if has_lambda:
+                lam = t[o][m]["lambda"]["factors"]
+                fl = sorted((*LAMBDA_FACTORS, 1.0))
+                a3.plot(fl, [lam[str(v)]["median"] * 1e3 for v in fl],
+                        "-" if m == "cv" else "--", color=f"C{k + 2}", marker=".",
+                        label=f"{m.upper()} {o}")  # fmt: skip
     a1.set_xticks(xo, objs)
     a1.set_yscale("log")
     a1.set_ylabel("held-out median L_t (m² ×10⁻³)")
@@ -585,6 +765,19 @@ def _plots(result: dict[str, Any], out: Path) -> list[Path]:
     a2.set_ylabel("median L_t (m² ×10⁻³)")
     a2.set_title("Robustness to ρ (test sets, each study's choice)", fontsize=9)
     a2.legend(fontsize=6, ncol=2)
+    if has_lambda:
+        fl = sorted((*LAMBDA_FACTORS, 1.0))
+        a3.set_xscale("log")
+        a3.set_yscale("log")
+        a3.set_xticks(fl, [f"×{v:g}" for v in fl])
+        a3.minorticks_off()
+        a3.set_xlabel("scene clutter rate λ / paper's λ (data simulated again)")
+        a3.set_ylabel("median L_t (m² ×10⁻³)")
+        a3.set_title(
+            f"Robustness to λ (first {result['settings'].get('n_lambda')} test sets, each "
+            "study's choice)", fontsize=9,
+        )  # fmt: skip
+        a3.legend(fontsize=6, ncol=2)
     p = out / "objectives.png"
     fig.savefig(p, dpi=110)
     plt.close(fig)
@@ -607,6 +800,15 @@ def summary(result: dict[str, Any]) -> str:
         )
     ch = result["objectives"]["choice"]
     lines.append(f"winner: {ch['winner']} (tied: {', '.join(ch['tied'])})")
+    if lambda_table(result):
+        lines.append("at scene clutter λ × 0.5 / 1 / 2 (median L_t ×10⁻³, catastrophic runs):")
+        for o, per in result["objectives"]["table"].items():
+            lines.append(f"  {o:8s} " + "  ".join(
+                f"{m.upper()} " + " / ".join(
+                    f"{x['median'] * 1e3:.4f} ({x['catastrophic']})"
+                    for x in (per[m]["lambda"]["factors"][str(v)]
+                              for v in sorted((*LAMBDA_FACTORS, 1.0)))
+                ) for m in MODELS))  # fmt: skip
     f = result["final"]
     lines.append("Table I, final design (median [95 %] / mean [95 %], ×10⁻³):")
     for m in MODELS:
@@ -626,19 +828,26 @@ def summary(result: dict[str, Any]) -> str:
 
 
 __all__ = [
+    "LAMBDA_FACTORS",
     "MARGIN",
     "PAPER_TABLE",
     "QUICK",
     "RHO_FACTORS",
     "Settings",
+    "add_lambda",
     "analyse_final",
+    "catastrophic_runs",
+    "lambda_paths",
+    "lambda_table",
     "render",
     "choose_objective",
     "ratios",
     "run",
     "score_choice",
+    "score_lambda",
     "spread",
     "summarise",
+    "summarise_lambda",
     "summary",
     "verdict",
 ]

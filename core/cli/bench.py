@@ -45,6 +45,12 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         help="fidelity, clouds, samplers, campaign: re-write the tables and plots from "
         "<out-dir>/<name>.json, no run",
     )
+    p.add_argument(
+        "--lambda-only",
+        action="store_true",
+        help="campaign: add the scene-clutter (λ × 0.5, × 2) scores of every stored choice to "
+        "<out-dir>/campaign.json and re-render; no study runs, nothing else changes",
+    )
     for model in ("cv", "ca"):
         p.add_argument(
             f"--params-{model}",
@@ -58,6 +64,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     if args.render_only:
         return _render_only(args)
+    if getattr(args, "lambda_only", False):
+        return _lambda_only(args)
     names = BENCHMARKS if args.name == "all" else (args.name,)
     out_dir = Path(args.out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
@@ -87,10 +95,45 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-def _render_only(args: argparse.Namespace) -> int:
-    """``--render-only``: a benchmark's tables and plots re-rendered from its stored result."""
+def _lambda_only(args: argparse.Namespace) -> int:
+    """``campaign --lambda-only``: the λ check added to the stored campaign result."""
+    from core.benchmarks.campaign import add_lambda, render, summary
+    from core.errors import InputError
+
+    if args.name != "campaign":
+        raise InputError(f"--lambda-only is for campaign only, not {args.name!r}")
+    path = Path(args.out_dir) / f"campaign{'-quick' if args.quick else ''}.json"
+    result = _load_result(path, args.name)
+    try:
+        result = add_lambda(result, quick=args.quick)
+    except (KeyError, TypeError, ValueError, IndexError) as exc:
+        raise InputError(f"not a campaign result: {exc!r}", str(path)) from None
+    write_json_atomic(path, result)
+    print(summary(result))
+    for out in (path, *render(result, quick=args.quick)):
+        print(f"written: {out}")
+    return 0
+
+
+def _load_result(path: Path, name: str) -> dict:
+    """A stored benchmark result; one-line InputError when it is missing or not JSON."""
     import json
 
+    from core.errors import InputError
+
+    if not path.exists():
+        raise InputError(f"no such file (run `radartune bench {name}` first)", str(path))
+    try:
+        result = json.loads(path.read_text())
+    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
+        raise InputError(f"not JSON: {exc}", str(path)) from None
+    if not isinstance(result, dict):
+        raise InputError(f"not a {name} result", str(path))
+    return result
+
+
+def _render_only(args: argparse.Namespace) -> int:
+    """``--render-only``: a benchmark's tables and plots re-rendered from its stored result."""
     from core.errors import InputError
 
     if args.name not in RENDERABLE:
@@ -105,12 +148,7 @@ def _render_only(args: argparse.Namespace) -> int:
         from core.benchmarks.samplers import render, summary  # type: ignore[assignment]
 
     path = Path(args.out_dir) / f"{args.name}{'-quick' if args.quick else ''}.json"
-    if not path.exists():
-        raise InputError(f"no such file (run `radartune bench {args.name}` first)", str(path))
-    try:
-        result = json.loads(path.read_text())
-    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
-        raise InputError(f"not JSON: {exc}", str(path)) from None
+    result = _load_result(path, args.name)
     try:
         written = render(result, quick=args.quick)
     except (KeyError, TypeError, ValueError, IndexError) as exc:

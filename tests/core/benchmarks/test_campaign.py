@@ -104,3 +104,77 @@ def test_quick_run_tables_are_the_statistics_of_the_cells(quick: tuple[dict, Pat
     assert f["verdict"] == campaign.verdict(r["median_ratio_lo"], r["median_ratio_hi"])
     for name in ("campaign.md", "test_sets.png", "table1.png", "objectives.png"):
         assert (root / "bench/results/campaign-quick" / name).stat().st_size > 0
+
+
+@pytest.mark.slow
+def test_quick_run_lambda_check_is_the_plain_score_at_factor_one(
+    quick: tuple[dict, Path],
+) -> None:
+    from core.dataset import Dataset
+    from core.evaluation.robustness import scene_clutter_rate
+
+    result, _ = quick
+    s = campaign.QUICK
+    test0 = Dataset.load(result["data"]["test"][0])
+    lam = result["data"]["lambda"]
+    assert sorted(lam) == sorted(str(f) for f in campaign.LAMBDA_FACTORS)
+    for f, paths in lam.items():
+        assert len(paths) == s.n_lambda
+        # λ' = f · λ: the variant's scenes carry the scaled scene clutter rate
+        assert scene_clutter_rate(Dataset.load(paths[0])) == pytest.approx(
+            float(f) * scene_clutter_rate(test0), rel=1e-12
+        )
+    for r in (*result["objectives"]["records"], *result["final"]["records"]):
+        for f in lam:
+            assert len(r["lambda"][f]["total"]) == s.n_lambda
+            assert 0 <= r["lambda"][f]["catastrophic"][0] <= s.n_trajectories
+        # the same test set at λ × 1 is the plain score exactly, catastrophic runs included
+        one = campaign.score_lambda(r["params"], {"1.0": [test0]})["1.0"]
+        assert one["total"][0] == r["loss"]["total"][0]
+        assert one["catastrophic"][0] == r["never"][0] + r["clutter"][0]
+    for o, per in result["objectives"]["table"].items():
+        for m in campaign.MODELS:
+            recs = [x for x in result["objectives"]["records"]
+                    if x["objective"] == o and x["model"] == m]  # fmt: skip
+            x = per[m]["lambda"]["factors"]
+            cells1 = np.array([sorted(recs, key=lambda r: r["seed"])[i]["loss"]["total"][:1]
+                               for i in range(len(recs))])  # fmt: skip
+            assert x["1.0"]["median"] == np.median(cells1)
+            for f in lam:
+                cells = np.array([r["lambda"][f]["total"] for r in recs])
+                assert x[f]["median"] == pytest.approx(np.median(cells), rel=1e-12)
+                assert x[f]["ratio"] == pytest.approx(np.median(cells) / np.median(cells1))
+
+
+@pytest.mark.slow
+def test_add_lambda_adds_the_same_scores_and_changes_nothing_else(
+    quick: tuple[dict, Path],
+) -> None:
+    result, _ = quick
+    stripped = json.loads(json.dumps(result))
+    del stripped["data"]["lambda"]
+    for r in (*stripped["objectives"]["records"], *stripped["final"]["records"]):
+        del r["lambda"]
+    for per in stripped["objectives"]["table"].values():
+        for m in campaign.MODELS:
+            del per[m]["lambda"]
+    for m in campaign.MODELS:
+        del stripped["final"]["models"][m]["lambda"]
+    assert campaign.lambda_table(stripped) == ""
+    added = campaign.add_lambda(stripped, quick=True)
+    assert added == json.loads(json.dumps(result))
+    assert "λ×2" in campaign.lambda_table(added)
+
+
+def test_lambda_only_bad_input_is_one_line_and_exit_2(tmp_path: Path, capsys) -> None:
+    from core.cli import main
+
+    out = ["--out-dir", str(tmp_path)]
+    assert main(["bench", "track", "--lambda-only", *out]) == 2
+    assert main(["bench", "campaign", "--lambda-only", *out]) == 2  # no campaign.json
+    (tmp_path / "campaign.json").write_text('{"settings": {}}')
+    before = (tmp_path / "campaign.json").read_text()
+    assert main(["bench", "campaign", "--lambda-only", *out]) == 2  # not a campaign result
+    assert (tmp_path / "campaign.json").read_text() == before  # nothing half-written
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 3 and "Traceback" not in "".join(err)
