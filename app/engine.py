@@ -525,19 +525,22 @@ def scene_dataset(frames: Sequence[FrameData], scene, path: Path) -> Path:
 
 def start_study(form, dataset_path: str | None = None) -> StudyProcesses:
     """Create or resume the study and start its worker processes (never in the GUI thread)."""
-    from core.optimization import StudySettings, resolve_dataset
+    from core.optimization import StudySettings, loss_of_study, resolve_dataset
     from core.optimization import start_study as _start
 
     if dataset_path is None:
         dataset_path = resolve_dataset(None)
+    url = storage_url(form.storage)
     settings = StudySettings(
         model=form.model,
         n_trials=form.n_trials,
         n_jobs=form.n_jobs,
-        storage=storage_url(form.storage),
+        storage=url,
         study_name=form.effective_name,
         seed=form.seed,
         dataset=str(dataset_path),
+        # a study resumed from an older storage keeps the objective it was started with
+        loss=loss_of_study(url, form.effective_name),
     )
     log = Path(form.storage).expanduser().with_suffix(".workers.log")
     with open(log, "ab") as fh:

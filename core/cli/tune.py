@@ -250,23 +250,11 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _default_loss(args: argparse.Namespace) -> str:
-    """The objective when ``--loss`` is not given: a study being resumed keeps its own (one made
-    before robust objectives existed: the paper's); a new study gets
-    :data:`core.evaluation.robust.DEFAULT_OBJECTIVE`."""
-    from core.evaluation.robust import DEFAULT_OBJECTIVE
-    from core.optimization.storage import load_existing_study, open_storage
+    """The objective when ``--loss`` is not given (:func:`core.optimization.loss_of_study`)."""
+    from core.optimization.study import loss_of_study
 
     name = args.study or f"radartune-{args.model}"
-    if args.repeats > 1:
-        name = f"{name}-r0"
-    try:
-        store = open_storage(args.storage, create=False)
-    except InputError:
-        return DEFAULT_OBJECTIVE  # no storage yet: a new study
-    study = load_existing_study(store, name)
-    if study is None:
-        return DEFAULT_OBJECTIVE
-    return str(study.user_attrs.get("loss", "paper"))
+    return loss_of_study(args.storage, f"{name}-r0" if args.repeats > 1 else name)
 
 
 def _repeat(base: StudySettings, i: int, n: int, *, dataset: str | None) -> StudySettings:

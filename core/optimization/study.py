@@ -342,6 +342,22 @@ def fail_stale_trials(study: Any, *, stale_after_s: float = STALE_AFTER_S) -> li
 
 
 # ---- creating, loading ------------------------------------------------------------------------
+def loss_of_study(storage: str, study_name: str) -> str:
+    """The objective a study started now minimises when none is asked for: a study being resumed
+    keeps its own (one made before robust objectives existed: the paper's); a new study gets
+    :data:`core.evaluation.robust.DEFAULT_OBJECTIVE`."""
+    from core.evaluation.robust import DEFAULT_OBJECTIVE
+
+    try:
+        store = open_storage(storage, create=False)
+    except InputError:
+        return DEFAULT_OBJECTIVE  # no storage yet: a new study
+    study = load_existing_study(store, study_name)
+    if study is None:
+        return DEFAULT_OBJECTIVE
+    return str(study.user_attrs.get("loss", "paper"))
+
+
 def prepare_study(settings: StudySettings, *, dataset_path: str | None = None) -> Any:
     """Create the study (once, before any worker starts) or resume it; return the Optuna study.
 

@@ -116,3 +116,34 @@ def test_stop_ends_a_running_study_early(
     assert 2 <= p.n_finished < 500
     assert p.n_running == 0  # the worker finished its trial; nothing is left RUNNING
     assert window.study_panel.start_button.isEnabled()
+
+
+def test_a_study_resumed_from_an_older_storage_keeps_its_objective(tmp_path, monkeypatch) -> None:
+    """The app has no objective field: a new study minimises the default objective, one made
+    before robust objectives existed (no ``loss`` attribute: the paper's) is resumed with it
+    instead of refused."""
+    import optuna
+
+    import core.optimization
+    from app.data import StudyForm
+    from app.engine import start_study, storage_url
+    from core.evaluation.robust import DEFAULT_OBJECTIVE
+    from core.optimization.storage import open_storage
+    from core.tracking.synthetic import synthetic_dataset
+
+    data = str(tmp_path / "d.npz")
+    synthetic_dataset(seed=1, n_per_class=1, n_frames=50).save(data)
+    db = str(tmp_path / "studies.db")
+    old = open_storage(storage_url(db)).create_new_study(
+        [optuna.study.StudyDirection.MINIMIZE], "old-paper"
+    )
+    store = open_storage(storage_url(db))
+    for key, value in (("model", "cv"), ("objective", "tracker"), ("sampler", "tpe"),
+                       ("pruner", "asha")):  # fmt: skip
+        store.set_study_user_attr(old, key, value)
+    asked = []
+    monkeypatch.setattr(core.optimization, "start_study", lambda s, **kw: asked.append(s))
+    monkeypatch.setattr("app.engine.StudyProcesses", lambda handle: handle)
+    for name in ("old-paper", "new"):
+        start_study(StudyForm(storage=db, study_name=name), dataset_path=data)
+    assert [s.loss for s in asked] == ["paper", DEFAULT_OBJECTIVE]
