@@ -12,7 +12,7 @@ import socket
 import subprocess
 import tempfile
 import time
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
 from pathlib import Path
 
@@ -42,6 +42,15 @@ def postgres_server() -> Iterator[str | None]:
     if os.environ.get(ENV):
         yield os.environ[ENV]
         return
+    with throwaway_postgres() as url:
+        yield url
+
+
+@contextmanager
+def throwaway_postgres(settings: Sequence[str] = ()) -> Iterator[str | None]:
+    """Yield the URL of a new PostgreSQL cluster in a temporary folder, started with the server
+    settings ``settings`` (``"name=value"``, e.g. ``"fsync=off"``), stopped and removed on exit;
+    None when the server binaries are missing or it did not accept connections within 10 s."""
     bindir = server_binaries()
     if bindir is None:
         yield None
@@ -70,9 +79,10 @@ def postgres_server() -> Iterator[str | None]:
             cwd=tmp,
         )
         port = free_port()
+        options = [a for v in ("listen_addresses=127.0.0.1", *settings) for a in ("-c", v)]
         server = subprocess.Popen(
             [str(bindir / "postgres"), "-D", str(data), "-p", str(port), "-k", str(tmp),
-             "-c", "listen_addresses=127.0.0.1"],
+             *options],
             stdout=subprocess.DEVNULL,
             stderr=subprocess.DEVNULL,
             preexec_fn=preexec,

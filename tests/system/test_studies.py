@@ -9,19 +9,16 @@ from __future__ import annotations
 
 import json
 import os
-import pwd
-import shutil
 import signal
 import subprocess
 import sys
-import tempfile
 import time
 from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
 
-from core.benchmarks.postgres import free_port, server_binaries
+from core.benchmarks.postgres import free_port, server_binaries, throwaway_postgres
 from core.optimization import study_progress
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -41,70 +38,14 @@ def cli(*args: str, timeout: float = 300) -> subprocess.CompletedProcess:
 # ---- PostgreSQL ---------------------------------------------------------------------------------
 @pytest.fixture(scope="session")
 def postgres_url() -> Iterator[str]:
-    bindir = server_binaries()
-    if bindir is None:
+    if server_binaries() is None:
         if os.environ.get("CI"):
             pytest.fail("CI is set but PostgreSQL server binaries (initdb) are missing")
         pytest.skip("PostgreSQL server binaries (initdb) not installed")
-    tmp = Path(tempfile.mkdtemp(prefix="radartune-pg-"))
-    preexec = None
-    if os.geteuid() == 0:  # initdb and postgres refuse to run as root
-        pw = pwd.getpwnam("postgres")
-        os.chown(tmp, pw.pw_uid, pw.pw_gid)
-
-        def preexec() -> None:
-            os.setgid(pw.pw_gid)
-            os.setuid(pw.pw_uid)
-
-    data = tmp / "data"
-    subprocess.run(
-        [str(bindir / "initdb"), "-D", str(data), "-A", "trust", "-U", "postgres"],
-        check=True,
-        capture_output=True,
-        preexec_fn=preexec,
-        cwd=tmp,
-    )
-    port = free_port()
-    server = subprocess.Popen(
-        [
-            str(bindir / "postgres"),
-            "-D",
-            str(data),
-            "-p",
-            str(port),
-            "-k",
-            str(tmp),
-            "-c",
-            "listen_addresses=127.0.0.1",
-            "-c",
-            "fsync=off",
-        ],
-        stdout=subprocess.DEVNULL,
-        stderr=subprocess.DEVNULL,
-        preexec_fn=preexec,
-        cwd=tmp,
-    )
-    url = f"postgresql://postgres@127.0.0.1:{port}/postgres"
-    try:
-        import psycopg2
-
-        for _ in range(100):
-            try:
-                psycopg2.connect(url).close()
-                break
-            except psycopg2.OperationalError:
-                time.sleep(0.1)
-        else:
-            pytest.fail("PostgreSQL did not accept connections within 10 s")
+    with throwaway_postgres(("fsync=off",)) as url:
+        if url is None:
+            pytest.fail("PostgreSQL did not start or accept connections within 10 s")
         yield url
-    finally:
-        server.send_signal(signal.SIGINT)  # fast shutdown
-        try:
-            server.wait(20)
-        except subprocess.TimeoutExpired:
-            server.kill()
-            server.wait()
-        shutil.rmtree(tmp, ignore_errors=True)
 
 
 @pytest.fixture(params=["sqlite", "journal", "postgresql"])
