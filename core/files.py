@@ -78,6 +78,18 @@ def atomic_open(path: str | os.PathLike, mode: str = "w") -> Iterator[IO[Any]]:
         raise
 
 
+def save_figure(fig: Any, path: str | os.PathLike, *, dpi: int = 100, **savefig: Any) -> Path:
+    """Write a Matplotlib figure as PNG through :func:`atomic_open`; returns ``path``.
+
+    ``savefig`` is passed on to ``fig.savefig`` (e.g. ``bbox_inches="tight"``). The figure is
+    left open (the caller closes it).
+    """
+    path = Path(path)
+    with atomic_open(path, "wb") as fh:
+        fig.savefig(fh, format="png", dpi=dpi, **savefig)
+    return path
+
+
 def check_output_path(path: str | os.PathLike, *, what: str = "output file") -> Path:
     """``path`` as a :class:`Path` if a file can be written there (checked before long work):
     not a folder, its folder a folder (or creatable) and writable; else one line naming it."""

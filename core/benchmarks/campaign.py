@@ -42,6 +42,7 @@ import numpy as np
 
 from core.evaluation.intervals import two_level_bootstrap
 from core.evaluation.robust import FAR_FRAMES, OBJECTIVES
+from core.files import save_figure
 
 MODELS = ("cv", "ca")
 CLASSES = ("A", "B", "C", "D", "E")
@@ -693,9 +694,8 @@ def _plots(result: dict[str, Any], out: Path) -> list[Path]:
     )
     ax.legend(fontsize=8)
     p = out / "test_sets.png"
-    fig.savefig(p, dpi=110)
+    written.append(save_figure(fig, p, dpi=110))
     plt.close(fig)
-    written.append(p)
     # 2. Table I per class: medians with intervals
     fig, ax = plt.subplots(figsize=(7, 3.8), layout="constrained")
     cols = (*CLASSES, "total")
@@ -718,9 +718,8 @@ def _plots(result: dict[str, Any], out: Path) -> list[Path]:
     )
     ax.legend(fontsize=8)
     p = out / "table1.png"
-    fig.savefig(p, dpi=110)
+    written.append(save_figure(fig, p, dpi=110))
     plt.close(fig)
-    written.append(p)
     # 3. objectives: held-out median per objective, and against the clutter density
     t = result["objectives"]["table"]
     objs = list(t)
@@ -779,9 +778,8 @@ def _plots(result: dict[str, Any], out: Path) -> list[Path]:
         )  # fmt: skip
         a3.legend(fontsize=6, ncol=2)
     p = out / "objectives.png"
-    fig.savefig(p, dpi=110)
+    written.append(save_figure(fig, p, dpi=110))
     plt.close(fig)
-    written.append(p)
     return written
 
 

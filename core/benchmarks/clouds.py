@@ -32,7 +32,7 @@ from core.evaluation.clouds import (
     dataset_person_points,
     rule_person_points,
 )
-from core.files import write_text_atomic
+from core.files import save_figure, write_text_atomic
 
 #: The RadHAR walking recording inside the real-data folder.
 RADHAR_WALK = Path("radhar_walk") / "__20_walk_6.txt"
@@ -432,7 +432,7 @@ def _plot(result: dict, out: Path) -> list[Path]:
         ax.set_xlabel("time (s)")
         ax.set_ylabel("radial velocity (m/s)")
     fig.colorbar(im, ax=axes[0].tolist(), label="power (dB)")
-    written.append(_save(fig, out / "micro_doppler.png"))
+    written.append(save_figure(fig, out / "micro_doppler.png"))
     plt.close(fig)
 
     fig, axes = plt.subplots(
@@ -463,16 +463,9 @@ def _plot(result: dict, out: Path) -> list[Path]:
         ax.set_xlabel("radial velocity (m/s)")
         ax.set_ylabel("range (m)")
     fig.colorbar(im, ax=axes[0].tolist(), label="power (dB)")
-    written.append(_save(fig, out / "rd_map.png"))
+    written.append(save_figure(fig, out / "rd_map.png"))
     plt.close(fig)
     return written
-
-
-def _save(fig, path: Path) -> Path:
-    tmp = path.with_suffix(".tmp.png")
-    fig.savefig(tmp, dpi=100)
-    os.replace(tmp, path)
-    return path
 
 
 def summary(result: dict) -> str:

@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from core.evaluation.intervals import LOSS_TOLERANCE, TAIL_FACTOR
-from core.files import write_text_atomic
+from core.files import save_figure, write_text_atomic
 
 __all__ = ["render", "report_paths", "summary", "tables"]
 
@@ -306,10 +306,8 @@ def _plot(result: dict, path: Path) -> None:
     ax2.set_title(f"bulk tracking loss (runs < {TAIL_FACTOR:g}× exact's median) vs run time")
     ax2.legend(fontsize=8)
     fig.tight_layout()
-    tmp = path.with_name(path.stem + ".tmp.png")
-    fig.savefig(tmp, dpi=110)
+    save_figure(fig, path, dpi=110)
     plt.close(fig)
-    tmp.replace(path)
 
 
 def summary(result: dict) -> str:

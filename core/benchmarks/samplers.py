@@ -44,7 +44,7 @@ from typing import Any
 
 import numpy as np
 
-from core.files import write_text_atomic
+from core.files import save_figure, write_text_atomic
 
 #: trials after which the incumbent is read off (those up to ``n_trials``) and shown in tables
 TRIAL_CHECKPOINTS = (10, 20, 50, 100, 200, 300, 500, 1000)
@@ -510,10 +510,8 @@ def _plot(result: dict, path: Path) -> Path:
         fontsize=10,
     )
     fig.tight_layout()
-    tmp = path.with_suffix(".tmp.png")
-    fig.savefig(tmp, dpi=100)
+    save_figure(fig, path)
     plt.close(fig)
-    os.replace(tmp, path)
     return path
 
 

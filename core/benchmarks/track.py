@@ -20,6 +20,8 @@ from dataclasses import replace
 
 import numpy as np
 
+from core.files import save_figure
+
 PAPER_PASS_FRAMES = 35 * (75 + 250) // 2  # 35 trajectories of 6–20 s at 80 ms: 5 687 frames
 
 
@@ -360,10 +362,8 @@ def _plot_people_cost(result: dict, quick: bool):
     ax.grid(alpha=0.3)
     ax.legend()
     fig.tight_layout()
-    tmp = path.with_name(path.stem + ".tmp.png")
-    fig.savefig(tmp, dpi=110)
+    save_figure(fig, path, dpi=110)
     plt.close(fig)
-    tmp.replace(path)
     return path
 
 

@@ -39,7 +39,7 @@ from typing import Any
 import numpy as np
 
 from core.errors import InputError
-from core.files import write_json_atomic, write_text_atomic
+from core.files import save_figure, write_json_atomic, write_text_atomic
 from core.optimization.progress import TrialSummary, study_progress
 from core.optimization.report_sensitivity import sensitivity_markdown
 from core.optimization.storage import open_storage, redact
@@ -141,12 +141,6 @@ def main_study(studies: Sequence[StudyRecord], model: str) -> StudyRecord | None
     return min(mine, key=lambda s: (s.best.value, s.name))
 
 
-def _save_fig(fig: Any, path: Path) -> None:
-    tmp = path.with_name(f".{path.stem}.tmp.png")
-    fig.savefig(tmp, dpi=110, bbox_inches="tight")
-    os.replace(tmp, path)
-
-
 def _num(v: float | None) -> float | None:
     return None if v is None or not math.isfinite(v) else float(v)
 
@@ -200,7 +194,7 @@ def plot_loss_vs_time(studies: Sequence[StudyRecord], model: str, path: Path) ->
     ax.set_title(f"{model.upper()}: best loss against run time")
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8)
-    _save_fig(fig, path)
+    save_figure(fig, path, dpi=110, bbox_inches="tight")
     plt.close(fig)
     return True
 
@@ -251,7 +245,7 @@ def plot_tracks(
         ax.grid(True, alpha=0.3)
         ax.legend(fontsize=8)
     fig.suptitle("Tracking with the optimal parameters (after the paper's Fig. 4)")
-    _save_fig(fig, path)
+    save_figure(fig, path, dpi=110, bbox_inches="tight")
     plt.close(fig)
 
 
@@ -557,7 +551,7 @@ def plot_test_sets(entry: dict[str, Any], path: Path) -> None:
     ax.set_xlabel("box: quartiles, line: median, ◇: mean, whiskers: 1.5 IQR; dots: the sets")
     ax.set_title(f"Chosen parameters on {len(entry['datasets'])} test data sets")
     ax.grid(True, axis="y", alpha=0.3)
-    _save_fig(fig, path)
+    save_figure(fig, path, dpi=110, bbox_inches="tight")
     plt.close(fig)
 
 

@@ -29,7 +29,7 @@ from typing import Any
 import numpy as np
 
 from core.errors import InputError
-from core.files import atomic_open
+from core.files import save_figure
 from core.optimization.sensitivity import IMPORTANCE_EVALUATOR, OAT_POINTS
 
 #: λ factors of the data-set variants besides ×1.
@@ -165,11 +165,6 @@ def _same_file(a: str, b: str) -> bool:
         return False
 
 
-def _save(fig: Any, path: Path) -> None:
-    with atomic_open(path, "wb") as fh:
-        fig.savefig(fh, format="png", dpi=110, bbox_inches="tight")
-
-
 def plot_importance(entry: dict[str, Any], model: str, path: Path) -> bool:
     """Horizontal bars of the PED-ANOVA importance per parameter, one colour per study."""
     import matplotlib
@@ -198,7 +193,7 @@ def plot_importance(entry: dict[str, Any], model: str, path: Path) -> bool:
     ax.set_title(f"{model.upper()}: which parameters the best trials needed")
     ax.grid(True, axis="x", alpha=0.3)
     ax.legend(fontsize=7, loc="lower right")
-    _save(fig, path)
+    save_figure(fig, path, dpi=110, bbox_inches="tight")
     plt.close(fig)
     return True
 
@@ -259,7 +254,7 @@ def plot_oat(entry: dict[str, Any], model: str, path: Path) -> bool:
     fig.suptitle(f"{model.upper()}: one parameter at a time around the chosen parameters "
                  "(dotted: the optimum)")  # fmt: skip
     fig.tight_layout(rect=(0, 0.04, 1, 1))
-    _save(fig, path)
+    save_figure(fig, path, dpi=110, bbox_inches="tight")
     plt.close(fig)
     return True
 
