@@ -409,8 +409,8 @@ def _fast_stage_profile(
             a, b = start[f], start[f + 1]
             patches_kernel(
                 states[f], rd, amp[a:b], theta[a:b], slow[a:b], slow1[a:b], spec.wd, spec.b,
-                spec.s2, steer[a:b], spec.slot, spec.threshold, spec.half_r, spec.tw_d, True,
-                spec.n_use,
+                spec.s2, steer[a:b], spec.slot, spec.threshold, spec.half_r, spec.tw_d, spec.env,
+                True, spec.n_use,
             )  # fmt: skip
         c4 = time.process_time()
         spent["whole"] += c1 - c0

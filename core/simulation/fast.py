@@ -115,6 +115,7 @@ from core.simulation.fast_model import (
     doppler_weights,
     noise_map,
     patches_kernel,
+    range_envelopes,
     slow_time_sequences,
     twiddles,
 )
@@ -221,6 +222,7 @@ def fast_spectrum(
         np.arange(n_v) // radar.n_rx,
         PATCH_THRESHOLD,
         *twiddles(n_r, n_d),
+        range_envelopes(settings.range_window, n_r),
         noise,
         n_use,
     )
@@ -495,6 +497,7 @@ class SpectrumTables(NamedTuple):
     threshold: float  # patch threshold relative to s2 (PATCH_THRESHOLD)
     half_r: np.ndarray  # (2 n_r,) exp(j pi u / n_r): the range responses' half angles
     tw_d: np.ndarray  # Doppler twiddles (see twiddles)
+    env: np.ndarray  # (2, Q n_r / 2 + 1) the range responses' far bounds (range_envelopes)
 
 
 class PointTables(NamedTuple):
@@ -529,6 +532,7 @@ def spectrum_tables(
         threshold=PATCH_THRESHOLD,
         half_r=half_r,
         tw_d=tw_d,
+        env=range_envelopes(settings.range_window, n_r),
     )
 
 
@@ -579,7 +583,7 @@ def _frame_kernel(
     """
     cells_k, cells_d, x, along, ortho = patches_kernel(
         s, rd, amp, theta, slow, slow1, spec.wd, spec.b, spec.s2, steer, spec.slot,
-        spec.threshold, spec.half_r, spec.tw_d, noise, spec.n_use,
+        spec.threshold, spec.half_r, spec.tw_d, spec.env, noise, spec.n_use,
     )  # fmt: skip
     if has_cfar:
         r, d, nz = two_stage_kernel(rd, cfar)

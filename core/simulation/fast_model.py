@@ -151,6 +151,43 @@ def cosine_sum_coefficients(name: str, n: int) -> np.ndarray:
     return b
 
 
+#: Samples per range bin of :func:`range_envelopes`.
+ENVELOPE_PER_BIN = 8
+
+
+@functools.lru_cache(maxsize=32)
+def range_envelopes(name: str, n: int) -> np.ndarray:
+    """Bounds of a unit scatterer's range responses away from its tone, ``(2, Q N/2 + 1)``.
+
+    ``env[0, g] >= |R(Delta)|^2`` and ``env[1, g] >= |R1(Delta)|^2`` for every offset
+    ``|Delta| >= g / Q`` range bins (circular, ``Q`` = :data:`ENVELOPE_PER_BIN`) between the
+    beat tone and the bin, with ``R(Delta) = sum_m w_m exp(j 2 pi Delta m / N)`` the window's
+    response (``w`` rebuilt from :func:`cosine_sum_coefficients`, as the patch kernel uses it)
+    and ``R1`` that of ``w_m (m - (N - 1)/2)``; ``N = n``. Non-increasing in ``g``. Computed
+    on a grid of 128 offsets per bin (zero-padded FFT), each sample's bound taken from one grid
+    step nearer the tone, times 2 for the peaks between grid points (the response changes by a
+    few per cent over 1/128 bin).
+    """
+    fine = 128
+    b = cosine_sum_coefficients(name, n)
+    half = (b.shape[0] - 1) // 2
+    idx = np.arange(n)
+    w = np.real(
+        np.sum(b[:, None] * np.exp(2j * np.pi * np.outer(np.arange(-half, half + 1), idx) / n), 0)
+    )
+    out = np.empty((2, ENVELOPE_PER_BIN * (n // 2) + 1))
+    for row, weights in enumerate((w, w * (idx - (n - 1) / 2))):
+        p = np.abs(np.fft.fft(weights, n * fine)) ** 2  # |R(-u / fine)|^2, u = 0 .. n fine - 1
+        # both signs of the offset: |R(u / fine)|^2 is p[n fine - u]
+        mirror = np.concatenate(([p[0]], p[::-1][: n * fine // 2]))
+        both = np.maximum(p[: n * fine // 2 + 1], mirror)
+        beyond = np.maximum.accumulate(both[::-1])[::-1]  # max over offsets >= u / fine
+        start = np.maximum(np.arange(out.shape[1]) * (fine // ENVELOPE_PER_BIN) - 1, 0)
+        out[row] = 2.0 * beyond[start]
+    out.flags.writeable = False
+    return out
+
+
 @numba.njit(cache=True, nogil=True)
 def _slow_time_kernel(
     pos, vel, n_tx, n_loops, t_chirp, k_phase, k_beat, n_samples, clutter_removal
@@ -289,8 +326,9 @@ def _fft2_pow2(x, x1, w, rev, tw, a, a1):  # pragma: no cover
 
 @numba.njit(cache=True, nogil=True)
 def patches_kernel(
-    s, rd, amp, theta, slow, slow1, wd, b, s2, steer, slot, threshold, half_r, tw_d, noise, k_max
-):  # pragma: no cover
+    s, rd, amp, theta, slow, slow1, wd, b, s2, steer, slot, threshold, half_r, tw_d, env, noise,
+    k_max,
+):  # fmt: skip  # pragma: no cover
     """Patch cells, their noise-free channel values and their noisy channel sums.
 
     amp (N,), theta (N,) beat tone rad/sample, slow/slow1 (N, n_tx, M) slow-time sequences
@@ -299,9 +337,14 @@ def patches_kernel(
     steer (N, L), slot (L,) TX slot of each channel (``v // n_rx``), half_r (2 Nadc,) =
     exp(j pi u / Nadc); tw_d either
     (M, M) = exp(-j 2 pi (d - M/2) m / M) (direct DFT) or (1, M/2) = exp(-j 2 pi k / M) (M a
-    power of two: radix-2 FFT of the window-shifted sequence, the same transform). Adds the
-    patch cells' noisy power into ``rd`` (draws from the generator state ``s``); only range
-    bins below ``k_max`` are looked at.
+    power of two: radix-2 FFT of the window-shifted sequence, the same transform); env
+    (2, Q Nadc / 2 + 1) :func:`range_envelopes`. Adds the patch cells' noisy power into ``rd``
+    (draws from the generator state ``s``); only range bins below ``k_max`` are looked at.
+
+    A scatterer's range responses are computed only in the range bins its envelope bound
+    (``env``, the range window's far response) cannot rule out: beyond them its power is below
+    -60 dB of the noise in every cell, where the patch test and the sums ignore it anyway, so
+    the result is the same as computing every bin (tested bit for bit).
     """
     n_samples = half_r.shape[0] // 2
     n_s = amp.shape[0]
@@ -327,61 +370,6 @@ def patches_kernel(
         u = (t - half) % (2 * nn)
         cos_b[t] = half_r[u].real
         sin_b[t] = half_r[u].imag
-    g_re = np.empty(n_g)
-    g_im = np.empty(n_g)
-    g1_re = np.empty(n_g)
-    g1_im = np.empty(n_g)
-    rr = np.empty((n_s, k_max), dtype=np.complex128)
-    rr1 = np.empty((n_s, k_max), dtype=np.complex128)
-    pr = np.empty((n_s, k_max))
-    pr1 = np.empty((n_s, k_max))
-    for i in range(n_s):
-        e_n = np.exp(1j * theta[i] * nn)
-        num_re = 1.0 - e_n.real  # 1 - exp(j N theta)
-        num_im = -e_n.imag
-        a_re = nn * e_n.imag  # -j N exp(j N theta)
-        a_im = -nn * e_n.real
-        sin_a = np.sin(0.5 * theta[i])
-        cos_a = np.cos(0.5 * theta[i])
-        for t in range(n_g):
-            # sin and cos of phi_t / 2 = theta / 2 - b_t
-            sn = sin_a * cos_b[t] - cos_a * sin_b[t]
-            cs = cos_a * cos_b[t] + sin_a * sin_b[t]
-            sing = abs(sn) < 5e-10  # |1 - exp(j phi)|^2 < 1e-18: G = N, dG/dtheta = j N (N-1)/2
-            # w = 1 / (1 - exp(j phi)) = 1/2 + j cot(phi / 2) / 2
-            w_im = 0.5 * cs / (1.0 if sing else sn)
-            # G = num w
-            gr = 0.5 * num_re - num_im * w_im
-            gi = num_re * w_im + 0.5 * num_im
-            # dG/dtheta = -j N exp(j N theta) w + j num (w^2 - w)   (q / (1 - q)^2 = w^2 - w)
-            q_re = -0.25 - w_im * w_im
-            q_im = 0.0
-            h_re = -(num_re * q_im + num_im * q_re)
-            h_im = num_re * q_re - num_im * q_im
-            g_re[t] = nn if sing else gr
-            g_im[t] = 0.0 if sing else gi
-            g1_re[t] = 0.0 if sing else 0.5 * a_re - a_im * w_im + h_re
-            g1_im[t] = nn * (nn - 1) / 2 if sing else a_re * w_im + 0.5 * a_im + h_im
-        for k in range(k_max):
-            acc_re = 0.0
-            acc_im = 0.0
-            acc1_re = 0.0
-            acc1_im = 0.0
-            for jj in range(-half, half + 1):
-                # G at phi = theta - 2 pi (k - jj) / N is g[k - jj + J]
-                acc_re += bj[jj + half] * g_re[k - jj + half]
-                acc_im += bj[jj + half] * g_im[k - jj + half]
-                acc1_re += bj[jj + half] * g1_re[k - jj + half]
-                acc1_im += bj[jj + half] * g1_im[k - jj + half]
-            x_re = amp[i] * acc_re
-            x_im = amp[i] * acc_im
-            # R1 = A (acc1 - j centre acc)
-            y_re = amp[i] * (acc1_re + centre * acc_im)
-            y_im = amp[i] * (acc1_im - centre * acc_re)
-            rr[i, k] = complex(x_re, x_im)
-            rr1[i, k] = complex(y_re, y_im)
-            pr[i, k] = x_re * x_re + x_im * x_im
-            pr1[i, k] = y_re * y_re + y_im * y_im
     # Doppler responses D_i[s, d] = sum_m wd[m] y[m] exp(-j 2 pi (d - M/2) m / M), D1 of delta y
     dd = np.empty((n_s, n_tx, m), dtype=np.complex128)
     dd1 = np.empty((n_s, n_tx, m), dtype=np.complex128)
@@ -420,8 +408,101 @@ def patches_kernel(
     s2_min = s2[0]
     for d in range(m):
         s2_min = min(s2_min, s2[d])
-    lim_min = threshold * s2_min
     floor_min = 1e-6 * s2_min
+    cut = min(floor_min, threshold * s2_min)  # what neither the patch test nor the sums use
+    # each scatterer's range bins: those closer to its beat tone than the envelope's reach
+    # (at most two runs k_run[i, 0]:k_run[i, 1] and k_run[i, 2]:k_run[i, 3] after wrapping)
+    n_env = env.shape[1]
+    q_env = (n_env - 1) / (nn / 2)  # envelope samples per range bin
+    k_run = np.zeros((n_s, 4), dtype=np.int64)
+    for i in range(n_s):
+        a2 = amp[i] * amp[i]
+        # smallest g with a2 (env0[g] pd_max + env1[g] pd1_max) < cut (env non-increasing)
+        lo = 0
+        hi = n_env
+        while lo < hi:
+            mid = (lo + hi) // 2
+            if a2 * (env[0, mid] * pd_max[i] + env[1, mid] * pd1_max[i]) < cut:
+                hi = mid
+            else:
+                lo = mid + 1
+        reach = lo / q_env  # bins; beyond it (circularly) the scatterer is below the floor
+        kappa = (theta[i] * nn / (2 * np.pi)) % nn
+        t_lo = int(np.floor(kappa - reach)) - 1
+        t_hi = int(np.ceil(kappa + reach)) + 1
+        if lo == n_env or t_hi - t_lo + 1 >= nn:
+            k_run[i, 1] = k_max
+            continue
+        k0 = t_lo % nn
+        k1 = k0 + t_hi - t_lo + 1
+        k_run[i, 0] = min(k0, k_max)
+        k_run[i, 1] = min(k1, k_max)
+        if k1 > nn:  # wraps past the last bin
+            k_run[i, 3] = min(k1 - nn, k_max)
+    g_re = np.empty(n_g)
+    g_im = np.empty(n_g)
+    g1_re = np.empty(n_g)
+    g1_im = np.empty(n_g)
+    rr = np.empty((n_s, k_max), dtype=np.complex128)
+    rr1 = np.empty((n_s, k_max), dtype=np.complex128)
+    pr = np.empty((n_s, k_max))
+    pr1 = np.empty((n_s, k_max))
+    for i in range(n_s):
+        if k_run[i, 1] == k_run[i, 0] and k_run[i, 3] == k_run[i, 2]:
+            continue
+        e_n = np.exp(1j * theta[i] * nn)
+        num_re = 1.0 - e_n.real  # 1 - exp(j N theta)
+        num_im = -e_n.imag
+        a_re = nn * e_n.imag  # -j N exp(j N theta)
+        a_im = -nn * e_n.real
+        sin_a = np.sin(0.5 * theta[i])
+        cos_a = np.cos(0.5 * theta[i])
+        for run in range(2):
+            ka = k_run[i, 2 * run]
+            kb = k_run[i, 2 * run + 1]
+            if kb <= ka:
+                continue
+            for t in range(ka, kb + 2 * half):
+                # sin and cos of phi_t / 2 = theta / 2 - b_t
+                sn = sin_a * cos_b[t] - cos_a * sin_b[t]
+                cs = cos_a * cos_b[t] + sin_a * sin_b[t]
+                # |1 - exp(j phi)|^2 < 1e-18: G = N, dG/dtheta = j N (N-1)/2
+                sing = abs(sn) < 5e-10
+                # w = 1 / (1 - exp(j phi)) = 1/2 + j cot(phi / 2) / 2
+                w_im = 0.5 * cs / (1.0 if sing else sn)
+                # G = num w
+                gr = 0.5 * num_re - num_im * w_im
+                gi = num_re * w_im + 0.5 * num_im
+                # dG/dtheta = -j N exp(j N theta) w + j num (w^2 - w)  (q/(1-q)^2 = w^2 - w)
+                q_re = -0.25 - w_im * w_im
+                q_im = 0.0
+                h_re = -(num_re * q_im + num_im * q_re)
+                h_im = num_re * q_re - num_im * q_im
+                g_re[t] = nn if sing else gr
+                g_im[t] = 0.0 if sing else gi
+                g1_re[t] = 0.0 if sing else 0.5 * a_re - a_im * w_im + h_re
+                g1_im[t] = nn * (nn - 1) / 2 if sing else a_re * w_im + 0.5 * a_im + h_im
+            for k in range(ka, kb):
+                acc_re = 0.0
+                acc_im = 0.0
+                acc1_re = 0.0
+                acc1_im = 0.0
+                for jj in range(-half, half + 1):
+                    # G at phi = theta - 2 pi (k - jj) / N is g[k - jj + J]
+                    acc_re += bj[jj + half] * g_re[k - jj + half]
+                    acc_im += bj[jj + half] * g_im[k - jj + half]
+                    acc1_re += bj[jj + half] * g1_re[k - jj + half]
+                    acc1_im += bj[jj + half] * g1_im[k - jj + half]
+                x_re = amp[i] * acc_re
+                x_im = amp[i] * acc_im
+                # R1 = A (acc1 - j centre acc)
+                y_re = amp[i] * (acc1_re + centre * acc_im)
+                y_im = amp[i] * (acc1_im - centre * acc_re)
+                rr[i, k] = complex(x_re, x_im)
+                rr1[i, k] = complex(y_re, y_im)
+                pr[i, k] = x_re * x_re + x_im * x_im
+                pr1[i, k] = y_re * y_re + y_im * y_im
+    lim_min = threshold * s2_min
     lim = np.empty(m)
     for d in range(m):
         lim[d] = threshold * s2[d]
@@ -430,21 +511,19 @@ def patches_kernel(
     # the smallest limit
     mask = np.zeros((k_max, m), dtype=np.bool_)
     row = np.zeros(k_max, dtype=np.bool_)
-    bound = np.empty(k_max)
     for i in range(n_s):
-        for k in range(k_max):
-            bound[k] = pr[i, k] * pd_max[i] + pr1[i, k] * pd1_max[i]
-        for k in range(k_max):
-            if bound[k] <= lim_min:
-                continue
-            a0 = pr[i, k]
-            a1 = pr1[i, k]
-            hit = False
-            for d in range(m):
-                h = a0 * pd[i, d] + a1 * pd1[i, d] > lim[d]
-                mask[k, d] |= h
-                hit |= h
-            row[k] |= hit
+        for run in range(2):
+            for k in range(k_run[i, 2 * run], k_run[i, 2 * run + 1]):
+                if pr[i, k] * pd_max[i] + pr1[i, k] * pd1_max[i] <= lim_min:
+                    continue
+                a0 = pr[i, k]
+                a1 = pr1[i, k]
+                hit = False
+                for d in range(m):
+                    h = a0 * pd[i, d] + a1 * pd1[i, d] > lim[d]
+                    mask[k, d] |= h
+                    hit |= h
+                row[k] |= hit
     cells_k = np.empty(k_max * m, dtype=np.int64)
     cells_d = np.empty(k_max * m, dtype=np.int64)
     n_c = 0
@@ -466,7 +545,7 @@ def patches_kernel(
     for k in range(k_max):
         row_at[k + 1] += row_at[k]
     # the sums, scatterer by scatterer (each cell still adds its scatterers in index order), over
-    # the range bins where its bound reaches -60 dB of the noise; x_re[c n_v + v]
+    # its range bins where its bound reaches -60 dB of the noise; x_re[c n_v + v]
     x_re = np.zeros(n_c * n_v)
     x_im = np.zeros(n_c * n_v)
     a_re = np.empty(n_v)
@@ -475,35 +554,36 @@ def patches_kernel(
         for v in range(n_v):
             a_re[v] = steer[i, v].real
             a_im[v] = steer[i, v].imag
-        for k in range(k_max):
-            c_lo = row_at[k]
-            c_hi = row_at[k + 1]
-            if c_lo == c_hi:
-                continue
-            p0 = pr[i, k]
-            p1 = pr1[i, k]
-            if p0 * pd_max[i] + p1 * pd1_max[i] < floor_min:
-                continue
-            r0r = rr[i, k].real
-            r0i = rr[i, k].imag
-            r1r = rr1[i, k].real
-            r1i = rr1[i, k].imag
-            for c in range(c_lo, c_hi):
-                d = cells_d[c]
-                if p0 * pd[i, d] + p1 * pd1[i, d] < 1e-6 * s2[d]:
-                    continue  # below -60 dB of the noise: nothing to add
-                base = c * n_v
-                for sl in range(n_tx):
-                    # first order in the beat tone's drift: g = R D + R1 D1
-                    u0 = dd[i, sl, d]
-                    u1 = dd1[i, sl, d]
-                    gr = (r0r * u0.real - r0i * u0.imag) + (r1r * u1.real - r1i * u1.imag)
-                    gi = (r0r * u0.imag + r0i * u0.real) + (r1r * u1.imag + r1i * u1.real)
-                    v0 = sl * n_rx
-                    for r in range(n_rx):
-                        # X[c, v] = sum_i A_i R_i[k] D_i[slot(v), d] a_i[v],  v = slot n_rx + rx
-                        x_re[base + v0 + r] += gr * a_re[v0 + r] - gi * a_im[v0 + r]
-                        x_im[base + v0 + r] += gr * a_im[v0 + r] + gi * a_re[v0 + r]
+        for run in range(2):
+            for k in range(k_run[i, 2 * run], k_run[i, 2 * run + 1]):
+                c_lo = row_at[k]
+                c_hi = row_at[k + 1]
+                if c_lo == c_hi:
+                    continue
+                p0 = pr[i, k]
+                p1 = pr1[i, k]
+                if p0 * pd_max[i] + p1 * pd1_max[i] < floor_min:
+                    continue
+                r0r = rr[i, k].real
+                r0i = rr[i, k].imag
+                r1r = rr1[i, k].real
+                r1i = rr1[i, k].imag
+                for c in range(c_lo, c_hi):
+                    d = cells_d[c]
+                    if p0 * pd[i, d] + p1 * pd1[i, d] < 1e-6 * s2[d]:
+                        continue  # below -60 dB of the noise: nothing to add
+                    base = c * n_v
+                    for sl in range(n_tx):
+                        # first order in the beat tone's drift: g = R D + R1 D1
+                        u0 = dd[i, sl, d]
+                        u1 = dd1[i, sl, d]
+                        gr = (r0r * u0.real - r0i * u0.imag) + (r1r * u1.real - r1i * u1.imag)
+                        gi = (r0r * u0.imag + r0i * u0.real) + (r1r * u1.imag + r1i * u1.real)
+                        v0 = sl * n_rx
+                        for r in range(n_rx):
+                            # X[c, v] = sum_i A_i R_i[k] D_i[slot(v), d] a_i[v],  v = slot n_rx + rx
+                            x_re[base + v0 + r] += gr * a_re[v0 + r] - gi * a_im[v0 + r]
+                            x_im[base + v0 + r] += gr * a_im[v0 + r] + gi * a_re[v0 + r]
     # Marsaglia-Tsang constants of Gamma(L - 1)
     dk = n_v - 1.0 - 1.0 / 3.0
     ck = 1.0 / np.sqrt(9.0 * dk)
