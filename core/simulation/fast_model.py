@@ -24,6 +24,12 @@ from core.simulation.scatterers import Scatterers
 #: by less than 0.1 % elsewhere).
 PATCH_THRESHOLD = 1e-3
 
+#: Per-channel power of one scatterer in a patch cell, relative to the cell's noise power, below
+#: which it is left out of the cell's coherent sum (-50 dB: each one left out moves a channel of
+#: signal power ``P`` by at most ``2 sqrt(SUM_FLOOR P s2) + SUM_FLOOR s2``, 2 % of the noise
+#: power and 0.2 % of ``P`` at 10 dB over the noise; see docs/decisions/scene-06-walking-body.md).
+SUM_FLOOR = 1e-5
+
 
 @functools.lru_cache(maxsize=32)
 def _doppler_window_shifted(name: str, n: int) -> np.ndarray:
@@ -343,7 +349,7 @@ def patches_kernel(
 
     A scatterer's range responses are computed only in the range bins its envelope bound
     (``env``, the range window's far response) cannot rule out: beyond them its power is below
-    -60 dB of the noise in every cell, where the patch test and the sums ignore it anyway, so
+    :data:`SUM_FLOOR` in every cell, where the patch test and the sums ignore it anyway, so
     the result is the same as computing every bin (tested bit for bit).
     """
     n_samples = half_r.shape[0] // 2
@@ -408,7 +414,7 @@ def patches_kernel(
     s2_min = s2[0]
     for d in range(m):
         s2_min = min(s2_min, s2[d])
-    floor_min = 1e-6 * s2_min
+    floor_min = SUM_FLOOR * s2_min
     cut = min(floor_min, threshold * s2_min)  # what neither the patch test nor the sums use
     # each scatterer's range bins: those closer to its beat tone than the envelope's reach
     # (at most two runs k_run[i, 0]:k_run[i, 1] and k_run[i, 2]:k_run[i, 3] after wrapping)
@@ -545,7 +551,7 @@ def patches_kernel(
     for k in range(k_max):
         row_at[k + 1] += row_at[k]
     # the sums, scatterer by scatterer (each cell still adds its scatterers in index order), over
-    # its range bins where its bound reaches -60 dB of the noise; x_re[c n_v + v]
+    # its range bins where its bound reaches SUM_FLOOR; x_re[c n_v + v]
     x_re = np.zeros(n_c * n_v)
     x_im = np.zeros(n_c * n_v)
     a_re = np.empty(n_v)
@@ -570,8 +576,8 @@ def patches_kernel(
                 r1i = rr1[i, k].imag
                 for c in range(c_lo, c_hi):
                     d = cells_d[c]
-                    if p0 * pd[i, d] + p1 * pd1[i, d] < 1e-6 * s2[d]:
-                        continue  # below -60 dB of the noise: nothing to add
+                    if p0 * pd[i, d] + p1 * pd1[i, d] < SUM_FLOOR * s2[d]:
+                        continue  # below SUM_FLOOR: left out
                     base = c * n_v
                     for sl in range(n_tx):
                         # first order in the beat tone's drift: g = R D + R1 D1
