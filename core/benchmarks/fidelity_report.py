@@ -246,7 +246,7 @@ def _plot(result: dict, path: Path) -> None:
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    from matplotlib.ticker import LogLocator, NullFormatter, ScalarFormatter
+    from matplotlib.ticker import FormatStrFormatter, LogLocator, NullFormatter, ScalarFormatter
 
     lv = result["levels"]
     names = list(lv)
@@ -299,6 +299,8 @@ def _plot(result: dict, path: Path) -> None:
             for n, x, y in zip(names, xs, ys):
                 ax2.annotate(n, (x, y), textcoords="offset points", xytext=(6, 6), fontsize=8)
     ax2.axhspan(1 - LOSS_TOLERANCE, 1 + LOSS_TOLERANCE, color="g", alpha=0.12, label="±10 %")
+    # about one decade: label the 2s and 5s too, or only "1" shows
+    ax2.xaxis.set_minor_formatter(FormatStrFormatter("%g"))
     ax2.set_xlabel("CPU time per trial: simulate the data set + track it (s)")
     ax2.set_ylabel(
         "bulk tracking loss / exact's\n(95 % bootstrap interval; exact: half against half)"
