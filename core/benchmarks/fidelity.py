@@ -126,6 +126,11 @@ def _frames(scene, seed):
     return frames, antenna, settings, p.elevation, refl
 
 
+def _model_arg(person_model: str) -> str:
+    """``, person_model='walking'`` for a body, nothing for the paper's point person."""
+    return "" if person_model == "point" else f", person_model={person_model!r}"
+
+
 def _batch_simulator(name: str):
     """The level's all-frames entry point (``core.simulation.LEVELS``) or None."""
     from core.simulation import LEVELS
@@ -133,11 +138,14 @@ def _batch_simulator(name: str):
     return LEVELS[name].simulate_frames
 
 
-def run(quick: bool = False, params_cv=None, params_ca=None) -> dict:
+def run(quick: bool = False, params_cv=None, params_ca=None, person_model: str = "point") -> dict:
     """Run every level on the same scenes; returns JSON-ready figures (see module docstring).
 
     ``params_cv`` / ``params_ca``: tracker parameter files (default: the tuned parameters in
     ``docs/report/best_<model>.json`` when present, see :func:`tracker_parameters`).
+    ``person_model``: the paper scenes' person (``point``, the paper's; ``walking``; ``blob``).
+    The person's point errors are taken from its scatterer for the point person, and from the
+    mean of its scatterers (position and velocity, at the frame's middle) for a body.
     """
     from core import pipeline
     from core.dataset import Dataset
@@ -151,7 +159,7 @@ def run(quick: bool = False, params_cv=None, params_ca=None) -> dict:
 
     per_class = PER_CLASS_QUICK if quick else PER_CLASS
     seeds = N_SEEDS_QUICK if quick else N_SEEDS
-    scenes = paper_scenes(0, 5 * per_class)
+    scenes = paper_scenes(0, 5 * per_class, person_model=person_model)
     levels = list(FIDELITY_LEVELS)
     n_seeds = {name: seeds.get(name, 2) for name in levels}
     runs = [(name, s) for s in range(max(n_seeds.values())) for name in levels if s < n_seeds[name]]
@@ -220,11 +228,12 @@ def run(quick: bool = False, params_cv=None, params_ca=None) -> dict:
                 a["hit"].append(bool(np.any(src == 0)))
                 person = np.flatnonzero(sc.source == 0)
                 if person.size:
-                    i = person[0]
-                    pos = sc.position_m[i] + sc.velocity_mps[i] * t_mid
+                    # the point person's scatterer, or the mean of a body's scatterers
+                    vel = sc.velocity_mps[person].mean(axis=0)
+                    pos = sc.position_m[person].mean(axis=0) + vel * t_mid
                     r = np.linalg.norm(pos)
                     az = np.arctan2(pos[0], pos[1])
-                    vr = pos @ sc.velocity_mps[i] / r
+                    vr = pos @ vel / r
                     for j in edges[f] + np.flatnonzero(src == 0):
                         a["err"].append(
                             (
@@ -448,8 +457,10 @@ def run(quick: bool = False, params_cv=None, params_ca=None) -> dict:
             "tracking": trk,
         }
     out = {
-        "scenes": f"paper_scenes(seed=0): first {len(scenes)} trajectories "
-        f"({per_class} per class a-e)" + (f", first {QUICK_FRAMES} frames each" if quick else ""),
+        "scenes": f"paper_scenes(seed=0{_model_arg(person_model)}): first {len(scenes)} "
+        f"trajectories ({per_class} per class a-e)"
+        + (f", first {QUICK_FRAMES} frames each" if quick else ""),
+        "person_model": person_model,
         "frames_per_level": exact["frames"],
         "noise_seeds": n_seeds,
         "bootstrap": f"{N_BOOTSTRAP} paired resamples of the {len(scenes)} trajectories",

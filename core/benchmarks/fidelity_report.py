@@ -19,16 +19,26 @@ from core.files import save_figure, write_text_atomic
 __all__ = ["render", "report_paths", "summary", "tables"]
 
 
-def report_paths(quick: bool = False) -> tuple[Path, Path]:
+def result_name(person_model: str = "point", quick: bool = False) -> str:
+    """The result's file stem: ``fidelity``, ``fidelity-walking``, ``…-quick``."""
+    tail = "" if person_model == "point" else f"-{person_model}"
+    return f"fidelity{tail}{'-quick' if quick else ''}"
+
+
+def report_paths(quick: bool = False, person_model: str = "point") -> tuple[Path, Path]:
     """Where the report goes: ``(table.md, plot.png)`` (the quick run's beside its JSON)."""
     if quick:
-        return Path("bench/results/fidelity-quick.md"), Path("bench/results/fidelity-quick.png")
-    return Path("docs/fidelity/results.md"), Path("docs/fidelity/error_vs_runtime.png")
+        stem = Path("bench/results") / result_name(person_model, quick)
+        return stem.with_suffix(".md"), stem.with_suffix(".png")
+    tail = "" if person_model == "point" else f"-{person_model}"
+    return Path(f"docs/fidelity/results{tail}.md"), Path(
+        f"docs/fidelity/error_vs_runtime{tail}.png"
+    )
 
 
 def render(result: dict, quick: bool = False) -> tuple[Path, Path]:
     """Write the Markdown tables and the plot of a fidelity result; returns their paths."""
-    md, png = report_paths(quick)
+    md, png = report_paths(quick, result.get("person_model", "point"))
     md.parent.mkdir(parents=True, exist_ok=True)
     _write_table(result, md)
     _plot(result, png)
@@ -209,18 +219,28 @@ def tables(result: dict) -> str:
 
 
 def _write_table(result: dict, path: Path) -> None:
+    model = result.get("person_model", "point")
+    flag = "" if model == "point" else f" --person-model {model}"
+    who = "" if model == "point" else f" ({model} person)"
     text = (
-        "# Fidelity levels: error against run time\n\n"
-        f"Command: `radartune bench fidelity` (writes this file, the plot and "
-        f"`bench/results/fidelity.json`, which holds every figure; "
-        "`radartune bench fidelity --render-only` re-renders this file and the plot from it).\n\n"
+        f"# Fidelity levels: error against run time{who}\n\n"
+        f"Command: `radartune bench fidelity{flag}` (writes this file, the plot and "
+        f"`bench/results/{result_name(model)}.json`, which holds every figure; "
+        f"`radartune bench fidelity{flag} --render-only` re-renders this file and the plot from "
+        "it).\n\n"
         f"- Scenes: {result['scenes']}; {result['frames_per_level']} frames per level and seed.\n"
         f"- Noise seeds: {result['noise_seeds']}.\n"
         f"- Tracker: {result['tracker_parameters']}.\n"
         f"- Timing: {result['timing']}.\n"
         "- KS: two-sample Kolmogorov-Smirnov distance of the person's point errors to `exact` "
         "(first seed of each level); `exact*` is the yardstick (same scenes, other noise).\n"
-        "- Loss: eq. (14) on the level's own data set (×1e-3), mean over the noise seeds "
+        + (
+            ""
+            if model == "point"
+            else "- Point errors of a body: offsets from the mean of its scatterers (position "
+            "and velocity at the frame's middle), so their spread is the body's.\n"
+        )
+        + "- Loss: eq. (14) on the level's own data set (×1e-3), mean over the noise seeds "
         "(smallest and largest seed in brackets); trial CPU = simulation of the data set + one "
         "tracking run.\n"
         f"- Loss ratio: mean loss of the level over that of `exact`, each trajectory's loss "

@@ -58,6 +58,13 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
             help=f"fidelity: {model.upper()} tracker parameters (default: "
             f"docs/report/best_{model}.json when present, else the defaults)",
         )
+    p.add_argument(
+        "--person-model",
+        choices=("point", "walking", "blob"),
+        default="point",
+        help="fidelity: the paper scenes' person (default: %(default)s, the paper's; walking "
+        "writes fidelity-walking.json and docs/fidelity/results-walking.md)",
+    )
     p.set_defaults(func=run)
 
 
@@ -71,14 +78,19 @@ def run(args: argparse.Namespace) -> int:
     out_dir.mkdir(parents=True, exist_ok=True)
     for name in names:
         module = importlib.import_module(f"core.benchmarks.{MODULES.get(name, name)}")
-        extra, flags = {}, ""
+        extra, flags, stem = {}, "", f"{name}{'-quick' if args.quick else ''}"
         if name == "fidelity":
+            from core.benchmarks.fidelity_report import result_name
+
+            model = args.person_model
             extra = {"params_cv": args.params_cv, "params_ca": args.params_ca}
+            extra["person_model"] = model
             flags = "".join(
                 f" --params-{m} {v}"
                 for m, v in (("cv", args.params_cv), ("ca", args.params_ca))
                 if v
-            )
+            ) + ("" if model == "point" else f" --person-model {model}")
+            stem = result_name(model, args.quick)
         result = module.run(quick=args.quick, **extra)
         result = {
             "benchmark": name,
@@ -88,7 +100,7 @@ def run(args: argparse.Namespace) -> int:
             **result,
         }
         # a quick run never overwrites the full run's figures
-        path = out_dir / f"{name}{'-quick' if args.quick else ''}.json"
+        path = out_dir / f"{stem}.json"
         write_json_atomic(path, result)
         print(module.summary(result))
         print(f"written: {path}")
@@ -147,7 +159,12 @@ def _render_only(args: argparse.Namespace) -> int:
     else:
         from core.benchmarks.samplers import render, summary  # type: ignore[assignment]
 
-    path = Path(args.out_dir) / f"{args.name}{'-quick' if args.quick else ''}.json"
+    stem = f"{args.name}{'-quick' if args.quick else ''}"
+    if args.name == "fidelity":
+        from core.benchmarks.fidelity_report import result_name
+
+        stem = result_name(args.person_model, args.quick)
+    path = Path(args.out_dir) / f"{stem}.json"
     result = _load_result(path, args.name)
     try:
         written = render(result, quick=args.quick)
