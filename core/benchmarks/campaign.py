@@ -360,17 +360,27 @@ def summarise(records: list[dict[str, Any]]) -> dict[str, Any]:
     }
 
 
+def _ratio_interval(x: np.ndarray, base: np.ndarray) -> tuple[float, float]:
+    """95 % interval of ``median(x) / median(base)``, paired (study, set) matrices."""
+    _, lo, hi = two_level_bootstrap(lambda a, b: _median(a) / _median(b), x, base)
+    return float(lo), float(hi)
+
+
 def summarise_lambda(records: list[dict[str, Any]]) -> dict[str, Any]:
     """The λ check of one model's (or objective's) studies: per factor (×1: the same first test
     sets as scored plainly) the median and mean of L_t over the (study, set) cells, the ratio of
-    the median to the one at ×1, and the catastrophic runs of all cells."""
+    the median to the one at ×1 with its paired two-level bootstrap 95 % interval (studies and
+    sets resampled together, :func:`~core.evaluation.intervals.two_level_bootstrap`), and the
+    catastrophic runs of all cells."""
     rs = sorted(records, key=lambda r: r["seed"])
     n = len(rs[0]["lambda"][str(LAMBDA_FACTORS[0])]["total"])
     base = _cells(rs)[:, :n]
     # the catastrophic runs at λ × 1 are the plain scores' on those sets
     cat1 = int(sum(sum(r["never"][:n]) + sum(r["clutter"][:n]) for r in rs))
-    out = {"1.0": {"median": float(np.median(base)), "mean": float(np.mean(base)),
-                   "ratio": 1.0, "catastrophic": cat1}}  # fmt: skip
+    out: dict[str, dict[str, Any]] = {
+        "1.0": {"median": float(np.median(base)), "mean": float(np.mean(base)), "ratio": 1.0,
+                "catastrophic": cat1}
+    }  # fmt: skip
     for f in LAMBDA_FACTORS:
         x = np.array([r["lambda"][str(f)]["total"] for r in rs], dtype=float)
         out[str(f)] = {
@@ -378,6 +388,7 @@ def summarise_lambda(records: list[dict[str, Any]]) -> dict[str, Any]:
             "mean": float(np.mean(x)),
             # median L_t at λ × f over median L_t at λ × 1, on the same sets and studies
             "ratio": float(np.median(x) / np.median(base)),
+            "ratio_ci95": list(_ratio_interval(x, base)),
             "catastrophic": int(sum(sum(r["lambda"][str(f)]["catastrophic"]) for r in rs)),
         }
     return {"n_sets": n, "n_runs": int(base.size), "factors": out}
@@ -391,13 +402,17 @@ def add_lambda(result: dict[str, Any], quick: bool = False) -> dict[str, Any]:
     n_lambda = int(s.get("n_lambda", (QUICK if quick else Settings()).n_lambda))
     from core.dataset import Dataset
 
-    paths = lambda_paths(result["data"]["test"], n_lambda)
-    lam = {f: [Dataset.load(p) for p in ps] for f, ps in paths.items()}
     out = json.loads(json.dumps(result))
     out["settings"]["n_lambda"] = n_lambda
-    out["data"]["lambda"] = paths
-    for rec in (*out["objectives"]["records"], *out["final"]["records"]):
-        if "lambda" not in rec:
+    missing = [
+        rec for rec in (*out["objectives"]["records"], *out["final"]["records"])
+        if "lambda" not in rec
+    ]  # fmt: skip
+    if missing:  # the λ variants are simulated (or read from the cache) only when needed
+        paths = lambda_paths(result["data"]["test"], n_lambda)
+        lam = {f: [Dataset.load(p) for p in ps] for f, ps in paths.items()}
+        out["data"]["lambda"] = paths
+        for rec in missing:
             rec["lambda"] = score_lambda(rec["params"], lam)
     a = out["objectives"]["records"]
     for o, per in out["objectives"]["table"].items():
@@ -498,6 +513,12 @@ def report_dirs(quick: bool = False) -> tuple[Path, Path]:
     return Path("docs/campaign"), Path("docs/report/walking-campaign")
 
 
+def _ratio_cell(x: dict[str, Any]) -> str:
+    """``0.98 [0.85, 1.10]``: a λ ratio and its interval (results made before it: the ratio)."""
+    ci = x.get("ratio_ci95")
+    return f"{x['ratio']:.2f}" + ("" if ci is None else f" [{ci[0]:.2f}, {ci[1]:.2f}]")
+
+
 def _fmt(x: float) -> str:
     return f"{x * 1e3:.4f}"
 
@@ -555,7 +576,7 @@ def lambda_table(result: dict[str, Any]) -> str:
         x = lam["factors"]
         return (
             f"| {label} | {m.upper()} | " + " | ".join(_fmt(x[f]["median"]) for f in fs) + " | "
-            + " | ".join(f"{x[f]['ratio']:.2f}" for f in others) + " | "
+            + " | ".join(_ratio_cell(x[f]) for f in others) + " | "
             + " / ".join(str(x[f]["catastrophic"]) for f in fs)
             + f" of {lam['n_runs'] * n_traj} |"
         )  # fmt: skip

@@ -144,6 +144,8 @@ def test_quick_run_lambda_check_is_the_plain_score_at_factor_one(
                 cells = np.array([r["lambda"][f]["total"] for r in recs])
                 assert x[f]["median"] == pytest.approx(np.median(cells), rel=1e-12)
                 assert x[f]["ratio"] == pytest.approx(np.median(cells) / np.median(cells1))
+                lo, hi = x[f]["ratio_ci95"]
+                assert lo <= x[f]["ratio"] <= hi
 
 
 @pytest.mark.slow
