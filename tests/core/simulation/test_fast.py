@@ -319,7 +319,15 @@ def test_range_envelopes_bound_the_window_response_beyond_each_offset(name) -> N
             assert env[0, bins * q] < 4 * resp[0][beyond].max()
 
 
-def test_range_pruning_changes_no_bit_of_the_patches() -> None:
+@pytest.mark.parametrize(
+    "settings",
+    [
+        DEFAULT_PROCESSING,
+        ProcessingSettings(range_window="rect", doppler_window="hamming"),
+        ProcessingSettings(range_window="blackman", static_clutter_removal=False),
+    ],
+)
+def test_range_pruning_changes_no_bit_of_the_patches(settings) -> None:
     """The patch kernel computes a scatterer's range responses only within its envelope's
     reach: against no pruning (an infinite envelope), every output is the same bit for bit —
     patch cells, channel values, noise draws, the map and the generator state — for strong and
@@ -340,7 +348,6 @@ def test_range_pruning_changes_no_bit_of_the_patches() -> None:
     pos = np.column_stack((rng.uniform(-3, 3, n), rng.uniform(0.02, 9, n), rng.uniform(-1, 1, n)))
     pos[:4] = [[0.0, 0.03, 0.0], [0.0, 0.06, 0.0], [0.1, 0.5, 0.0], [0.0, 0.9, 0.2]]  # wrap
     sc = scatterers(pos, rng.normal(0, 1.5, (n, 3)), rng.uniform(-30, 25, n))
-    settings = DEFAULT_PROCESSING
     spec = spectrum_tables(RADAR, settings, True)
     power = received_power_w(RADAR, sc.range_m, sc.azimuth_rad, sc.rcs_dbsm, ANT)
     amp = signal_amplitude_v(RADAR, power)
