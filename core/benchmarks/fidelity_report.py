@@ -296,7 +296,7 @@ def _plot(result: dict, path: Path) -> None:
     fps = [lv[n]["fps"] for n in names]
     ax1.set_xlim(min(fps) / 1.8, max(fps) * 1.8)  # room for the labels
     ax1.set_title("point errors against run time")
-    ax1.legend(fontsize=8, loc="lower right")
+    ax1.legend(fontsize=8, loc="center left")  # clear of the levels' markers and labels
     names = [n for n in names if n != "exact*"]
     for model, mk in (("cv", "o"), ("ca", "s")):
         xs = np.array([lv[n]["tracking"][model]["trial_cpu_s"] for n in names])
