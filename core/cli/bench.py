@@ -60,15 +60,18 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         )
     p.add_argument(
         "--person-model",
-        choices=("point", "walking", "blob"),
         default="point",
-        help="fidelity: the paper scenes' person (default: %(default)s, the paper's; walking "
-        "writes fidelity-walking.json and docs/fidelity/results-walking.md)",
+        help="fidelity: the paper scenes' person, point (the paper's, default), blob or walking "
+        "(writes fidelity-walking.json and docs/fidelity/results-walking.md)",
     )
     p.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
+    if args.person_model != "point" and args.name != "fidelity":
+        from core.errors import InputError
+
+        raise InputError(f"--person-model is for fidelity only, not {args.name!r}")
     if args.render_only:
         return _render_only(args)
     if getattr(args, "lambda_only", False):
@@ -80,9 +83,7 @@ def run(args: argparse.Namespace) -> int:
         module = importlib.import_module(f"core.benchmarks.{MODULES.get(name, name)}")
         extra, flags, stem = {}, "", f"{name}{'-quick' if args.quick else ''}"
         if name == "fidelity":
-            from core.benchmarks.fidelity_report import result_name
-
-            model = args.person_model
+            model, stem = _fidelity_model(args)
             extra = {"params_cv": args.params_cv, "params_ca": args.params_ca}
             extra["person_model"] = model
             flags = "".join(
@@ -90,7 +91,6 @@ def run(args: argparse.Namespace) -> int:
                 for m, v in (("cv", args.params_cv), ("ca", args.params_ca))
                 if v
             ) + ("" if model == "point" else f" --person-model {model}")
-            stem = result_name(model, args.quick)
         result = module.run(quick=args.quick, **extra)
         result = {
             "benchmark": name,
@@ -105,6 +105,18 @@ def run(args: argparse.Namespace) -> int:
         print(module.summary(result))
         print(f"written: {path}")
     return 0
+
+
+def _fidelity_model(args: argparse.Namespace) -> tuple[str, str]:
+    """``--person-model`` checked (one-line InputError) and the fidelity result's file stem."""
+    from core.benchmarks.fidelity_report import result_name
+    from core.errors import InputError
+    from core.scene.scene import PERSON_MODELS
+
+    model = args.person_model
+    if model not in PERSON_MODELS:
+        raise InputError(f"--person-model must be one of {list(PERSON_MODELS)}, got {model!r}")
+    return model, result_name(model, args.quick)
 
 
 def _lambda_only(args: argparse.Namespace) -> int:
@@ -161,9 +173,7 @@ def _render_only(args: argparse.Namespace) -> int:
 
     stem = f"{args.name}{'-quick' if args.quick else ''}"
     if args.name == "fidelity":
-        from core.benchmarks.fidelity_report import result_name
-
-        stem = result_name(args.person_model, args.quick)
+        stem = _fidelity_model(args)[1]
     path = Path(args.out_dir) / f"{stem}.json"
     result = _load_result(path, args.name)
     try:

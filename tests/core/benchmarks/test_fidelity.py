@@ -112,3 +112,18 @@ def test_a_walking_body_result_renders_beside_the_point_persons(tmp_path, monkey
     assert "fidelity-walking.json" in text and "mean of its scatterers" in text
     # the point person's stored result says nothing of bodies
     assert "mean of its scatterers" not in render(_stored(), quick=False)[0].read_text()
+
+
+def test_person_model_bad_or_misplaced_is_one_line_and_exit_2(tmp_path, capsys) -> None:
+    from core.cli import main
+
+    out = ["--out-dir", str(tmp_path)]
+    for argv, said in (
+        (["bench", "fidelity", "--render-only", "--person-model", "nobody"], "'nobody'"),
+        (["bench", "sim", "--person-model", "walking"], "fidelity only"),
+        (["bench", "clouds", "--render-only", "--person-model", "walking"], "fidelity only"),
+    ):
+        assert main([*argv, *out]) == 2
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and said in err[0]
+    assert list(tmp_path.iterdir()) == []
