@@ -19,10 +19,14 @@ from core.files import save_figure, write_text_atomic
 __all__ = ["render", "report_paths", "summary", "tables"]
 
 
+def _tail(person_model: str) -> str:
+    """File-name tail of a person model's report: nothing for the paper's point person."""
+    return "" if person_model == "point" else f"-{person_model}"
+
+
 def result_name(person_model: str = "point", quick: bool = False) -> str:
     """The result's file stem: ``fidelity``, ``fidelity-walking``, ``…-quick``."""
-    tail = "" if person_model == "point" else f"-{person_model}"
-    return f"fidelity{tail}{'-quick' if quick else ''}"
+    return f"fidelity{_tail(person_model)}{'-quick' if quick else ''}"
 
 
 def report_paths(quick: bool = False, person_model: str = "point") -> tuple[Path, Path]:
@@ -30,7 +34,7 @@ def report_paths(quick: bool = False, person_model: str = "point") -> tuple[Path
     if quick:
         stem = Path("bench/results") / result_name(person_model, quick)
         return stem.with_suffix(".md"), stem.with_suffix(".png")
-    tail = "" if person_model == "point" else f"-{person_model}"
+    tail = _tail(person_model)
     return Path(f"docs/fidelity/results{tail}.md"), Path(
         f"docs/fidelity/error_vs_runtime{tail}.png"
     )
@@ -224,7 +228,8 @@ def _write_table(result: dict, path: Path) -> None:
     who = "" if model == "point" else f" ({model} person)"
     text = (
         f"# Fidelity levels: error against run time{who}\n\n"
-        f"Command: `radartune bench fidelity{flag}` (writes this file, the plot and "
+        f"Command: `{result.get('command', 'radartune bench fidelity' + flag)}` (writes this "
+        "file, the plot and "
         f"`bench/results/{result_name(model)}.json`, which holds every figure; "
         f"`radartune bench fidelity{flag} --render-only` re-renders this file and the plot from "
         "it).\n\n"

@@ -90,14 +90,15 @@ def test_render_only_without_a_stored_result_is_one_line_and_exit_2(tmp_path, ca
 def test_a_walking_body_result_renders_beside_the_point_persons(tmp_path, monkeypatch) -> None:
     """``--person-model walking`` reads ``fidelity-walking.json`` and writes
     ``results-walking.md`` and its plot, leaving the point person's report alone; its header
-    names the command with the flag and says how a body's point errors are taken."""
+    names the command the result was made with and says how a body's point errors are taken."""
     import json
 
     from core.cli import main
 
     out = tmp_path / "results"
     out.mkdir()
-    result = {**_stored(), "person_model": "walking"}
+    command = "radartune bench fidelity --person-model walking"
+    result = {**_stored(), "person_model": "walking", "command": command}
     (out / "fidelity-walking.json").write_text(json.dumps(result))
     monkeypatch.chdir(tmp_path)
     argv = ["bench", "fidelity", "--render-only", "--person-model", "walking"]
@@ -108,7 +109,8 @@ def test_a_walking_body_result_renders_beside_the_point_persons(tmp_path, monkey
         "results-walking.md",
     ]
     text = (docs / "results-walking.md").read_text()
-    assert "`radartune bench fidelity --person-model walking`" in text
+    assert f"Command: `{command}`" in text
+    assert f"`{command} --render-only`" in text
     assert "fidelity-walking.json" in text and "mean of its scatterers" in text
     # the point person's stored result says nothing of bodies
     assert "mean of its scatterers" not in render(_stored(), quick=False)[0].read_text()
