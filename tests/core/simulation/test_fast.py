@@ -43,6 +43,14 @@ SCENE = scatterers(
 )
 
 
+#: processing settings that cover every range window family the fast level's closed form uses
+WINDOWS = [
+    DEFAULT_PROCESSING,
+    ProcessingSettings(range_window="rect", doppler_window="hamming"),
+    ProcessingSettings(range_window="blackman", static_clutter_removal=False),
+]
+
+
 def exact_doppler_cube(sc: Scatterers, settings=DEFAULT_PROCESSING) -> np.ndarray:
     rc = range_fft(synthesize_signal(RADAR, sc, ANT), settings.range_window)
     if settings.static_clutter_removal:
@@ -50,14 +58,7 @@ def exact_doppler_cube(sc: Scatterers, settings=DEFAULT_PROCESSING) -> np.ndarra
     return doppler_fft(rc, settings.doppler_window)
 
 
-@pytest.mark.parametrize(
-    "settings",
-    [
-        DEFAULT_PROCESSING,
-        ProcessingSettings(range_window="rect", doppler_window="hamming"),
-        ProcessingSettings(range_window="blackman", static_clutter_removal=False),
-    ],
-)
+@pytest.mark.parametrize("settings", WINDOWS)
 def test_noise_free_spectrum_equals_exact(settings) -> None:
     """Closed-form cells equal the exact chain's Doppler cube; the patch holds its energy."""
     dc = exact_doppler_cube(SCENE, settings)
@@ -319,14 +320,7 @@ def test_range_envelopes_bound_the_window_response_beyond_each_offset(name) -> N
             assert env[0, bins * q] < 4 * resp[0][beyond].max()
 
 
-@pytest.mark.parametrize(
-    "settings",
-    [
-        DEFAULT_PROCESSING,
-        ProcessingSettings(range_window="rect", doppler_window="hamming"),
-        ProcessingSettings(range_window="blackman", static_clutter_removal=False),
-    ],
-)
+@pytest.mark.parametrize("settings", WINDOWS)
 def test_range_pruning_changes_no_bit_of_the_patches(settings) -> None:
     """The patch kernel computes a scatterer's range responses only within its envelope's
     reach: against no pruning (an infinite envelope), every output is the same bit for bit —
