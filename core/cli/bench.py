@@ -81,9 +81,9 @@ def run(args: argparse.Namespace) -> int:
     out_dir.mkdir(parents=True, exist_ok=True)
     for name in names:
         module = importlib.import_module(f"core.benchmarks.{MODULES.get(name, name)}")
-        extra, flags, stem = {}, "", f"{name}{'-quick' if args.quick else ''}"
+        extra, flags, stem = {}, "", _result_stem(name, args)
         if name == "fidelity":
-            model, stem = _fidelity_model(args)
+            model = args.person_model  # checked by _result_stem
             extra = {"params_cv": args.params_cv, "params_ca": args.params_ca}
             extra["person_model"] = model
             flags = "".join(
@@ -107,8 +107,12 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-def _fidelity_model(args: argparse.Namespace) -> tuple[str, str]:
-    """``--person-model`` checked (one-line InputError) and the fidelity result's file stem."""
+def _result_stem(name: str, args: argparse.Namespace) -> str:
+    """A benchmark result's file stem in ``--out-dir``: ``<name>[-quick]``; for fidelity
+    :func:`~core.benchmarks.fidelity_report.result_name` of ``--person-model``, checked against
+    the scene's person models (one-line InputError)."""
+    if name != "fidelity":
+        return f"{name}{'-quick' if args.quick else ''}"
     from core.benchmarks.fidelity_report import result_name
     from core.errors import InputError
     from core.scene.scene import PERSON_MODELS
@@ -116,7 +120,7 @@ def _fidelity_model(args: argparse.Namespace) -> tuple[str, str]:
     model = args.person_model
     if model not in PERSON_MODELS:
         raise InputError(f"--person-model must be one of {list(PERSON_MODELS)}, got {model!r}")
-    return model, result_name(model, args.quick)
+    return result_name(model, args.quick)
 
 
 def _lambda_only(args: argparse.Namespace) -> int:
@@ -126,7 +130,7 @@ def _lambda_only(args: argparse.Namespace) -> int:
 
     if args.name != "campaign":
         raise InputError(f"--lambda-only is for campaign only, not {args.name!r}")
-    path = Path(args.out_dir) / f"campaign{'-quick' if args.quick else ''}.json"
+    path = Path(args.out_dir) / f"{_result_stem('campaign', args)}.json"
     result = _load_result(path, args.name)
     try:
         result = add_lambda(result, quick=args.quick)
@@ -171,10 +175,7 @@ def _render_only(args: argparse.Namespace) -> int:
     else:
         from core.benchmarks.samplers import render, summary  # type: ignore[assignment]
 
-    stem = f"{args.name}{'-quick' if args.quick else ''}"
-    if args.name == "fidelity":
-        stem = _fidelity_model(args)[1]
-    path = Path(args.out_dir) / f"{stem}.json"
+    path = Path(args.out_dir) / f"{_result_stem(args.name, args)}.json"
     result = _load_result(path, args.name)
     try:
         written = render(result, quick=args.quick)

@@ -187,12 +187,12 @@ def fast_spectrum(
     detected cells are rebuilt from the same draws by :func:`detected_channels`.
     """
     n_r, n_d, n_v = radar.n_samples, radar.n_loops, radar.n_virtual
-    s2 = cell_noise_power_v2(radar, settings)  # (n_d,)
     n_use = n_r if n_range_bins is None else max(0, min(n_r, int(n_range_bins)))
+    spec = spectrum_tables(radar, settings, True)._replace(n_use=n_use)
     state = state6(state_from(rng if noise else None))
     rd = np.zeros((n_r, n_d), dtype=np.float32)
     if noise:
-        noise_map(state, rd, s2, n_use, n_v)
+        noise_map(state, rd, spec.s2, n_use, n_v)
     if len(scatterers) == 0:
         e = np.zeros(0)
         return Spectrum(
@@ -209,23 +209,12 @@ def fast_spectrum(
     )
     # theta = 2 pi (2 S R / c) / Fs   (rad per sample)
     theta = beat_rad_per_sample_per_m(radar) * r_mid
+    slow, slow1 = slow_time_sequences(radar, scatterers, settings)
     k_idx, d_idx, x, along, ortho = patches_kernel(
-        state,
-        rd,
-        amp,
-        theta,
-        *slow_time_sequences(radar, scatterers, settings),
-        doppler_weights(settings.doppler_window, n_d),
-        cosine_sum_coefficients(settings.range_window, n_r),
-        s2,
-        steering_vectors(radar, scatterers),
-        np.arange(n_v) // radar.n_rx,
-        PATCH_THRESHOLD,
-        *twiddles(n_r, n_d),
-        range_envelopes(settings.range_window, n_r),
-        noise,
-        n_use,
-    )
+        state, rd, amp, theta, slow, slow1, spec.wd, spec.b, spec.s2,
+        steering_vectors(radar, scatterers), spec.slot, spec.threshold, spec.half_r, spec.tw_d,
+        spec.env, noise, n_use,
+    )  # fmt: skip
     return Spectrum(rd, np.column_stack((k_idx, d_idx)).astype(np.int64), x, along, ortho, state)
 
 
