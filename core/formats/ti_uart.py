@@ -41,7 +41,7 @@ import math
 import os
 import struct
 from collections import Counter
-from collections.abc import Callable, Iterable, Iterator
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import NamedTuple, Protocol, TypeVar
@@ -592,6 +592,10 @@ class RawPacket(NamedTuple):
     side_info: bytes
     points: UartPoints | None
     extras: tuple[str, ...]
+    #: The firmware's own tracks (TLV 1010 / 308, :data:`TARGET_3D` records) and target index
+    #: (TLV 1011 / 309, one byte per point of the previous frame), when the packet has them.
+    targets: np.ndarray | None = None
+    target_index: np.ndarray | None = None
 
 
 #: TLV types whose payload the fast path checks by length only.
@@ -614,6 +618,7 @@ def parse_packet_raw(
             continue
         float_points = side = b""
         names: list[str] = []
+        targets = target_index = None
         simple = True
         for t, off, n in tlvs:
             if t == DETECTED_POINTS:
@@ -633,6 +638,10 @@ def parse_packet_raw(
                     simple = False
                     break
                 names.append(AUX_TLVS[t][0])
+                if t in (TARGET_LIST_3D, EXT_TARGET_LIST):
+                    targets = _records(packet, off, n, TARGET_3D).copy()
+                elif t in (TARGET_INDEX, EXT_TARGET_INDEX):
+                    target_index = _records(packet, off, n, np.dtype("u1")).copy()
             else:  # other point formats, unknown types: the full decoder
                 simple = False
                 break
@@ -645,6 +654,8 @@ def parse_packet_raw(
                 side,
                 None,
                 tuple(names),
+                targets,
+                target_index,
             )
         break
     frame = _parse_packet(packet, offset, radar, rep, src)
@@ -658,6 +669,8 @@ def parse_packet_raw(
         b"",
         frame.points,
         tuple(frame.extras),
+        frame.extras.get("targets"),
+        frame.extras.get("target_index"),
     )
 
 
@@ -871,8 +884,11 @@ def encode_frame(
     fmt: str = "sdk3",
     radar: RadarConfig | None = None,
     time_cpu_cycles: int = 0,
+    extra_tlvs: Sequence[tuple[int, bytes]] = (),
 ) -> bytes:
-    """One packet holding ``cloud`` in point format ``fmt`` (:data:`WRITE_FORMATS`).
+    """One packet holding ``cloud`` in point format ``fmt`` (:data:`WRITE_FORMATS`), then the
+    TLVs ``extra_tlvs`` (type, payload) as given (e.g. TI's tracks, 1010, and target index,
+    1011).
 
     ``sdk3``: float points (type 1) and side info (type 7), 40-byte header, xWR68xx;
     ``sdk2``: Q9 points (type 1 with descriptor), 40-byte header (xWR16xx SDK 2.x);
@@ -939,6 +955,7 @@ def encode_frame(
         tlvs.append((COMPRESSED_POINTS, u.tobytes() + p.tobytes()))
     else:
         raise InputError(f"UART point format must be one of {list(WRITE_FORMATS)}, got {fmt!r}")
+    tlvs += list(extra_tlvs)
     hdr_dtype = HEADER_36 if fmt == "sdk1-xwr14" else HEADER_40
     body = b"".join(np.array([(t, len(pl))], TLV_HEADER).tobytes() + pl for t, pl in tlvs)
     used = hdr_dtype.itemsize + len(body)
