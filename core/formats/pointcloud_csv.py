@@ -38,6 +38,7 @@ from core.formats.recording import (
     point_tracks_from_indices,
     points_to_cloud,
 )
+from core.formats.ti_uart import linear_snr_db, peak_db
 from core.limits import FRAME_PERIOD_RANGE_S
 
 #: Names of the three CSV rows of :data:`core.recordings.FORMATS`.
@@ -337,14 +338,10 @@ def read_oob(path: Path, radar: RadarConfig | None) -> Recording:
     slot, t_s, trajectory, cfg, notes = _frame_grid(numbers, times, radar, src, "out-of-box CSV")
     pts = ~placeholder
     if extra >= 1:
-        intensity = a[:, 6]
-        with np.errstate(divide="ignore", invalid="ignore"):
-            snr = np.where(
-                intensity > 0, 10.0 * np.log10(np.where(intensity > 0, intensity, 1.0)), np.nan
-            )
+        snr = peak_db(a[:, 6])
         notes.append(
-            "SNR: 10·log10(Intensity), the linear peak value on a dB scale (the noise level is "
-            "not in the file: it ranks points, it is not the demo's SNR)"
+            "SNR: 20·log10(Intensity), the linear peak value on a dB scale (the noise level is "
+            "not in the file: it ranks points, it is not an SNR)"
         )
     else:
         snr = np.full(n_rows, np.nan)
@@ -476,8 +473,7 @@ def read_people(path: Path, radar: RadarConfig | None) -> Recording:
     else:
         doppler, order_note = c2, "Doppler before range"
     snr_lin, snr_note = _unsigned_snr(snr_raw)
-    with np.errstate(divide="ignore"):
-        snr_db = np.where(snr_lin > 0, 10.0 * np.log10(np.where(snr_lin > 0, snr_lin, 1.0)), np.nan)
+    snr_db = linear_snr_db(snr_lin)
     notes.insert(
         0,
         f"{src}: {len(rows['v6'])} points (v6, {order_note} in this file), "

@@ -774,7 +774,7 @@ def _detected_points(
                 y_m=p["y"] * scale,
                 z_m=p["z"] * scale,
                 velocity_mps=p["doppler_idx"] * dv,
-                snr_db=nan,
+                snr_db=peak_db(p["peak"]),
                 noise_db=nan,
             ),
             "q",
@@ -790,6 +790,29 @@ def _detected_points(
         ),
         "float",
     )
+
+
+def peak_db(peak: np.ndarray) -> np.ndarray:
+    """The level of SDK 1.x/2.x points in dB from their ``peakVal``: ``20·log10(peakVal)``.
+
+    TI's SDK 1.x/2.x demos set ``peakVal`` to the magnitude of the angle-FFT peak,
+    ``sqrt(max|X_az|² / (N_range·N_angle·N_Doppler))`` (xWR16xx DSP data path; the xWR14xx
+    hardware accelerator's ``|X_az|`` directly), a linear amplitude: 20·log10 puts it on a dB
+    scale. The packet carries no noise level, so this is the point's level above one FFT unit,
+    not a signal-to-noise ratio (for SDK 3, TI gives ``peak dB = snr + noise``, both in the side
+    info). ``peakVal`` 0 gives NaN (no level)."""
+    a = np.asarray(peak, dtype=np.float64)
+    with np.errstate(divide="ignore"):
+        return np.where(a > 0, 20.0 * np.log10(np.where(a > 0, a, 1.0)), np.nan)
+
+
+def linear_snr_db(snr: np.ndarray) -> np.ndarray:
+    """The people-tracking demo's point SNR, which TI's output structure documents as linear
+    (``Pcount3DDemo_output_message_point.snr``: "Range detection SNR, linear"), in dB:
+    ``10·log10(snr)``; 0 (or less) gives NaN."""
+    a = np.asarray(snr, dtype=np.float64)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(a > 0, 10.0 * np.log10(np.where(a > 0, a, 1.0)), np.nan)
 
 
 def _ext_points(packet: bytes, off: int, n: int) -> UartPoints:
@@ -832,7 +855,7 @@ def _compressed_points(packet: bytes, off: int, n: int) -> UartPoints:
         p["azimuth"] * az_u,
         p["elevation"] * el_u,
         p["doppler"] * dop_u,
-        p["snr"] * snr_u,
+        linear_snr_db(p["snr"] * snr_u),
     )
 
 
@@ -863,7 +886,8 @@ COMPRESSED_UNITS = {
     "azimuth_unit": math.pi / 127,
     "doppler_unit": 2.0**-8,
     "range_unit": 2.0**-8,
-    "snr_unit": 0.04,
+    # linear SNR steps of 0.25: up to 16 383 (42 dB), 0.17 dB steps at 5 dB
+    "snr_unit": 0.25,
 }
 #: Platform codes written in the header.
 PLATFORM = {"xwr68xx": 0xA6843, "xwr14xx": 0xA1443, "xwrl6432": 0x6432}
@@ -920,7 +944,8 @@ def encode_frame(
         p["range_idx"] = _clip_round(
             np.asarray(cloud.range_m) / radar.range_resolution_m, np.uint16
         )
-        p["peak"] = _clip_round(np.maximum(snr, 0) * 100, np.uint16)
+        # peakVal: the amplitude whose 20·log10 is the level (the reader's peak_db)
+        p["peak"] = np.maximum(_clip_round(10.0 ** (snr / 20.0), np.uint16), 1)
         tlvs.append((DETECTED_POINTS, d.tobytes() + p.tobytes()))
         if fmt == "sdk1-xwr14":
             platform = PLATFORM["xwr14xx"]
@@ -951,7 +976,8 @@ def encode_frame(
         p["range"] = _clip_round(
             np.asarray(cloud.range_m) / COMPRESSED_UNITS["range_unit"], np.uint16
         )
-        p["snr"] = _clip_round(snr / COMPRESSED_UNITS["snr_unit"], np.uint16)
+        # the demo's SNR is linear (see linear_snr_db)
+        p["snr"] = _clip_round(10.0 ** (snr / 10.0) / COMPRESSED_UNITS["snr_unit"], np.uint16)
         tlvs.append((COMPRESSED_POINTS, u.tobytes() + p.tobytes()))
     else:
         raise InputError(f"UART point format must be one of {list(WRITE_FORMATS)}, got {fmt!r}")
