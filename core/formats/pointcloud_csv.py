@@ -520,7 +520,7 @@ def _integers(cells: list[str], lines: np.ndarray, src: str, field: str) -> np.n
 
 
 #: A host time stamp of the vendor CSV.
-_STAMP = re.compile(r"^\d{4}-\d{2}-\d{2}[ T]\d{2}:\d{2}:\d{2}(\.\d{1,9})?$")
+_STAMP = re.compile(r"^\d{4}-\d{2}-\d{2}[ T]\d{2}:\d{2}:\d{2}(\.\d{1,9})?$", re.ASCII)
 
 
 def _timestamps(cells: list[str], lines: np.ndarray, src: str) -> np.ndarray:
