@@ -417,8 +417,20 @@ def track_frame(ft) -> TrackFrame:
     names, per track); otherwise −1 and NaN.
     """
     n = len(ft.ids)
-    state = np.asarray(ft.state, dtype=float).reshape(n, -1)
-    cov = np.asarray(ft.covariance, dtype=float).reshape(n, state.shape[1], state.shape[1])
+    state = np.asarray(ft.state, dtype=float)
+    # no track (a recording that opens with empty frames): a (0, 4) state, not a reshape of
+    # an empty array whose width cannot be inferred
+    state = (
+        state.reshape(n, -1)
+        if n
+        else np.zeros((0, max(4, state.shape[-1] if state.ndim == 2 else 4)))
+    )
+    dim = state.shape[1]
+    cov = (
+        np.asarray(ft.covariance, dtype=float).reshape(n, dim, dim)
+        if n
+        else np.zeros((0, dim, dim))
+    )
     n_assoc = getattr(ft, "n_associated", None)
     nis = getattr(ft, "nis", None)
     return TrackFrame(
