@@ -331,8 +331,12 @@ def align_truth(truth: np.ndarray, alignment: TruthAlignment) -> np.ndarray:
         return truth
     out = truth.copy()
     out["time_s"] = alignment.times(truth["time_s"])
-    xyz = alignment.positions(truth["x_m"], truth["y_m"], truth["z_m"])
-    out["x_m"], out["y_m"], out["z_m"] = xyz[:, 0], xyz[:, 1], xyz[:, 2]
+    has_z = "z_m" in (truth.dtype.names or ())
+    z = truth["z_m"] if has_z else np.full(len(truth), np.nan)
+    xyz = alignment.positions(truth["x_m"], truth["y_m"], z)
+    out["x_m"], out["y_m"] = xyz[:, 0], xyz[:, 1]
+    if has_z:
+        out["z_m"] = xyz[:, 2]
     return np.sort(out, order=("time_s", "person"))
 
 

@@ -55,6 +55,11 @@ def test_time_offset_and_drift() -> None:
     )
     out = align_truth(truth, a)
     assert out["time_s"][0] == pytest.approx(0.1) and out["x_m"][0] == 1.0
+    # a truth array without z_m (built by hand) aligns too
+    flat = np.array([(100.0, 0, 1.0, 2.0)], dtype=[("time_s", "f8"), ("person", "i4"),
+                    ("x_m", "f8"), ("y_m", "f8")])  # fmt: skip
+    moved = align_truth(flat, TruthAlignment(offset_s=-100.0, sensor_x_m=1.0))
+    assert moved["x_m"][0] == 0.0 and moved["time_s"][0] == 0.0
 
 
 def _walk(tmp_path: Path) -> Path:
