@@ -29,6 +29,7 @@ from core.limits import (
 from core.scene.aoi import AOI
 from core.scene.body import N_BODY_SCATTERERS
 from core.scene.clutter import check_clutter_radar, expected_clutter_count
+from core.scene.room import N_FURNITURE_SCATTERERS, ROOM_KEYS, Room, parse_room
 from core.scene.trajectory import (
     TRAJECTORY_CLASSES,
     Trajectory,
@@ -55,6 +56,10 @@ SCENE_KEYS = (
     "aoi",
     "static_reflectors",
     "persons",
+    # a room (docs/rooms.md): written only when the scene has one
+    "walls",
+    "furniture",
+    "sensor",
 )
 PERSON_KEYS = ("trajectory", "rcs_dbsm", "model", "height_m", "gait_phase")
 #: Person models: the paper's point, the 5-scatterer blob (:mod:`core.scene.body`) and the
@@ -185,6 +190,8 @@ class Scene:
     aoi: AOI = field(default_factory=AOI)
     static_reflectors: tuple[StaticReflector, ...] = ()
     persons: tuple[Person, ...] = ()
+    #: walls, furniture and sensor pose (docs/rooms.md); ``None``: the paper's open field
+    room: Room | None = None
 
     def __post_init__(self) -> None:
         if not (isinstance(self.seed, int) and not isinstance(self.seed, bool) and self.seed >= 0):
@@ -210,8 +217,10 @@ class Scene:
     def is_planar(self) -> bool:
         """True when every reflector has z = 0 (point and blob persons are at z = 0; walking
         bodies have their segments at their heights)."""
-        return all(r.z_m == 0.0 for r in self.static_reflectors) and not any(
-            p.kind == "walking" for p in self.persons
+        return (
+            all(r.z_m == 0.0 for r in self.static_reflectors)
+            and not any(p.kind == "walking" for p in self.persons)
+            and self.room is None
         )
 
     @property
@@ -251,7 +260,7 @@ class Scene:
             radar = self.radar_spec
         else:
             radar = dict(self.radar_spec)
-        return {
+        d = {
             "schema_version": SCHEMA_VERSION,
             "radar": radar,
             "seed": self.seed,
@@ -260,6 +269,9 @@ class Scene:
             "static_reflectors": [r.to_dict() for r in self.static_reflectors],
             "persons": [p.to_dict() for p in self.persons],
         }
+        if self.room is not None:
+            d.update(self.room.to_dict())
+        return d
 
     def to_json(self, path: str | os.PathLike | None = None) -> str:
         """The scene as JSON text; with ``path``, also written atomically (temp file + rename)."""
@@ -507,6 +519,7 @@ def _parse_scene(data: Any, base_dir: Path) -> Scene:
                 rcs_dbsm=_number(r.get("rcs_dbsm", 10.0), f"{where}.rcs_dbsm", *RCS_RANGE_DBSM),
             )
         )
+    room = parse_room(data) if any(k in data for k in ROOM_KEYS) else None
     persons_d = data.get("persons", [])
     if not isinstance(persons_d, list):
         raise InputError("persons must be a list")
@@ -564,6 +577,7 @@ def _parse_scene(data: Any, base_dir: Path) -> Scene:
     scatterers = (
         sum(scatterers_per_person(p.model) for p in persons)
         + len(reflectors)
+        + (N_FURNITURE_SCATTERERS * len(room.furniture) if room is not None else 0)
         + expected_clutter_count(aoi, density)
     )
     if n_frames * scatterers > MAX_SCATTERER_FRAMES:
@@ -586,6 +600,7 @@ def _parse_scene(data: Any, base_dir: Path) -> Scene:
         aoi=aoi,
         static_reflectors=tuple(reflectors),
         persons=tuple(persons),
+        room=room,
     )
 
 
