@@ -55,10 +55,13 @@ class Dataset:
     radar_json: str
     fidelity: str = "exact"
     seed: int = 0
+    #: ``(P,)`` int8 wall bounces of each point's path (PointCloud.path_order); ``None`` where
+    #: the simulation had no room (the file then has no such array)
+    path_order: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         p = np.shape(self.frame)[0] if np.ndim(self.frame) == 1 else -1
-        for name in PER_POINT:
+        for name in (*PER_POINT, *(("path_order",) if self.path_order is not None else ())):
             if np.shape(getattr(self, name)) != (p,):
                 raise ValueError(
                     f"Dataset.{name} must have shape (P,) like frame, got "
@@ -152,7 +155,9 @@ class Dataset:
         """The point cloud of one global frame."""
         lo, hi = np.searchsorted(self.frame, [frame, frame + 1])
         return PointCloud(
-            **{f: getattr(self, f)[lo:hi] for f in POINT_FIELDS}, source=self.source[lo:hi]
+            **{f: getattr(self, f)[lo:hi] for f in POINT_FIELDS},
+            source=self.source[lo:hi],
+            path_order=None if self.path_order is None else self.path_order[lo:hi],
         )
 
     def scene(self) -> dict:
@@ -225,6 +230,9 @@ class Dataset:
             radar_json=radar_json,
             fidelity=fidelity,
             seed=int(seed),
+            path_order=None
+            if merged.path_order is None
+            else np.asarray(merged.path_order, dtype=np.int8),
         )
 
     # ---- files -------------------------------------------------------------------------------
@@ -238,6 +246,8 @@ class Dataset:
         arrays["radar_json"] = np.array(self.radar_json)
         arrays["fidelity"] = np.array(self.fidelity)
         arrays["seed"] = np.array(self.seed)
+        if self.path_order is not None:
+            arrays["path_order"] = self.path_order
         write_npz_atomic(path, arrays)
         return path
 
@@ -252,6 +262,8 @@ class Dataset:
         kw: dict = {}
         for k in (*PER_POINT, *PER_FRAME, "trajectory_class"):
             kw[k] = _typed(data[k], k, src)
+        if "path_order" in data:
+            kw["path_order"] = _typed(data["path_order"], "path_order", src).astype(np.int8)
         for k in ("scene_json", "radar_json", *(("fidelity",) if "fidelity" in data else ())):
             kw[k] = _text(data[k], k, src)
         if kw["scene_json"]:
@@ -276,7 +288,7 @@ class Dataset:
 
 
 #: dtype kinds accepted per array: integers for indices, real numbers for values, text for class.
-_INTEGER_ARRAYS = ("frame", "source", "trajectory")
+_INTEGER_ARRAYS = ("frame", "source", "trajectory", "path_order")
 
 
 def _typed(a: np.ndarray, name: str, src: str) -> np.ndarray:

@@ -298,8 +298,8 @@ def _radar_inside(walls: tuple[Wall, ...]) -> bool:
     """Whether the radar at the origin is inside the room (or mounted on a wall).
 
     On (within :data:`MOUNT_TOLERANCE_M` of) a wall: inside. Walls that close into a loop
-    (every endpoint shared by two walls): the even-odd rule. Open walls (a corridor): inside
-    their bounding box along each axis the walls span.
+    (every endpoint shared by two walls): the even-odd rule. Open walls (a corridor, a lone
+    wall) enclose nothing: inside.
     """
     a = np.array([w.from_m for w in walls], dtype=np.float64)
     b = np.array([w.to_m for w in walls], dtype=np.float64)
@@ -309,13 +309,10 @@ def _radar_inside(walls: tuple[Wall, ...]) -> bool:
         return True
     ends = np.round(np.concatenate((a, b)), 6)
     _, counts = np.unique(ends, axis=0, return_counts=True)
-    if np.all(counts == 2):
-        # even-odd: walls crossing the ray x > 0 along y = 0
-        crosses = (a[:, 1] > 0) != (b[:, 1] > 0)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            x = a[:, 0] - a[:, 1] * ab[:, 0] / ab[:, 1]
-        return bool(np.sum(crosses & (x > 0)) % 2 == 1)
-    lo, hi = np.minimum(a, b).min(axis=0), np.maximum(a, b).max(axis=0)
-    spans = hi - lo > 2 * MOUNT_TOLERANCE_M  # a lone wall constrains only along itself
-    inside = (lo <= MOUNT_TOLERANCE_M) & (hi >= -MOUNT_TOLERANCE_M)
-    return bool(np.all(inside | ~spans))
+    if not np.all(counts == 2):
+        return True  # open walls (a corridor, a lone wall) enclose nothing to be outside of
+    # even-odd: walls crossing the ray x > 0 along y = 0
+    crosses = (a[:, 1] > 0) != (b[:, 1] > 0)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        x = a[:, 0] - a[:, 1] * ab[:, 0] / ab[:, 1]
+    return bool(np.sum(crosses & (x > 0)) % 2 == 1)
