@@ -249,7 +249,7 @@ class Reflectors:
         """Each frame's reflectors in the scene's room (furniture, bounce paths, sensor pose;
         :func:`core.simulation.multipath.room_frame`), their ``source`` the path labels."""
         from core import simulation as sim
-        from core.simulation.multipath import room_frame
+        from core.simulation.multipath import room_frames
 
         room = self.scene.room
         assert room is not None
@@ -264,15 +264,19 @@ class Reflectors:
         # the floor (core.scene.walking); a room's coordinates start at the floor
         position = position.copy()
         position[source >= 0, 2] += RADAR_HEIGHT_M
+        n_f = len(start) - 1
+        frame = np.repeat(np.arange(n_f), np.diff(start))
+        slot = np.arange(len(frame)) - start[frame]
+        clutter = (slot >= first_clutter[frame]) & (slot < (first_clutter + n_clutter)[frame])
+        pos, vel, rcs_all, labels, at = room_frames(
+            room, position, velocity, rcs, source, clutter, frame, n_f, antenna, snr_db
+        )
+        whole_ok = _arrays_ok(pos, vel, rcs_all)
         out = []
-        for row in range(len(start) - 1):
-            s = slice(start[row], start[row + 1])
-            clutter = np.zeros(start[row + 1] - start[row], dtype=bool)
-            clutter[first_clutter[row] : first_clutter[row] + n_clutter[row]] = True
-            part = room_frame(
-                room, position[s], velocity[s], rcs[s], source[s], clutter, antenna, snr_db
-            )
-            out.append(_scatterers(sim, *part))
+        for row in range(n_f):
+            s = slice(at[row], at[row + 1])
+            part = (pos[s], vel[s], rcs_all[s], labels[s])
+            out.append(_checked_scatterers(sim, *part) if whole_ok else _scatterers(sim, *part))
         return out
 
     def _walking_rows(self, i, frames, xy, v, rcs):

@@ -290,25 +290,45 @@ def split_labels(labels: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 #: The bounce paths of a person's body start from this many proxies (docs/rooms.md): its
 #: scatterers sorted by speed and cut into groups of consecutive speeds.
 GHOST_GROUPS = 3
-#: Furniture: one proxy per piece (its five scatterers together).
 
 
-def ghost_groups(source: np.ndarray, velocity_mps: np.ndarray, furniture: np.ndarray) -> np.ndarray:
-    """``(N,)`` the proxy each reflector's bounce paths start from.
+def ghost_groups(
+    source: np.ndarray,
+    velocity_mps: np.ndarray,
+    furniture: np.ndarray,
+    frame: np.ndarray | None = None,
+) -> np.ndarray:
+    """``(N,)`` the proxy each reflector's bounce paths start from (the index of the proxy's
+    first member).
 
-    A person's scatterers (``source >= 0``) are sorted by speed and split into
-    :data:`GHOST_GROUPS` groups of (nearly) equal counts; a piece of furniture (five consecutive
-    ``furniture`` reflectors) is one group; any other reflector is its own group.
+    A person's scatterers (``source >= 0``) of one frame (``frame``, default all one frame)
+    are sorted by speed and split into :data:`GHOST_GROUPS` groups of (nearly) equal counts,
+    as ``numpy.array_split`` cuts them; a piece of furniture (five consecutive ``furniture``
+    reflectors) is one group; any other reflector is its own group.
     """
     n = len(source)
+    source = np.asarray(source, dtype=np.int64)
+    frame = np.zeros(n, dtype=np.int64) if frame is None else np.asarray(frame, dtype=np.int64)
     group = np.arange(n, dtype=np.int64)
-    for p in np.unique(source[source >= 0]):
-        idx = np.flatnonzero(source == p)
-        if len(idx) <= GHOST_GROUPS:
-            continue
-        by_speed = idx[np.argsort(np.linalg.norm(velocity_mps[idx], axis=1), kind="stable")]
-        for part in np.array_split(by_speed, GHOST_GROUPS):
-            group[part] = part[0]
+    person = np.flatnonzero(source >= 0)
+    if len(person):
+        speed = np.linalg.norm(velocity_mps[person], axis=1)
+        order = person[np.lexsort((speed, source[person], frame[person]))]
+        key = frame[order] * (int(source.max()) + 1) + source[order]
+        first = np.flatnonzero(np.r_[True, key[1:] != key[:-1]])
+        count = np.diff(np.r_[first, len(order)])
+        rank = np.arange(len(order)) - np.repeat(first, count)
+        size = np.repeat(count, count)
+        g = np.minimum(GHOST_GROUPS, size)
+        # numpy.array_split: the first (size % g) parts have one more member
+        big, small = size // g + 1, size // g
+        n_big = size % g
+        part = np.where(rank < n_big * big, rank // big, n_big + (rank - n_big * big) // small)
+        # a group is named by its first member in the sorted order
+        start = np.repeat(first, count) + np.where(
+            part < n_big, part * big, n_big * big + (part - n_big) * small
+        )
+        group[order] = order[start]
     f = np.flatnonzero(furniture)
     if len(f):
         group[f] = f[(np.arange(len(f)) // N_FURNITURE_SCATTERERS) * N_FURNITURE_SCATTERERS]
@@ -318,87 +338,101 @@ def ghost_groups(source: np.ndarray, velocity_mps: np.ndarray, furniture: np.nda
 def group_proxies(group, position_m, velocity_mps, rcs_dbsm, source):
     """One proxy per group: the RCS the group's powers sum to, ``sigma_g = sum sigma_k``, at the
     power-weighted mean position and velocity. Returns ``(G, 3)``, ``(G, 3)``, ``(G,)``,
-    ``(G,)`` in the order of the groups' first members."""
+    ``(G,)`` and the groups' keys ``(G,)`` (sorted)."""
     keys, inverse = np.unique(group, return_inverse=True)
     w = 10 ** (np.asarray(rcs_dbsm) / 10)
     total = np.bincount(inverse, weights=w, minlength=len(keys))
-    pos = np.column_stack(
-        [np.bincount(inverse, weights=w * position_m[:, c], minlength=len(keys)) for c in range(3)]
-    )
-    vel = np.column_stack(
-        [
-            np.bincount(inverse, weights=w * velocity_mps[:, c], minlength=len(keys))
-            for c in range(3)
-        ]
-    )
+    cols = [
+        np.bincount(inverse, weights=w * a[:, c], minlength=len(keys))
+        for a in (position_m, velocity_mps)
+        for c in range(3)
+    ]
     return (
-        pos / total[:, None],
-        vel / total[:, None],
+        np.column_stack(cols[:3]) / total[:, None],
+        np.column_stack(cols[3:]) / total[:, None],
         10 * np.log10(total),
         np.asarray(source)[keys],
+        keys,
     )
 
 
-def room_frame(
+def room_frames(
     room: Room,
     position_m: np.ndarray,
     velocity_mps: np.ndarray,
     rcs_dbsm: np.ndarray,
     source: np.ndarray,
     clutter: np.ndarray,
+    frame: np.ndarray,
+    n_frames: int,
     antenna: AntennaGain,
-    snr_floor_db,
+    snr_db,
 ):
-    """One frame's reflectors in a room, in sensor coordinates, with their path labels.
+    """Every frame's reflectors in a room, in sensor coordinates, with their path labels.
 
     ``position_m``, ``velocity_mps`` ``(N, 3)``: persons and static reflectors in room
     coordinates; clutter (``clutter`` ``(N,)`` bool) is already in sensor coordinates (it stands
-    for returns drawn around the radar). The room's furniture is added (static, label
-    ``STATIC_LABEL``), then every non-clutter reflector's bounce paths (:func:`image_paths`)
-    whose SNR ``snr_floor_db(range_m, azimuth_rad, rcs_dbsm)`` (post-processing, dB) reaches
-    :data:`GHOST_FLOOR_SNR_DB`. Returns positions, velocities (sensor coordinates), RCS and
-    labels (:func:`path_labels`).
+    for returns drawn around the radar); ``frame`` ``(N,)`` each reflector's frame
+    (non-decreasing, ``0 .. n_frames - 1``). Each frame gets the room's furniture (static, label
+    ``STATIC_LABEL``), then the bounce paths (:func:`image_paths`) of its non-clutter
+    reflectors' proxies (:func:`ghost_groups`) whose post-processing SNR
+    ``snr_db(range_m, azimuth_rad, rcs_dbsm)`` reaches :data:`GHOST_FLOOR_SNR_DB`.
+
+    Returns positions and velocities ``(M, 3)`` (sensor coordinates), RCS ``(M,)``, labels
+    ``(M,)`` (:func:`path_labels`) and ``start`` ``(n_frames + 1,)``: frame ``f`` is
+    ``start[f]:start[f + 1]``, in the order direct reflectors, furniture, clutter, paths.
     """
     pos = np.asarray(position_m, dtype=np.float64)
     vel = np.asarray(velocity_mps, dtype=np.float64)
     rcs = np.asarray(rcs_dbsm, dtype=np.float64)
-    src = np.asarray(source)
+    src = np.asarray(source, dtype=np.int64)
     clutter = np.asarray(clutter, dtype=bool)
+    frame = np.asarray(frame, dtype=np.int64)
     f_pos, f_rcs = room.furniture_scatterers()
+    n_fur = len(f_rcs)
     real = ~clutter
-    body_pos = np.concatenate((pos[real], f_pos))
-    body_vel = np.concatenate((vel[real], np.zeros_like(f_pos)))
-    body_rcs = np.concatenate((rcs[real], f_rcs))
-    body_src = np.concatenate((src[real], np.full(len(f_rcs), -1)))
-    group = ghost_groups(body_src, body_vel, np.arange(len(body_src)) >= real.sum())
-    p_pos, p_vel, p_rcs, p_src = group_proxies(group, body_pos, body_vel, body_rcs, body_src)
+    # the frame's real reflectors, then its furniture
+    fr_fur = np.repeat(np.arange(n_frames), n_fur)
+    b_frame = np.concatenate((frame[real], fr_fur))
+    b_block = np.concatenate((np.zeros(int(real.sum()), np.int64), np.ones(len(fr_fur), np.int64)))
+    b_pos = np.concatenate((pos[real], np.tile(f_pos, (n_frames, 1))))
+    b_vel = np.concatenate((vel[real], np.zeros((len(fr_fur), 3))))
+    b_rcs = np.concatenate((rcs[real], np.tile(f_rcs, n_frames)))
+    b_src = np.concatenate((src[real], np.full(len(fr_fur), -1, dtype=np.int64)))
+    by = np.lexsort((b_block, b_frame))  # frame by frame: real reflectors, then furniture
+    b_frame, b_pos, b_vel, b_rcs, b_src = b_frame[by], b_pos[by], b_vel[by], b_rcs[by], b_src[by]
+    is_fur = b_block[by] == 1
+    group = ghost_groups(b_src, b_vel, is_fur, b_frame)
+    p_pos, p_vel, p_rcs, p_src, keys = group_proxies(group, b_pos, b_vel, b_rcs, b_src)
+    p_frame = b_frame[keys]
     paths = image_paths(room, p_pos, p_vel, p_rcs, antenna)
     g_pos, g_vel = room.sensor.to_sensor(paths.position_m, paths.velocity_mps)
+    bright = np.zeros(len(paths), dtype=bool)
     if len(paths):
         r = np.linalg.norm(g_pos, axis=1)
-        bright = snr_floor_db(r, np.arctan2(g_pos[:, 0], g_pos[:, 1]), paths.rcs_dbsm) >= (
-            GHOST_FLOOR_SNR_DB
-        )
-        g_pos, g_vel = g_pos[bright], g_vel[bright]
-        g_rcs, g_src, g_ord = (
-            paths.rcs_dbsm[bright],
-            p_src[paths.index[bright]],
-            paths.path_order[bright],
-        )
-    else:
-        g_rcs, g_src, g_ord = np.zeros(0), np.zeros(0, dtype=np.int32), np.zeros(0, np.int8)
-    d_pos, d_vel = room.sensor.to_sensor(body_pos, body_vel)
-    n_d, n_c, n_g = len(body_rcs), int(clutter.sum()), len(g_rcs)
-    labels = np.concatenate(
+        az = np.arctan2(g_pos[:, 0], g_pos[:, 1])
+        bright = snr_db(r, az, paths.rcs_dbsm) >= GHOST_FLOOR_SNR_DB
+    g_frame = p_frame[paths.index[bright]]
+    g_labels = path_labels(
+        p_src[paths.index[bright]], paths.path_order[bright], np.zeros(int(bright.sum()), bool)
+    )
+    d_pos, d_vel = room.sensor.to_sensor(b_pos, b_vel)
+    d_labels = path_labels(b_src, np.zeros(len(b_src)), np.zeros(len(b_src), dtype=bool))
+    all_frame = np.concatenate((b_frame, frame[clutter], g_frame))
+    all_block = np.concatenate(
         (
-            path_labels(body_src, np.zeros(n_d), np.zeros(n_d, dtype=bool)),
-            np.full(n_c, -1, dtype=np.int32),
-            path_labels(g_src, g_ord, np.zeros(n_g, dtype=bool)),
+            np.zeros(len(b_frame), np.int64),
+            np.ones(int(clutter.sum()), np.int64),
+            np.full(len(g_frame), 2, np.int64),
         )
     )
-    return (
-        np.concatenate((d_pos, pos[clutter], g_pos)),
-        np.concatenate((d_vel, vel[clutter], g_vel)),
-        np.concatenate((body_rcs, rcs[clutter], g_rcs)),
-        labels,
-    )
+    order = np.lexsort((all_block, all_frame))  # stable: each block keeps its order
+    out_pos = np.concatenate((d_pos, pos[clutter], g_pos[bright]))[order]
+    out_vel = np.concatenate((d_vel, vel[clutter], g_vel[bright]))[order]
+    out_rcs = np.concatenate((b_rcs, rcs[clutter], paths.rcs_dbsm[bright]))[order]
+    labels = np.concatenate((d_labels, np.full(int(clutter.sum()), -1, dtype=np.int32), g_labels))[
+        order
+    ]
+    start = np.zeros(n_frames + 1, dtype=np.int64)
+    np.cumsum(np.bincount(all_frame, minlength=n_frames), out=start[1:])
+    return out_pos, out_vel, out_rcs, labels, start

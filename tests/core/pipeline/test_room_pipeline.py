@@ -4,6 +4,7 @@ labelled with their path order; no walls, no ghosts; scenes without a room uncha
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -104,3 +105,21 @@ def test_sensor_pose_puts_points_in_room_coordinates():
         np.testing.assert_allclose(cloud.y_m[i], run.truth_xy_m[f, 0, 1], atol=0.3)
         # the sensor sees the person 20 deg above its tilted boresight
         assert cloud.elevation_rad[i] == pytest.approx(math.radians(20.0), abs=math.radians(6))
+
+
+def test_room_frames_alone_equal_the_batch():
+    from core.pipeline.plan import processing_settings
+    from core.pipeline.reflectors import Reflectors
+    from core.pipeline.streams import stage_rng
+    from core.simulation import AntennaGain
+
+    sc = Scene.from_json(Path(__file__).parents[3] / "resources/scenes/room_walker.json")
+    antenna = AntennaGain.draw(sc.radar, stage_rng(sc.seed, "antenna"))
+    refl = Reflectors.build(sc, plan(sc), sc.seed, antenna, processing_settings(sc))
+    every, _ = refl.frames(12)
+    for f in (0, 5, 11):
+        alone, _ = refl.frame(f)
+        for name in ("position_m", "velocity_mps", "rcs_dbsm", "source"):
+            np.testing.assert_array_equal(getattr(alone, name), getattr(every[f], name))
+    # 17 segments direct, and ghosts of three proxies at most 15 paths each
+    assert all(17 <= len(s) <= 17 + 3 * 15 for s in every)

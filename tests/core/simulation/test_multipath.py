@@ -135,6 +135,23 @@ def test_proxies_keep_the_power_and_split_by_speed():
     g = ghost_groups(source, vel, np.zeros(6, dtype=bool))
     # sorted by speed: (0, 2) (4, 5) (3, 1)
     assert g[0] == g[2] and g[4] == g[5] and g[1] == g[3] and len(set(g)) == 3
-    p_pos, p_vel, p_rcs, _ = group_proxies(g, pos, vel, rcs, source)
+    p_pos, p_vel, p_rcs, _, _ = group_proxies(g, pos, vel, rcs, source)
     np.testing.assert_allclose(p_rcs, 10 * math.log10(2 * 0.1))
     np.testing.assert_allclose(sorted(p_vel[:, 1]), [0.15, 1.05, 2.5])
+
+
+@pytest.mark.parametrize("size", [1, 2, 3, 4, 5, 7, 17])
+def test_groups_cut_like_array_split_per_frame_and_person(size):
+    rng = np.random.default_rng(size)
+    # two frames, two persons each, shuffled
+    frame = np.repeat([0, 0, 1, 1], size)
+    source = np.tile(np.repeat([0, 1], size), 2)
+    vel = rng.normal(size=(4 * size, 3))
+    g = ghost_groups(source, vel, np.zeros(4 * size, dtype=bool), frame)
+    for f in (0, 1):
+        for p in (0, 1):
+            idx = np.flatnonzero((frame == f) & (source == p))
+            by_speed = idx[np.argsort(np.linalg.norm(vel[idx], axis=1), kind="stable")]
+            expected = [part.tolist() for part in np.array_split(by_speed, min(3, size))]
+            got = [by_speed[g[by_speed] == k].tolist() for k in dict.fromkeys(g[by_speed])]
+            assert got == expected
