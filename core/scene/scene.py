@@ -35,6 +35,7 @@ from core.scene.trajectory import (
     Trajectory,
     generate_trajectory,
     profile_trajectory,
+    stopping_waypoint_trajectory,
     validate_class_parameters,
     waypoint_duration_s,
     waypoint_trajectory,
@@ -93,6 +94,8 @@ def scatterers_per_person(name: str) -> int:
 REFLECTOR_KEYS = ("x_m", "y_m", "z_m", "rcs_dbsm")
 RCS_RANGE_DBSM = (-60.0, 60.0)
 WAYPOINT_SPEED_RANGE_MPS = (0.05, 3.0)
+#: A stop waypoint ``[x_m, y_m, 0, hold_s]`` holds for this long, s.
+WAYPOINT_HOLD_RANGE_S = (0.08, 600.0)
 MAX_PROFILE_FRAMES = MAX_FRAMES
 MIN_SCATTERER_RANGE_M = 0.1
 #: The longest a class trajectory without ``duration_s`` lasts (classes c-e draw 6-20 s).
@@ -405,18 +408,36 @@ def _parse_trajectory(
             raise InputError(f"{where}.waypoints must list at least 2 [x_m, y_m, speed_mps]")
         if len(w) > MAX_FRAMES:
             raise InputError(f"{where}.waypoints lists {len(w)} points, more than {MAX_FRAMES}")
-        rows = []
+        rows, holds = [], []
         for i, row in enumerate(w):
             f = f"{where}.waypoints[{i}]"
-            if not isinstance(row, list) or len(row) != 3:
-                raise InputError(f"{f} must be [x_m, y_m, speed_mps], got {row!r}")
+            if not isinstance(row, list) or len(row) not in (3, 4):
+                raise InputError(
+                    f"{f} must be [x_m, y_m, speed_mps] or a stop [x_m, y_m, 0, hold_s], "
+                    f"got {row!r}"
+                )
             x, y = _number(row[0], f"{f}[0]"), _number(row[1], f"{f}[1]")
-            s = _number(row[2], f"{f}[2] (speed_mps)", *WAYPOINT_SPEED_RANGE_MPS)
+            if len(row) == 4:
+                _number(row[2], f"{f}[2] (speed_mps of a stop)", 0.0, 0.0)
+                s, hold = 0.0, _number(row[3], f"{f}[3] (hold_s)", *WAYPOINT_HOLD_RANGE_S)
+            else:
+                s = _number(row[2], f"{f}[2] (speed_mps)", *WAYPOINT_SPEED_RANGE_MPS)
+                hold = 0.0
             if not aoi.contains(np.array([x, y])):
                 raise InputError(f"{f}: point ({x}, {y}) lies outside the AOI")
             rows.append((x, y, s))
-        _check_frames(waypoint_duration_s(np.array(rows)) / dt, where)
+            holds.append(hold)
+        if all(s == 0 for _, _, s in rows):
+            raise InputError(f"{where}.waypoints: stops only; give some waypoint a speed")
+        # the stops walked at the slowest speed given: an upper bound of the walking time
+        slowest = min(s for _, _, s in rows if s > 0)
+        walk = [r if r[2] > 0 else (r[0], r[1], slowest) for r in rows]
+        _check_frames((waypoint_duration_s(np.array(walk)) + sum(holds)) / dt, where)
         try:
+            if any(holds):
+                return stopping_waypoint_trajectory(
+                    np.array(rows), np.array(holds), frame_period_s=dt
+                )
             return waypoint_trajectory(np.array(rows), frame_period_s=dt)
         except InputError as exc:
             raise InputError(f"{where}: {exc.message}") from None
