@@ -43,8 +43,8 @@ N_FURNITURE_SCATTERERS = 5
 class Wall:
     """A vertical reflecting plane over the segment ``from_m`` → ``to_m`` (x, y in m).
 
-    ``reflection_db``: power kept at a bounce, dB, at most 0 (0: a perfect mirror; ``-inf``:
-    an absorber, no image).
+    ``reflection_db``: power kept at a bounce, dB, at most 0 (0: a perfect mirror; ``-inf``,
+    ``null`` in JSON: an absorber, no image).
     """
 
     from_m: tuple[float, float]
@@ -80,7 +80,7 @@ class Wall:
         return {
             "from_m": list(self.from_m),
             "to_m": list(self.to_m),
-            "reflection_db": self.reflection_db,
+            "reflection_db": None if self.reflection_db == -math.inf else self.reflection_db,
         }
 
 
@@ -240,7 +240,10 @@ def parse_room(data: dict) -> Room:
                 where,
                 from_m=tuple(w["from_m"]),
                 to_m=tuple(w["to_m"]),
-                reflection_db=w.get("reflection_db", DEFAULT_REFLECTION_DB),
+                # JSON has no -inf: null is an absorber
+                reflection_db=-math.inf
+                if "reflection_db" in w and w["reflection_db"] is None
+                else w.get("reflection_db", DEFAULT_REFLECTION_DB),
             )
         )
     furniture = []
@@ -307,12 +310,26 @@ def _radar_inside(walls: tuple[Wall, ...]) -> bool:
     t = np.clip(-(a * ab).sum(axis=1) / (ab * ab).sum(axis=1), 0.0, 1.0)
     if np.min(np.hypot(*(a + t[:, None] * ab).T)) <= MOUNT_TOLERANCE_M:
         return True
-    ends = np.round(np.concatenate((a, b)), 6)
-    _, counts = np.unique(ends, axis=0, return_counts=True)
+    return bool(inside_walls(walls, np.zeros((1, 2)))[0])
+
+
+def inside_walls(walls: tuple[Wall, ...], xy_m: np.ndarray) -> np.ndarray:
+    """``(N,)`` whether each point ``xy_m`` ``(N, 2)`` is inside the room the walls enclose.
+
+    Walls that close into a loop (every endpoint shared by two walls): the even-odd rule (a ray
+    along +x crosses the walls an odd number of times). Open walls enclose nothing: all True.
+    """
+    xy = np.asarray(xy_m, dtype=np.float64).reshape(-1, 2)
+    if not walls:
+        return np.ones(len(xy), dtype=bool)
+    a = np.array([w.from_m for w in walls], dtype=np.float64)
+    b = np.array([w.to_m for w in walls], dtype=np.float64)
+    _, counts = np.unique(np.round(np.concatenate((a, b)), 6), axis=0, return_counts=True)
     if not np.all(counts == 2):
-        return True  # open walls (a corridor, a lone wall) enclose nothing to be outside of
-    # even-odd: walls crossing the ray x > 0 along y = 0
-    crosses = (a[:, 1] > 0) != (b[:, 1] > 0)
+        return np.ones(len(xy), dtype=bool)
+    ay, by = a[None, :, 1], b[None, :, 1]
+    py = xy[:, 1:2]
+    crosses = (ay > py) != (by > py)
     with np.errstate(divide="ignore", invalid="ignore"):
-        x = a[:, 0] - a[:, 1] * ab[:, 0] / ab[:, 1]
-    return bool(np.sum(crosses & (x > 0)) % 2 == 1)
+        x = a[None, :, 0] + (py - ay) * (b[None, :, 0] - a[None, :, 0]) / (by - ay)
+    return np.sum(crosses & (x > xy[:, 0:1]), axis=1) % 2 == 1

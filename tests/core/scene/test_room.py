@@ -123,6 +123,14 @@ def test_sensor_inside_rooms():
     parse_room({"walls": [{"from_m": [2.0, 1.0], "to_m": [4.0, 20.0]}]})
 
 
+def test_absorbing_wall_is_null_in_json():
+    room = parse_room(
+        {"walls": [{"from_m": [-3.0, 0.0], "to_m": [-3.0, 8.0], "reflection_db": None}]}
+    )
+    assert room.walls[0].reflection_db == -math.inf
+    assert room.to_dict()["walls"][0]["reflection_db"] is None
+
+
 def test_absorbing_wall_reads_minus_infinity():
     room = parse_room(
         {"walls": [{"from_m": [-3.0, 0.0], "to_m": [-3.0, 8.0], "reflection_db": -math.inf}]}
