@@ -123,3 +123,30 @@ def test_room_frames_alone_equal_the_batch():
             np.testing.assert_array_equal(getattr(alone, name), getattr(every[f], name))
     # 17 segments direct, and ghosts of three proxies at most 15 paths each
     assert all(17 <= len(s) <= 17 + 3 * 15 for s in every)
+
+
+def test_furniture_is_static_and_cleared_by_clutter_removal():
+    from core.pipeline.reflectors import frame_scatterers
+    from core.simulation.multipath import split_labels
+
+    desk = {
+        "x_m": -1.0,
+        "y_m": 4.0,
+        "width_m": 1.2,
+        "depth_m": 0.6,
+        "height_m": 0.75,
+        "rcs_dbsm": 10.0,
+    }
+    sc = scene(reflection_db=-math.inf, furniture=[desk])
+    s = frame_scatterers(sc, 0)
+    src, order = split_labels(s.source)
+    fur = (src == -1) & (order == 0)
+    assert fur.sum() == 5
+    np.testing.assert_array_equal(s.velocity_mps[fur], 0.0)
+    # 10 dBsm split over five scatterers
+    assert 10 * np.log10(np.sum(10 ** (s.rcs_dbsm[fur] / 10))) == pytest.approx(10.0)
+    # the sensor is 1 m up: the desk top is 0.25 m below it
+    np.testing.assert_allclose(s.position_m[fur][:, 2], -0.25)
+    run = simulate_scene(sc)
+    for cloud in run.clouds:
+        assert not np.any((cloud.source == -1) & (cloud.path_order == 0))
