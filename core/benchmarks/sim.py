@@ -30,6 +30,7 @@ import time
 import numpy as np
 
 from core.benchmarks.sim_room import run_case as room_case
+from core.benchmarks.sim_room import summary_line as room_summary_line
 from core.config import SPEED_OF_LIGHT_MPS, ProcessingSettings, RadarConfig
 
 AOI_MIN_M, AOI_MAX_M, AOI_AZ_DEG = 0.5, 10.0, 60.0
@@ -579,6 +580,8 @@ def summary(result: dict) -> str:
             f"{wb['fast_over_exact_walking_per_pass']['max']:.1f}x; goal >= 10x); reflectors "
             f"{wb['reflectors_ms_per_frame_walking']:.3f} ms/frame"
         )
+    if result.get("room"):
+        lines.append(room_summary_line(result["room"]))
     stages = result.get("stages_ms")
     if stages:
         lines.append(

@@ -14,6 +14,7 @@ fraction of the person's points that are ghosts.
 from __future__ import annotations
 
 import dataclasses
+import os
 import time
 from pathlib import Path
 
@@ -62,23 +63,26 @@ def run_case(quick: bool = False) -> dict:
         radar, walls[:2], [np.random.default_rng(0)] * 2, antenna=antenna, settings=settings
     )
     reps = 1 if quick else 3
-    spent = {"room": 0.0, "open": 0.0}
-    t_fast = 0.0
-    rngs = [np.random.default_rng(100 + i) for i in range(n)]
+    spent = {"room": [0.0, 0.0], "open": [0.0, 0.0]}  # wall clock, CPU
+    t_fast = c_fast = 0.0
     for _ in range(reps):
-        t0 = time.perf_counter()
+        rngs = [np.random.default_rng(100 + i) for i in range(n)]
+        t0, c0 = time.perf_counter(), time.process_time()
         simulate_frames_fast(radar, walls[:n], rngs, antenna=antenna, settings=settings)
         t_fast += time.perf_counter() - t0
+        c_fast += time.process_time() - c0
         for b in range(0, n, BLOCK):
             for name, frames in (("room", walls), ("open", field)):
-                t0 = time.perf_counter()
+                t0, c0 = time.perf_counter(), time.process_time()
                 for i, f in enumerate(frames[b : min(b + BLOCK, n)]):
                     simulate_frame(
                         radar, f, np.random.default_rng(b + i), antenna=antenna, settings=settings
                     )
-                spent[name] += time.perf_counter() - t0
-    fps = {k: reps * n / v for k, v in spent.items()}
-    fast_fps = reps * n / t_fast
+                spent[name][0] += time.perf_counter() - t0
+                spent[name][1] += time.process_time() - c0
+    fps = {k: reps * n / v[0] for k, v in spent.items()}
+    fps_cpu = {k: reps * n / v[1] for k, v in spent.items()}
+    fast_fps, fast_fps_cpu = reps * n / t_fast, reps * n / c_fast
 
     def ghosts(frames) -> tuple[float, float]:
         counts, person = [], []
@@ -107,8 +111,13 @@ def run_case(quick: bool = False) -> dict:
         "exact_fps_room": fps["room"],
         "exact_fps_open": fps["open"],
         "exact_room_cost_over_open": fps["open"] / fps["room"],
+        "exact_fps_cpu_room": fps_cpu["room"],
+        "exact_fps_cpu_open": fps_cpu["open"],
+        "exact_room_cost_over_open_cpu": fps_cpu["open"] / fps_cpu["room"],
         "fast_fps_room": fast_fps,
         "fast_over_exact_room": fast_fps / fps["room"],
+        "fast_over_exact_room_cpu": fast_fps_cpu / fps_cpu["room"],
+        "load_average_1min": os.getloadavg()[0],
         "reflectors_ms_per_frame_room": 1e3 * refl_room,
         "reflectors_ms_per_frame_open": 1e3 * refl_open,
         "ghost_points_per_frame": {"proxies": proxies[0], "every_segment": segments[0]},
@@ -117,3 +126,19 @@ def run_case(quick: bool = False) -> dict:
         "ghost_groups": keep,
         "goal": {"exact_fps_room": 150.0, "exact_room_cost_over_open": 2.0, "fast_over_exact": 10},
     }
+
+
+def summary_line(room: dict) -> str:
+    """The room case in one line of ``radartune bench sim``'s summary."""
+    return (
+        f"  room ({room['scene']}, {room['scatterers_per_frame_room']:.1f} scatterers/frame "
+        f"against {room['scatterers_per_frame_open']:.1f} in the open field): exact "
+        f"{room['exact_fps_room']:.0f} frames/s, open field {room['exact_fps_open']:.0f} in the "
+        f"same run (room cost {room['exact_room_cost_over_open']:.2f}x; CPU "
+        f"{room.get('exact_room_cost_over_open_cpu', float('nan')):.2f}x; goal >= 150 frames/s, "
+        f"<= 2x); fast {room['fast_over_exact_room']:.1f}x exact (CPU "
+        f"{room.get('fast_over_exact_room_cpu', float('nan')):.1f}x; goal >= 10x); reflectors "
+        f"{room['reflectors_ms_per_frame_room']:.2f} ms/frame; ghost points/frame "
+        f"{room['ghost_points_per_frame']['proxies']:.1f} with {room['ghost_groups']} proxies, "
+        f"{room['ghost_points_per_frame']['every_segment']:.1f} with every segment"
+    )
