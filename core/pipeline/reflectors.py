@@ -372,7 +372,10 @@ def frame_scatterers(scene: Scene, frame: int, *, seed: int | None = None, the_p
     Returns
     -------
     core.simulation.Scatterers
-        ``source``: person index, or −1 for clutter and static reflectors.
+        ``source``: person index, or −1 for clutter and static reflectors. In a room
+        (``scene.room``) the reflectors are in sensor coordinates with the room's furniture and
+        bounce paths added, and ``source`` holds the path labels
+        (:func:`core.simulation.multipath.split_labels` gives person and path order).
     """
     from core import simulation as sim
 
