@@ -89,10 +89,13 @@ class Dataset:
     ref_vy_mps: np.ndarray = field(default_factory=_empty_float)
     ref_point_track: np.ndarray = field(default_factory=_empty_int)
     people_count: np.ndarray = field(default_factory=_empty_int)
+    #: ``(P,)`` int8 wall bounces of each point's path (PointCloud.path_order); ``None`` where
+    #: the simulation had no room (the file then has no such array)
+    path_order: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         p = np.shape(self.frame)[0] if np.ndim(self.frame) == 1 else -1
-        for name in PER_POINT:
+        for name in (*PER_POINT, *(("path_order",) if self.path_order is not None else ())):
             if np.shape(getattr(self, name)) != (p,):
                 raise ValueError(
                     f"Dataset.{name} must have shape (P,) like frame, got "
@@ -233,7 +236,9 @@ class Dataset:
         """The point cloud of one global frame."""
         lo, hi = np.searchsorted(self.frame, [frame, frame + 1])
         return PointCloud(
-            **{f: getattr(self, f)[lo:hi] for f in POINT_FIELDS}, source=self.source[lo:hi]
+            **{f: getattr(self, f)[lo:hi] for f in POINT_FIELDS},
+            source=self.source[lo:hi],
+            path_order=None if self.path_order is None else self.path_order[lo:hi],
         )
 
     def scene(self) -> dict:
@@ -306,6 +311,9 @@ class Dataset:
             radar_json=radar_json,
             fidelity=fidelity,
             seed=int(seed),
+            path_order=None
+            if merged.path_order is None
+            else np.asarray(merged.path_order, dtype=np.int8),
         )
 
     # ---- files -------------------------------------------------------------------------------
@@ -322,6 +330,8 @@ class Dataset:
         for name in OPTIONAL_ARRAYS:
             if len(getattr(self, name)):
                 arrays[name] = getattr(self, name)
+        if self.path_order is not None:
+            arrays["path_order"] = self.path_order
         write_npz_atomic(path, arrays)
         return path
 
@@ -347,6 +357,8 @@ class Dataset:
             raise InputError(
                 f"the reference layer is incomplete: missing arrays {missing_ref}", src
             )
+        if "path_order" in data:
+            kw["path_order"] = _typed(data["path_order"], "path_order", src).astype(np.int8)
         for k in ("scene_json", "radar_json", *(("fidelity",) if "fidelity" in data else ())):
             kw[k] = _text(data[k], k, src)
         if kw["scene_json"]:
@@ -377,7 +389,15 @@ class Dataset:
 
 
 #: dtype kinds accepted per array: integers for indices, real numbers for values, text for class.
-_INTEGER_ARRAYS = ("frame", "source", "trajectory", *REF_INT, "ref_point_track", "people_count")
+_INTEGER_ARRAYS = (
+    "frame",
+    "source",
+    "trajectory",
+    *REF_INT,
+    "ref_point_track",
+    "people_count",
+    "path_order",
+)
 
 
 def _typed(a: np.ndarray, name: str, src: str) -> np.ndarray:

@@ -9,6 +9,8 @@ import numpy as np
 #: Ground-truth labels in ``PointCloud.source`` besides person indices (>= 0).
 SOURCE_CLUTTER = -1
 SOURCE_OTHER = -2
+#: ``PointCloud.path_order`` of clutter and noise points (else the number of wall bounces).
+PATH_CLUTTER = -1
 
 POINT_FIELDS = (
     "range_m",
@@ -28,6 +30,9 @@ class PointCloud:
 
     ``source`` is the ground-truth label: the index of the person the point came from,
     ``-1`` for clutter, ``-2`` for noise or sidelobe detections that match no reflector.
+    ``path_order`` (int8, optional: ``None`` where the simulation had no room): the number of
+    wall bounces of the path the point came from (0 direct, 1 or 2), ``-1`` for clutter or
+    noise (:data:`PATH_CLUTTER`).
     """
 
     range_m: np.ndarray
@@ -39,12 +44,15 @@ class PointCloud:
     y_m: np.ndarray
     z_m: np.ndarray
     source: np.ndarray
+    path_order: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         n = len(self.range_m)
         for name in (*POINT_FIELDS, "source"):
             if np.shape(getattr(self, name)) != (n,):
                 raise ValueError(f"PointCloud.{name} must have shape ({n},)")
+        if self.path_order is not None and np.shape(self.path_order) != (n,):
+            raise ValueError(f"PointCloud.path_order must have shape ({n},)")
 
     def __len__(self) -> int:
         return len(self.range_m)
@@ -59,7 +67,21 @@ class PointCloud:
         if not clouds:
             return cls.empty()
         kw = {f: np.concatenate([getattr(c, f) for c in clouds]) for f in POINT_FIELDS}
-        return cls(**kw, source=np.concatenate([c.source for c in clouds]).astype(np.int32))
+        order = None
+        if any(c.path_order is not None for c in clouds):
+            order = np.concatenate(
+                [
+                    np.full(len(c), PATH_CLUTTER, dtype=np.int8)
+                    if c.path_order is None
+                    else np.asarray(c.path_order, dtype=np.int8)
+                    for c in clouds
+                ]
+            )
+        return cls(
+            **kw,
+            source=np.concatenate([c.source for c in clouds]).astype(np.int32),
+            path_order=order,
+        )
 
     def measurements(self) -> np.ndarray:
         """Tracker measurements ``z = [r, az, vr]``, shape ``(n_points, 3)``, float64."""

@@ -29,6 +29,8 @@ import time
 
 import numpy as np
 
+from core.benchmarks.sim_room import run_case as room_case
+from core.benchmarks.sim_room import summary_line as room_summary_line
 from core.config import SPEED_OF_LIGHT_MPS, ProcessingSettings, RadarConfig
 
 AOI_MIN_M, AOI_MAX_M, AOI_AZ_DEG = 0.5, 10.0, 60.0
@@ -247,6 +249,7 @@ def run(quick: bool = False) -> dict:
         "exact_person_detected_fraction": person_found,
     }
     result["walking_body"] = walking_case(quick)
+    result["room"] = room_case(quick)
     result["stages_ms"] = _stage_profile(radar, settings, antenna, frames[: 50 if quick else 300])
     result["dataset"] = _time_dataset(quick)
     return result
@@ -577,6 +580,8 @@ def summary(result: dict) -> str:
             f"{wb['fast_over_exact_walking_per_pass']['max']:.1f}x; goal >= 10x); reflectors "
             f"{wb['reflectors_ms_per_frame_walking']:.3f} ms/frame"
         )
+    if result.get("room"):
+        lines.append(room_summary_line(result["room"]))
     stages = result.get("stages_ms")
     if stages:
         lines.append(

@@ -35,6 +35,13 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         help="persons per trajectory, 1-8 (default 1: the paper's set); person j of trajectory "
         "k walks class abcde[(k+j) %% 5], person 0 is the one-person set's",
     )
+    p.add_argument(
+        "--room",
+        metavar="FILE",
+        default=None,
+        help="put every trajectory in this room: a JSON file of walls, furniture and a sensor "
+        "pose (docs/rooms.md); the trajectories and seeds stay the paper's",
+    )
     p.set_defaults(func=run)
 
 
@@ -70,6 +77,11 @@ def run(args: argparse.Namespace) -> int:
         raise InputError(
             f"--person-model must be one of {list(PERSON_MODELS)}, got {args.person_model!r}"
         ) from None
+    room = None
+    if args.room is not None:
+        from core.scene.room import Room
+
+        room = Room.from_json(args.room)
     ds = paper_dataset(
         args.seed,
         args.trajectories,
@@ -79,6 +91,7 @@ def run(args: argparse.Namespace) -> int:
         use_cache=not args.no_cache,
         person_model=args.person_model,
         n_persons=args.persons,
+        room=room,
     )
     ds.save(args.out)
     per_class = {c: int(np.sum(ds.trajectory_class == c)) for c in "abcde"}
@@ -87,4 +100,15 @@ def run(args: argparse.Namespace) -> int:
         f"{ds.n_persons} person(s), {ds.n_frames} frames, "
         f"{len(ds.frame)} points; elapsed {time.perf_counter() - t0:.1f} s"
     )
+    if room is not None:
+        from core.scene.room import inside_walls
+
+        xy = ds.truth_xy_m.reshape(-1, 2)
+        xy = xy[~np.isnan(xy[:, 0])]
+        out = 1.0 - float(np.mean(inside_walls(room.walls, xy))) if len(xy) else 0.0
+        ghosts = float(np.mean(ds.path_order > 0)) if ds.path_order is not None else 0.0
+        print(
+            f"room {args.room}: {100 * ghosts:.1f} % of the points from wall bounces; "
+            f"{100 * out:.1f} % of the persons' positions lie outside its walls"
+        )
     return 0

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import hashlib
 import json
@@ -21,6 +22,7 @@ from core.files import sources_hash
 from core.pipeline.frames import ProgressCallback, simulate_scene
 from core.pointcloud import PointCloud
 from core.scene import Scene, paper_scenes
+from core.scene.room import Room
 
 #: Bump when the simulation changes in a way that invalidates cached data sets.
 CACHE_VERSION = 1
@@ -220,6 +222,13 @@ def _assemble(
     )
 
 
+def in_room(scenes: list[Scene], room: Room | None) -> list[Scene]:
+    """The scenes in ``room`` (``None``: as they are)."""
+    if room is None:
+        return scenes
+    return [dataclasses.replace(s, room=room) for s in scenes]
+
+
 def paper_dataset(
     seed: int = 0,
     n_trajectories: int = 35,
@@ -231,6 +240,7 @@ def paper_dataset(
     use_cache: bool = True,
     person_model: str = "point",
     n_persons: int = 1,
+    room: Room | None = None,
 ) -> Dataset:
     """The paper's data set: :func:`core.scene.paper_scenes` simulated (cached).
 
@@ -238,8 +248,12 @@ def paper_dataset(
     of the scenes reproduces its frames of the data set bit for bit. ``person_model``
     (``"point"``, ``"blob"``/``"extended"`` or ``"walking"``) changes only the person's scattering
     model; ``n_persons`` puts that many persons in every scene (:func:`core.scene.paper_scenes`).
+    ``room`` puts every scene in that room (walls, furniture, sensor pose; docs/rooms.md): the
+    trajectories and seeds stay the paper's, the cache key includes the room.
     """
-    scenes = paper_scenes(seed, n_trajectories, person_model=person_model, n_persons=n_persons)
+    scenes = in_room(
+        paper_scenes(seed, n_trajectories, person_model=person_model, n_persons=n_persons), room
+    )
     return build_dataset(
         scenes,
         seeds=[s.seed for s in scenes],
@@ -262,14 +276,17 @@ def paper_dataset_file(
     progress: ProgressCallback | None = None,
     person_model: str = "point",
     n_persons: int = 1,
+    room: Room | None = None,
 ) -> Path:
     """Path of the cached paper data set (simulated first if not cached).
 
     For study workers, which should receive a file path rather than an in-memory data set: the
     file lives in the cache under its content key, so it is never stale. ``person_model`` as in
-    :func:`paper_dataset`, and ``n_persons``.
+    :func:`paper_dataset`, and ``n_persons`` and ``room``.
     """
-    scenes = paper_scenes(seed, n_trajectories, person_model=person_model, n_persons=n_persons)
+    scenes = in_room(
+        paper_scenes(seed, n_trajectories, person_model=person_model, n_persons=n_persons), room
+    )
     seeds = [s.seed for s in scenes]
     root = Path(cache_dir) if cache_dir is not None else default_cache_dir()
     key = dataset_key(scenes, fidelity=fidelity, seed=seed, seeds=seeds)

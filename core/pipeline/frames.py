@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 import time
@@ -129,7 +130,7 @@ def iter_frames(
             t_s=fi.t_s,
             truth_xy_m=fi.truth_xy_m,
             truth_v_mps=fi.truth_v_mps,
-            point_cloud=out.point_cloud,
+            point_cloud=in_room(scene, out.point_cloud),
             rd_map_db=out.rd_map_db if p.keep_rd_maps else None,
             detections=out.detections,
             n_clutter=fi.n_clutter,
@@ -137,6 +138,22 @@ def iter_frames(
             synthesis_s=out.synthesis_s,
             processing_s=out.processing_s,
         )
+
+
+def in_room(scene: Scene, cloud: PointCloud) -> PointCloud:
+    """A simulated cloud of a scene in a room: ``x_m``, ``y_m``, ``z_m`` in room coordinates
+    (range, angles and radial velocity stay the sensor's), ``source`` and ``path_order`` split
+    from the path labels (:func:`core.simulation.multipath.split_labels`). Without a room: the
+    cloud as it is."""
+    if scene.room is None:
+        return cloud
+    from core.simulation.multipath import split_labels
+
+    source, order = split_labels(cloud.source)
+    xyz = scene.room.sensor.to_room(np.column_stack((cloud.x_m, cloud.y_m, cloud.z_m)))
+    return dataclasses.replace(
+        cloud, x_m=xyz[:, 0], y_m=xyz[:, 1], z_m=xyz[:, 2], source=source, path_order=order
+    )
 
 
 @dataclass(frozen=True, slots=True, kw_only=True, eq=False)
@@ -250,7 +267,7 @@ def _simulate_scene_batch(
         scene=scene,
         plan=p,
         seed=seed,
-        clouds=tuple(out.clouds()),
+        clouds=tuple(in_room(scene, c) for c in out.clouds()),
         truth_t_s=reflectors.truth_t_s,
         truth_xy_m=reflectors.truth_xy_m,
         truth_v_mps=reflectors.truth_v_mps,

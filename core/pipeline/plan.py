@@ -132,6 +132,7 @@ def plan(
         return Stage(name=name, needs=needs, produces=produces, run=run, reason=why)
 
     lam = scene.clutter_density_per_m2
+    room = scene.room
     stages = (
         stage(
             "truth", ("trajectories",), ("truth_xy", "truth_v"), True,
@@ -162,9 +163,19 @@ def plan(
             "the scene has no static reflectors",
         ),
         stage(
+            "multipath", ("body_scatterers", "static_reflectors"), ("multipath_paths",),
+            room is not None and room.has_multipath,
+            "image method over "
+            f"{sum(w.reflection > 0 for w in room.walls) if room else 0} reflecting wall(s): "
+            "first order (both paths of a bounce), second order (a bounce out and back)",
+            "the scene has no reflecting walls: no multipath"
+            if room is None or not room.walls
+            else "every wall absorbs (reflection_db = -inf): no multipath",
+        ),
+        stage(
             "scatterers",
             ("truth_xy", "person_rcs", "body_scatterers", "clutter_reflectors",
-             "static_reflectors"),
+             "static_reflectors", "multipath_paths"),
             ("scatterers",), True, "reflectors of each frame", "",
         ),
         stage(

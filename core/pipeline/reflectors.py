@@ -4,6 +4,7 @@ the plan)."""
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 from typing import Any
 
@@ -17,6 +18,7 @@ from core.scene.body import N_BODY_SCATTERERS, body_scatterers, walking_headings
 from core.scene.scene import person_seed
 from core.scene.walking import (
     N_SEGMENTS,
+    RADAR_HEIGHT_M,
     RCS_SHARES,
     default_gait_phase,
     gait_phase,
@@ -45,6 +47,7 @@ class Reflectors:
     run_clutter: bool
     run_static: bool
     _consts: _FrameConstants
+    run_multipath: bool = False
 
     @classmethod
     def build(cls, scene: Scene, p: Plan, seed: int, antenna, settings) -> Reflectors:
@@ -88,6 +91,7 @@ class Reflectors:
             run_rcs=p.runs("person_rcs"),
             run_clutter=p.runs("clutter"),
             run_static=p.runs("static_reflectors"),
+            run_multipath=p.runs("multipath"),
             _consts=cls._constants(scene, fixed_rcs, p.runs("static_reflectors")),
         )
 
@@ -228,6 +232,10 @@ class Reflectors:
             position[at] = k.static_position[j]
             rcs_all[at] = k.static_rcs[j]
             source[at] = k.static_source[j]
+        if scene.room is not None:
+            return self._in_room(
+                position, velocity, rcs_all, source, start, n_point + n_body, n_clutter
+            ), n_clutter
         whole_ok = _arrays_ok(position, velocity, rcs_all)
         out = []
         for row in range(n_f):
@@ -236,6 +244,40 @@ class Reflectors:
             # an invalid reflector: the frame's validating constructor names the field
             out.append(_checked_scatterers(sim, *part) if whole_ok else _scatterers(sim, *part))
         return out, n_clutter
+
+    def _in_room(self, position, velocity, rcs, source, start, first_clutter, n_clutter):
+        """Each frame's reflectors in the scene's room (furniture, bounce paths, sensor pose;
+        :func:`core.simulation.multipath.room_frame`), their ``source`` the path labels."""
+        from core import simulation as sim
+        from core.simulation.multipath import room_frames
+
+        room = self.scene.room
+        assert room is not None
+        if not self.run_multipath:
+            room = dataclasses.replace(room, walls=())
+        radar, antenna, settings = self.scene.radar, self.antenna, self.settings
+
+        def snr_db(r, az, rcs_dbsm):
+            return sim.post_processing_snr_db(radar, r, az, rcs_dbsm, antenna, settings)
+
+        # the body models put a person's scatterers relative to a radar RADAR_HEIGHT_M above
+        # the floor (core.scene.walking); a room's coordinates start at the floor
+        position = position.copy()
+        position[source >= 0, 2] += RADAR_HEIGHT_M
+        n_f = len(start) - 1
+        frame = np.repeat(np.arange(n_f), np.diff(start))
+        slot = np.arange(len(frame)) - start[frame]
+        clutter = (slot >= first_clutter[frame]) & (slot < (first_clutter + n_clutter)[frame])
+        pos, vel, rcs_all, labels, at = room_frames(
+            room, position, velocity, rcs, source, clutter, frame, n_f, antenna, snr_db
+        )
+        whole_ok = _arrays_ok(pos, vel, rcs_all)
+        out = []
+        for row in range(n_f):
+            s = slice(at[row], at[row + 1])
+            part = (pos[s], vel[s], rcs_all[s], labels[s])
+            out.append(_checked_scatterers(sim, *part) if whole_ok else _scatterers(sim, *part))
+        return out
 
     def _walking_rows(self, i, frames, xy, v, rcs):
         """The walking body of person ``i`` in ``frames`` (vectorised over the frames).
@@ -330,7 +372,10 @@ def frame_scatterers(scene: Scene, frame: int, *, seed: int | None = None, the_p
     Returns
     -------
     core.simulation.Scatterers
-        ``source``: person index, or −1 for clutter and static reflectors.
+        ``source``: person index, or −1 for clutter and static reflectors. In a room
+        (``scene.room``) the reflectors are in sensor coordinates with the room's furniture and
+        bounce paths added, and ``source`` holds the path labels
+        (:func:`core.simulation.multipath.split_labels` gives person and path order).
     """
     from core import simulation as sim
 

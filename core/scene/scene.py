@@ -29,11 +29,13 @@ from core.limits import (
 from core.scene.aoi import AOI
 from core.scene.body import N_BODY_SCATTERERS
 from core.scene.clutter import check_clutter_radar, expected_clutter_count
+from core.scene.room import N_FURNITURE_SCATTERERS, ROOM_KEYS, Room, parse_room
 from core.scene.trajectory import (
     TRAJECTORY_CLASSES,
     Trajectory,
     generate_trajectory,
     profile_trajectory,
+    stopping_waypoint_trajectory,
     validate_class_parameters,
     waypoint_duration_s,
     waypoint_trajectory,
@@ -55,6 +57,10 @@ SCENE_KEYS = (
     "aoi",
     "static_reflectors",
     "persons",
+    # a room (docs/rooms.md): written only when the scene has one
+    "walls",
+    "furniture",
+    "sensor",
 )
 PERSON_KEYS = ("trajectory", "rcs_dbsm", "model", "height_m", "gait_phase")
 #: Person models: the paper's point, the 5-scatterer blob (:mod:`core.scene.body`) and the
@@ -88,6 +94,8 @@ def scatterers_per_person(name: str) -> int:
 REFLECTOR_KEYS = ("x_m", "y_m", "z_m", "rcs_dbsm")
 RCS_RANGE_DBSM = (-60.0, 60.0)
 WAYPOINT_SPEED_RANGE_MPS = (0.05, 3.0)
+#: A stop waypoint ``[x_m, y_m, 0, hold_s]`` holds for this long, s.
+WAYPOINT_HOLD_RANGE_S = (0.08, 600.0)
 MAX_PROFILE_FRAMES = MAX_FRAMES
 MIN_SCATTERER_RANGE_M = 0.1
 #: The longest a class trajectory without ``duration_s`` lasts (classes c-e draw 6-20 s).
@@ -185,6 +193,8 @@ class Scene:
     aoi: AOI = field(default_factory=AOI)
     static_reflectors: tuple[StaticReflector, ...] = ()
     persons: tuple[Person, ...] = ()
+    #: walls, furniture and sensor pose (docs/rooms.md); ``None``: the paper's open field
+    room: Room | None = None
 
     def __post_init__(self) -> None:
         if not (isinstance(self.seed, int) and not isinstance(self.seed, bool) and self.seed >= 0):
@@ -210,8 +220,10 @@ class Scene:
     def is_planar(self) -> bool:
         """True when every reflector has z = 0 (point and blob persons are at z = 0; walking
         bodies have their segments at their heights)."""
-        return all(r.z_m == 0.0 for r in self.static_reflectors) and not any(
-            p.kind == "walking" for p in self.persons
+        return (
+            all(r.z_m == 0.0 for r in self.static_reflectors)
+            and not any(p.kind == "walking" for p in self.persons)
+            and self.room is None
         )
 
     @property
@@ -251,7 +263,7 @@ class Scene:
             radar = self.radar_spec
         else:
             radar = dict(self.radar_spec)
-        return {
+        d = {
             "schema_version": SCHEMA_VERSION,
             "radar": radar,
             "seed": self.seed,
@@ -260,6 +272,9 @@ class Scene:
             "static_reflectors": [r.to_dict() for r in self.static_reflectors],
             "persons": [p.to_dict() for p in self.persons],
         }
+        if self.room is not None:
+            d.update(self.room.to_dict())
+        return d
 
     def to_json(self, path: str | os.PathLike | None = None) -> str:
         """The scene as JSON text; with ``path``, also written atomically (temp file + rename)."""
@@ -393,18 +408,36 @@ def _parse_trajectory(
             raise InputError(f"{where}.waypoints must list at least 2 [x_m, y_m, speed_mps]")
         if len(w) > MAX_FRAMES:
             raise InputError(f"{where}.waypoints lists {len(w)} points, more than {MAX_FRAMES}")
-        rows = []
+        rows, holds = [], []
         for i, row in enumerate(w):
             f = f"{where}.waypoints[{i}]"
-            if not isinstance(row, list) or len(row) != 3:
-                raise InputError(f"{f} must be [x_m, y_m, speed_mps], got {row!r}")
+            if not isinstance(row, list) or len(row) not in (3, 4):
+                raise InputError(
+                    f"{f} must be [x_m, y_m, speed_mps] or a stop [x_m, y_m, 0, hold_s], "
+                    f"got {row!r}"
+                )
             x, y = _number(row[0], f"{f}[0]"), _number(row[1], f"{f}[1]")
-            s = _number(row[2], f"{f}[2] (speed_mps)", *WAYPOINT_SPEED_RANGE_MPS)
+            if len(row) == 4:
+                _number(row[2], f"{f}[2] (speed_mps of a stop)", 0.0, 0.0)
+                s, hold = 0.0, _number(row[3], f"{f}[3] (hold_s)", *WAYPOINT_HOLD_RANGE_S)
+            else:
+                s = _number(row[2], f"{f}[2] (speed_mps)", *WAYPOINT_SPEED_RANGE_MPS)
+                hold = 0.0
             if not aoi.contains(np.array([x, y])):
                 raise InputError(f"{f}: point ({x}, {y}) lies outside the AOI")
             rows.append((x, y, s))
-        _check_frames(waypoint_duration_s(np.array(rows)) / dt, where)
+            holds.append(hold)
+        if all(s == 0 for _, _, s in rows):
+            raise InputError(f"{where}.waypoints: stops only; give some waypoint a speed")
+        # the stops walked at the slowest speed given: an upper bound of the walking time
+        slowest = min(s for _, _, s in rows if s > 0)
+        walk = [r if r[2] > 0 else (r[0], r[1], slowest) for r in rows]
+        _check_frames((waypoint_duration_s(np.array(walk)) + sum(holds)) / dt, where)
         try:
+            if any(holds):
+                return stopping_waypoint_trajectory(
+                    np.array(rows), np.array(holds), frame_period_s=dt
+                )
             return waypoint_trajectory(np.array(rows), frame_period_s=dt)
         except InputError as exc:
             raise InputError(f"{where}: {exc.message}") from None
@@ -507,6 +540,7 @@ def _parse_scene(data: Any, base_dir: Path) -> Scene:
                 rcs_dbsm=_number(r.get("rcs_dbsm", 10.0), f"{where}.rcs_dbsm", *RCS_RANGE_DBSM),
             )
         )
+    room = parse_room(data) if any(k in data for k in ROOM_KEYS) else None
     persons_d = data.get("persons", [])
     if not isinstance(persons_d, list):
         raise InputError("persons must be a list")
@@ -564,6 +598,7 @@ def _parse_scene(data: Any, base_dir: Path) -> Scene:
     scatterers = (
         sum(scatterers_per_person(p.model) for p in persons)
         + len(reflectors)
+        + (N_FURNITURE_SCATTERERS * len(room.furniture) if room is not None else 0)
         + expected_clutter_count(aoi, density)
     )
     if n_frames * scatterers > MAX_SCATTERER_FRAMES:
@@ -586,6 +621,7 @@ def _parse_scene(data: Any, base_dir: Path) -> Scene:
         aoi=aoi,
         static_reflectors=tuple(reflectors),
         persons=tuple(persons),
+        room=room,
     )
 
 

@@ -246,6 +246,87 @@ def waypoint_trajectory(waypoints: np.ndarray, *, frame_period_s: float = 0.08) 
     return _from_velocities(pos[0], vel, dt, "drawn")
 
 
+def stopping_waypoint_trajectory(
+    waypoints: np.ndarray, hold_s: np.ndarray, *, frame_period_s: float = 0.08
+) -> Trajectory:
+    """A drawn path with stops: waypoints ``[x_m, y_m, speed_mps]``, where a waypoint of speed
+    0 is a stop of ``hold_s`` seconds (shape ``(W,)``; 0 elsewhere).
+
+    Between stops the path is walked as :func:`waypoint_trajectory` walks it; a stop's own
+    speed (0) is replaced by its walking neighbour's (the walk arrives and leaves at that
+    speed), and the person stands still at the stop for its hold time (the walking body then
+    sways and breathes, :mod:`core.scene.walking`). Positions are sampled every frame of one
+    continuous clock and turned into an eq. (6) profile.
+    """
+    w = np.array(waypoints, dtype=np.float64)
+    hold = np.asarray(hold_s, dtype=np.float64)
+    dt = float(frame_period_s)
+    stops = np.flatnonzero(w[:, 2] == 0)
+    if not len(stops):
+        return waypoint_trajectory(w, frame_period_s=dt)
+    # pieces of the clock: ("hold", xy, duration) or ("walk", rows, duration)
+    pieces: list[tuple[str, np.ndarray, float]] = []
+    ends = sorted({0, len(w) - 1, *stops.tolist()})
+    for a, b in zip(ends, [*ends[1:], None]):
+        if w[a, 2] == 0:
+            pieces.append(("hold", w[a, :2], float(hold[a])))
+        if b is None:
+            break
+        rows = w[a : b + 1].copy()
+        if rows[0, 2] == 0:
+            rows[0, 2] = rows[1, 2] if rows[1, 2] > 0 else _walking_speed(w, a)
+        if rows[-1, 2] == 0:
+            rows[-1, 2] = rows[-2, 2] if rows[-2, 2] > 0 else _walking_speed(w, b)
+        pieces.append(("walk", rows, float(_waypoint_segments(rows)[3][-1])))
+    t_end = np.cumsum([d for _, _, d in pieces])
+    n_frames = int(math.floor(t_end[-1] / dt + 1e-9)) + 1
+    if n_frames < 2:
+        raise InputError("waypoints describe a path shorter than one frame")
+    t = np.arange(n_frames) * dt
+    piece = np.clip(np.searchsorted(t_end, t, side="right"), 0, len(pieces) - 1)
+    pos = np.empty((n_frames, 2))
+    for j, (kind, data, _) in enumerate(pieces):
+        at = np.flatnonzero(piece == j)
+        if not len(at):
+            continue
+        if kind == "hold":
+            pos[at] = data
+            continue
+        tau = t[at] - (t_end[j - 1] if j else 0.0)
+        pos[at] = _path_positions(data, tau)
+    vel = np.zeros_like(pos)
+    vel[1:] = np.diff(pos, axis=0) / dt
+    if pieces[0][0] == "walk":  # a walk from the first frame starts at its speed
+        rows = pieces[0][1]
+        d = rows[1, :2] - rows[0, :2]
+        if np.hypot(*d) > 0:
+            vel[0] = d / np.hypot(*d) * rows[0, 2]
+    return _from_velocities(pos[0], vel, dt, "drawn")
+
+
+def _walking_speed(w: np.ndarray, i: int) -> float:
+    """The speed of the walking waypoint nearest to waypoint ``i`` (a stop)."""
+    moving = np.flatnonzero(w[:, 2] > 0)
+    if not len(moving):
+        raise InputError("waypoints: a path of stops only; give some waypoint a speed")
+    return float(w[moving[np.argmin(np.abs(moving - i))], 2])
+
+
+def _path_positions(w: np.ndarray, tau: np.ndarray) -> np.ndarray:
+    """Positions ``(n, 2)`` at times ``tau`` (s from the start) along waypoints ``w`` walked as
+    :func:`waypoint_trajectory` walks them (clamped at the last waypoint)."""
+    seg, length, k, t_start = _waypoint_segments(w)
+    v0 = w[:-1, 2]
+    i = np.clip(np.searchsorted(t_start, tau, side="right") - 1, 0, len(seg) - 1)
+    rel = tau - t_start[i]
+    ki = k[i]
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        s = np.where(np.abs(ki) > 1e-12, v0[i] * np.expm1(ki * rel) / ki, v0[i] * rel)
+    s = np.clip(s, 0.0, length[i])
+    unit = seg[i] / np.where(length[i] > 0, length[i], 1.0)[:, None]
+    return w[i, :2] + unit * s[:, None]
+
+
 # ---- random classes a–e ------------------------------------------------------------------------
 
 
