@@ -141,6 +141,9 @@ class MainWindow(QtWidgets.QMainWindow):
 
         self.views_control = ViewsController(self)
         self.record = RecordController(self)
+        from app.live import LiveController  # File → Connect sensor … (a live TI sensor)
+
+        self.live = LiveController(self)
 
         # ---- wiring ----------------------------------------------------------------------------
         self.scene_control.info_changed.connect(self._on_scene_info)
@@ -674,6 +677,7 @@ class MainWindow(QtWidgets.QMainWindow):
         """Stop timers and workers (close, tests)."""
         self._draw_timer.stop()
         self.playback_control.stop()
+        self.live.shutdown()
         self.scene_control.stop()
         self.sim.wait()
         self.tracker.wait()

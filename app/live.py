@@ -1,0 +1,223 @@
+"""A live sensor in the app: File → Connect sensor … / Stop sensor.
+
+:class:`LiveWorker` runs :class:`core.live.LiveLink` in its own thread (the cfg dialogue, the
+data port, the recording, ``sensorStop`` on the way out), so the GUI never waits on a port. Each
+frame is handed to the GUI thread, which appends it to the window's frame cache as a simulation
+worker does; the cache is re-tracked with the tracker panel's parameters and drawn by the same
+playback path as a simulation or a replay, the view following the newest tracked frame. Stop
+ends the link (``sensorStop``); an error (a rejected cfg line, a port that vanished) is one line
+in the window's message box; Connect again reconnects.
+"""
+
+from __future__ import annotations
+
+import threading
+import time
+
+import numpy as np
+from PySide6 import QtCore, QtGui
+
+from app.data import FrameData
+from app.errors import log_exception, one_line
+from core.live import LinkSettings, LiveLink
+from core.pointcloud import PointCloud
+
+
+class LiveWorker(QtCore.QThread):
+    """One link from connect to close; every frame emitted as it arrives."""
+
+    connected = QtCore.Signal(object)  # core.config.RadarConfig of the cfg
+    frame_ready = QtCore.Signal(object)  # core.live.LiveFrame
+    failed = QtCore.Signal(str)
+    closed = QtCore.Signal(str)  # a one-line summary
+
+    def __init__(self, settings: LinkSettings, params, record: str | None, parent=None) -> None:
+        super().__init__(parent)
+        self.settings = settings
+        self.params = params
+        self.record = record
+        self._lock = threading.Lock()
+        self._stop = False
+        self._link: LiveLink | None = None
+
+    def stop(self) -> None:
+        """End the link at its next read (thread-safe); the worker then sends sensorStop."""
+        with self._lock:
+            self._stop = True
+            if self._link is not None:
+                self._link.stop()
+
+    def run(self) -> None:  # worker thread
+        link = None
+        n = 0
+        try:
+            link = LiveLink(self.settings, self.params, record=self.record)
+            with self._lock:
+                self._link = link
+                if self._stop:
+                    link.stop()
+            link.start()
+            self.connected.emit(link.radar)
+            for frame in link.frames():
+                n += 1
+                self.frame_ready.emit(frame)
+        except Exception as exc:  # any failure becomes a message, never a crash
+            log_exception("live link failed", exc)
+            self.failed.emit(one_line(exc))
+        finally:
+            if link is not None:
+                recorded = link.recorded_bytes
+                path = link.close()
+                kept = f"; recorded {recorded} bytes to {path}" if path is not None else ""
+                self.closed.emit(f"sensor stopped after {n} frames{kept}")
+
+
+class LiveController(QtCore.QObject):
+    """File → Connect sensor …, Stop sensor; feeds the window's cache from a :class:`LiveWorker`.
+
+    ``latencies_s``: for each drawn live frame, seconds from its last byte on the data port to
+    the end of the redraw that showed it (``radartune bench gui``).
+    """
+
+    def __init__(self, window) -> None:
+        super().__init__(window)
+        self._w = window
+        self._worker: LiveWorker | None = None
+        self.last_summary = ""
+        self._generation = -1
+        self._received_s: dict[int, float] = {}
+        self.latencies_s: list[float] = []
+        self.n_frames = 0
+        self.frame_period_s = float("nan")
+        menu = next(a.menu() for a in window.menuBar().actions() if a.text() == "&File")
+        quit_action = next((a for a in menu.actions() if a.text() == "&Quit"), None)
+        self.act_connect = QtGui.QAction("&Connect sensor …", window)
+        self.act_stop = QtGui.QAction("S&top sensor", window)
+        self.act_stop.setEnabled(False)
+        self.act_connect.triggered.connect(self.connect_dialog)
+        self.act_stop.triggered.connect(self.stop)
+        for action in (self.act_connect, self.act_stop):
+            menu.insertAction(quit_action, action)
+        menu.insertSeparator(quit_action)
+        window.tracking_model.changed.connect(self._on_tracked)
+
+    @property
+    def running(self) -> bool:
+        return self._worker is not None and self._worker.isRunning()
+
+    # ---- connect ----
+    def connect_dialog(self) -> None:
+        from app.connect_dialog import ConnectDialog
+
+        cfg = str(self._w.settings.value("live/cfg", "") or "")
+        dialog = ConnectDialog(self._w, cfg=cfg)
+        self.dialog = dialog
+
+        def accepted() -> None:
+            self._w.settings.setValue("live/cfg", dialog.cfg_edit.text())
+            self.start(dialog.settings(), dialog.record_path)
+
+        dialog.accepted.connect(accepted)
+        dialog.open()
+
+    def start(self, settings: LinkSettings, record: str | None = None) -> None:
+        """Connect: the simulation stops, the cache is cleared for the sensor's frames."""
+        w = self._w
+        if self.running:
+            w.show_error("live sensor: a sensor is connected; stop it before connecting again")
+            return
+        try:
+            params = w.params_model.params()
+        except Exception as exc:  # noqa: BLE001 - bad parameters are a message
+            w.show_error(one_line(exc))
+            return
+        w.sim.stop()
+        w.tracker.invalidate()
+        w.cache.clear(expected=0, truth_paths=())
+        self._generation = w.cache.generation
+        self._received_s.clear()
+        self.latencies_s.clear()
+        self.n_frames = 0
+        worker = LiveWorker(settings, params, record, self)
+        worker.connected.connect(self._on_connected)
+        worker.frame_ready.connect(self._on_frame)
+        worker.failed.connect(lambda m: w.show_error(f"live sensor: {m}"))
+        worker.closed.connect(self._on_closed)
+        worker.finished.connect(lambda: self._on_finished(worker))
+        self._worker = worker
+        self.act_stop.setEnabled(True)
+        self.act_connect.setEnabled(False)
+        w.statusBar().showMessage(f"connecting to {settings.cli_port} …", 5000)
+        worker.start()
+
+    def stop(self) -> None:
+        """Stop the sensor (``sensorStop``, sent by the worker as the link closes)."""
+        if self._worker is not None:
+            self._worker.stop()
+
+    def wait(self, timeout_ms: int = 10000) -> bool:
+        if self._worker is None:
+            return True
+        self.stop()
+        return self._worker.wait(timeout_ms)
+
+    def shutdown(self) -> None:
+        self.wait()
+
+    # ---- worker -> window ----
+    def _on_connected(self, radar) -> None:
+        w = self._w
+        self.frame_period_s = radar.frame_period_s
+        w.playback_control.set_frame_period(radar.frame_period_s)
+        w.tracker.frame_period_s = radar.frame_period_s
+        w.playback.set_playing(False)
+        w.statusBar().showMessage(
+            f"sensor configured ({self._worker.settings.cfg if self._worker else ''}); "
+            "frames arriving",
+            5000,
+        )
+
+    def _on_frame(self, frame) -> None:
+        w = self._w
+        if w.cache.generation != self._generation:
+            self.stop()  # the scene was changed: the cache is no longer the sensor's
+            return
+        empty = np.zeros((0, 2))
+        # frames lost on the way keep their place: empty frames, as the importer inserts
+        while len(w.cache) < frame.index:
+            k = len(w.cache)
+            w.cache.append(
+                FrameData(
+                    index=k, t_s=k * self.frame_period_s, cloud=PointCloud.empty(), truth_xy_m=empty
+                )
+            )
+        w.cache.append(
+            FrameData(index=frame.index, t_s=frame.t_s, cloud=frame.cloud, truth_xy_m=empty)
+        )
+        self._received_s[frame.index] = frame.received_s
+        self.n_frames += 1
+        w.tracker.request()
+        if w.tracking_model.result is None:
+            w.playback.set_frame(len(w.cache) - 1)
+
+    def _on_tracked(self, result) -> None:
+        """Follow the newest tracked frame while live."""
+        if result is None or self._worker is None or self._w.cache.generation != self._generation:
+            return
+        index = result.n_frames - 1
+        self._w.playback.set_frame(index)
+        received = self._received_s.pop(index, None)
+        if received is not None:
+            self._w.redraw()  # drawn now: the latency counts to the end of this redraw
+            self.latencies_s.append(time.perf_counter() - received)
+
+    def _on_closed(self, summary: str) -> None:
+        self.act_stop.setEnabled(False)
+        self.act_connect.setEnabled(True)
+        self._w.statusBar().showMessage(summary, 10000)
+        self.last_summary = summary
+
+    def _on_finished(self, worker: LiveWorker) -> None:
+        if self._worker is worker:
+            self._worker = None
+        worker.deleteLater()
