@@ -84,6 +84,7 @@ class LiveController(QtCore.QObject):
         self._w = window
         self._worker: LiveWorker | None = None
         self.last_summary = ""
+        self._edge = 0
         self._generation = -1
         self._received_s: dict[int, float] = {}
         self.latencies_s: list[float] = []
@@ -137,6 +138,7 @@ class LiveController(QtCore.QObject):
         self._generation = w.cache.generation
         self._received_s.clear()
         self.latencies_s.clear()
+        self._edge = 0  # the newest frame the view was moved to: following while it is there
         self.n_frames = 0
         worker = LiveWorker(settings, params, record, self)
         worker.connected.connect(self._on_connected)
@@ -205,6 +207,9 @@ class LiveController(QtCore.QObject):
         if result is None or self._worker is None or self._w.cache.generation != self._generation:
             return
         index = result.n_frames - 1
+        if self._w.playback.frame < self._edge:
+            return  # the user went back to an earlier frame: stay there
+        self._edge = index
         self._w.playback.set_frame(index)
         received = self._received_s.pop(index, None)
         if received is not None:

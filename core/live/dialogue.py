@@ -120,8 +120,8 @@ def read_answer(
             got = " ".join(text.split())[-120:] or "nothing"
             raise LinkError(
                 f"no answer from the sensor to {command!r} within {timeout_s:g} s "
-                f"(got: {got!r}); is {port_name} the CLI port (not the data port), "
-                f"at {CLI_BAUD} baud?"
+                f"(got: {got!r}); is this the CLI port (not the data port), at its baud rate "
+                f"({CLI_BAUD} by default)?"
             )
 
 

@@ -205,3 +205,24 @@ def test_reconnect_after_stop(capture, tmp_path) -> None:
             assert em.commands.count("sensorStop") == 2 * (session + 1)
             # each session's recording starts at the first packet
             assert rec.read_bytes()[:8] == data[:8]
+
+
+def test_no_answer_names_the_line_and_the_likely_cause(capture) -> None:
+    data, cfg = capture
+    with SensorEmulator(data) as em:
+        # the ports swapped: the cfg goes to the data port, which never answers
+        link = LiveLink(
+            LinkSettings(
+                cli_port=em.data_port, data_port=em.cli_port, cfg=str(cfg), answer_timeout_s=0.3
+            )
+        )
+        with pytest.raises(LinkError) as info:
+            try:
+                link.start()
+            finally:
+                link.close()
+    first = next(i for i, ln in enumerate(cfg.read_text().splitlines(), 1) if ln == "sensorStop")
+    assert str(info.value) == (
+        f"{cfg}:{first}: no answer from the sensor to 'sensorStop' within 0.3 s (got: 'nothing'); "
+        "is this the CLI port (not the data port), at its baud rate (115200 by default)?"
+    )
