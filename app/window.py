@@ -445,8 +445,8 @@ class MainWindow(QtWidgets.QMainWindow):
     def _on_frames_added(self, n: int) -> None:
         if n == 1:  # the radar chain is compiled: now the tracker kernel (priority order)
             self.tracker.start_warm_up()
-        if n == 1 or n % RETRACK_EVERY_N_FRAMES == 0:
-            self.tracker.request()
+        if (n == 1 or n % RETRACK_EVERY_N_FRAMES == 0) and not self.live.running:
+            self.tracker.request()  # (a live sensor's frames come tracked: app/live.py)
         if self.playback.frame >= n - 1:
             self._dirty = True
 

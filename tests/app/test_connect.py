@@ -61,17 +61,27 @@ def test_live_frames_are_tracked_drawn_and_stopped(window, qtbot, capture, tmp_p
         qtbot.waitUntil(lambda: window.live.n_frames >= 40, timeout=30000)
         # the GUI kept drawing while the link ran in its worker
         assert window.n_draws > draws0
-        qtbot.waitUntil(
-            lambda: (
-                window.tracking_model.result is not None
-                and window.tracking_model.result.n_frames >= 30
-            ),
-            timeout=30000,
-        )
+        # while live, the overlay is the link's own tracks (no truth: no loss, RMSE, OSPA)
+        live = window.tracking_model.result
+        assert live.params_key == "live" and live.n_frames >= 40
+        assert np.isnan(live.running_loss).all() and np.isnan(live.ospa_m).all()
         window.live.stop()
         qtbot.waitUntil(window.live.act_connect.isEnabled, timeout=10000)
         assert em.commands[-1] == "sensorStop" and em.stopped.is_set()
         sent = bytes(em.sent)
+    # after Stop the session is re-tracked with the panel's parameters (the same as the link's
+    # here): the same tracks, from the compiled kernel
+    qtbot.waitUntil(
+        lambda: (
+            window.tracking_model.result.params_key != "live"
+            and window.tracking_model.result.n_frames == len(window.cache)
+        ),
+        timeout=30000,
+    )
+    retracked = window.tracking_model.result
+    for a, b in zip(live.frames, retracked.frames):
+        np.testing.assert_array_equal(a.track_id, b.track_id)
+        np.testing.assert_allclose(a.xy_m, b.xy_m, rtol=0, atol=1e-6)
     frames = window.cache.frames
     assert len(frames) >= 40 and all(len(f.cloud) == 3 for f in frames)
     assert [f.index for f in frames] == list(range(len(frames)))
