@@ -38,7 +38,14 @@ class LiveTracks:
     def __init__(self) -> None:
         self.frames: list[TrackFrame] = []
         self._est: list[tuple[float, float]] = []
-        self._rows: list[tuple[np.ndarray, ...]] = []  # (ids, t index, xy, psi, confirmed)
+        # every track of every frame so far, sorted by (id, frame): ids, frame, xy, ψ, confirmed
+        self._sorted: tuple[np.ndarray, ...] = (
+            np.zeros(0, np.int64),
+            np.zeros(0, np.int64),
+            np.zeros((0, 2)),
+            np.zeros(0),
+            np.zeros(0, bool),
+        )
 
     def add(self, index: int, tracks) -> None:
         """The tracks (:class:`core.tracking.results.FrameTracks`) of frame ``index``; frames
@@ -52,22 +59,19 @@ class LiveTracks:
         self.frames.append(tf)
         e = tracks.estimate
         self._est.append(tuple(tf.xy_m[e]) if e >= 0 else (np.nan, np.nan))
-        n = len(tf)
-        if n:
-            t = np.full(n, index, dtype=np.int64)
-            self._rows.append((tf.track_id, t, tf.xy_m, tf.psi, tf.confirmed))
+        if len(tf):
+            t = np.full(len(tf), index, dtype=np.int64)
+            new = (tf.track_id, t, tf.xy_m, tf.psi, tf.confirmed)
+            merged = [np.concatenate((a, b)) for a, b in zip(self._sorted, new)]
+            # the new rows are the latest frame: a stable sort by id keeps (id, frame) order
+            order = np.argsort(merged[0], kind="stable")
+            self._sorted = tuple(a[order] for a in merged)
 
     def result(self, frame_period_s: float) -> TrackingResult:
         t0 = time.perf_counter()
         n_f = len(self.frames)
-        if self._rows:
-            ids, t_idx, xy, psi, conf = (np.concatenate(c) for c in zip(*self._rows))
-        else:
-            ids, t_idx = np.zeros(0, np.int64), np.zeros(0, np.int64)
-            xy, psi, conf = np.zeros((0, 2)), np.zeros(0), np.zeros(0, bool)
-        # trails and ψ curves: by track, then frame; a NaN between tracks breaks the curve
-        order = np.lexsort((t_idx, ids))
-        ids, t_idx, xy, psi, conf = ids[order], t_idx[order], xy[order], psi[order], conf[order]
+        ids, t_idx, xy, psi, conf = self._sorted
+        # trails and ψ curves by track, then frame; a NaN between tracks breaks the curve
         breaks = np.flatnonzero(np.diff(ids)) + 1
         psi_t = np.insert(t_idx * frame_period_s, breaks, np.nan)
         est = np.array(self._est, dtype=float).reshape(n_f, 2)
