@@ -107,8 +107,11 @@ def run(args: argparse.Namespace) -> int:
         # however it ended (Ctrl-C included): sensorStop, ports closed, files put in place
         recorded = link.recorded_bytes
         path = link.close()
-        written = [] if tracks is None else [tracks.close()]
+        # a link that failed before its first frame leaves no tracks file (as no recording)
+        keep_tracks = tracks is not None and (n > 0 or failure is None)
+        written = [tracks.close()] if keep_tracks else []
     kept = f"; {path} keeps the {recorded} bytes that arrived" if path is not None else ""
+    kept += "".join(f"; {w} holds the tracks of the {n} frames" for w in written)
     if failure is not None:
         raise LinkError(failure.message + kept, failure.source)
     for note in link.notes:

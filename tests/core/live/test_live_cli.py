@@ -66,9 +66,9 @@ def test_frames_n_tracks_records_and_stops(capture, tmp_path, capsys) -> None:
 )
 def test_faults_are_one_line_and_exit_2(capture, tmp_path, capsys, faults, expected) -> None:
     data, cfg = capture
-    rec = tmp_path / "rec.dat"
+    rec, tracks = tmp_path / "rec.dat", tmp_path / "tracks.csv"
     with SensorEmulator(data, faults=faults) as em:
-        code = main(live_args(em, cfg, "--record", rec, "--quiet"))
+        code = main(live_args(em, cfg, "--record", rec, "--tracks", tracks, "--quiet"))
         sent = bytes(em.sent)
     err = capsys.readouterr().err.strip().splitlines()
     assert code == 2
@@ -78,8 +78,11 @@ def test_faults_are_one_line_and_exit_2(capture, tmp_path, capsys, faults, expec
     if faults.vanish_after:
         assert "12 frames" in line and f"{rec} keeps the {len(sent)} bytes" in line
         assert rec.read_bytes() == sent
+        assert line.endswith(f"; {tracks} holds the tracks of the 12 frames")
+        frames = {int(r["frame"]) for r in csv.DictReader(tracks.open())}
+        assert max(frames) == 11
     else:
-        assert not rec.exists()
+        assert not rec.exists() and not tracks.exists()
 
 
 def test_bad_cfg_is_one_line_before_any_port(tmp_path, capsys) -> None:
