@@ -108,8 +108,7 @@ def run(args: argparse.Namespace) -> int:
         recorded = link.recorded_bytes
         path = link.close()
         # a link that failed before its first frame leaves no tracks file (as no recording)
-        keep_tracks = tracks is not None and (n > 0 or failure is None)
-        written = [tracks.close()] if keep_tracks else []
+        written = [tracks.close()] if tracks is not None and (n > 0 or failure is None) else []
     kept = f"; {path} keeps the {recorded} bytes that arrived" if path is not None else ""
     kept += "".join(f"; {w} holds the tracks of the {n} frames" for w in written)
     if failure is not None:
