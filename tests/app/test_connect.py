@@ -120,3 +120,19 @@ def test_link_errors_are_one_line_in_a_message_box(
     assert window.errors[0].startswith("live sensor: ")
     assert window._error_box is not None and window._error_box.isVisible()
     assert window.live.act_connect.isEnabled()
+
+
+def test_connect_again_after_stop(window, qtbot, capture) -> None:
+    data, cfg = capture
+    with SensorEmulator(data, faults=Faults(frame_period_s=0.01)) as em:
+        settings = LinkSettings(cli_port=em.cli_port, data_port=em.data_port, cfg=str(cfg))
+        for session in range(2):
+            window.live.start(settings)
+            qtbot.waitUntil(lambda: window.live.n_frames >= 5, timeout=20000)
+            window.live.stop()
+            qtbot.waitUntil(window.live.act_connect.isEnabled, timeout=10000)
+            assert em.commands.count("sensorStart") == session + 1
+            assert em.commands[-1] == "sensorStop"
+    # the second session's frames replaced the first's, from its own frame 0
+    assert window.cache.frames[0].index == 0 and len(window.cache) >= 5
+    assert window.errors == []
