@@ -8,6 +8,9 @@ Measures (medians over repetitions, this machine is shared):
 * **slider → overlay drawn**: a tracker slider moved, until the views have drawn the re-tracked
   overlay (the first redraw after the new tracking result reached the GUI thread);
 * **playback redraws/s** at 4× and 8× while playing the cached scene;
+* **a live sensor at 20 frames/s** (the sensor emulator on pseudo-terminals streaming the scene's
+  clouds): from a frame's last byte read on the data port to the redraw showing it tracked, and
+  frames sent against frames received;
 * **event-loop gaps while a study runs**: a 5 ms ``QTimer`` probe records its ticks; a gap is
   the time between two ticks (the longest, and how many exceed 100 ms).
 
@@ -163,6 +166,9 @@ def run(quick: bool = False) -> dict:
                 "max_gap_ms": gaps["max_gap_ms"],
             }
 
+        # ---- live sensor ----
+        out["live"] = _live(qa, w, tmp, seconds=10.0 if quick else 60.0)
+
         # ---- study ----
         n_trials = 4 if quick else 12
         w.study_model.set_form(n_trials=n_trials, n_jobs=1, storage=str(tmp / "study.db"))
@@ -187,6 +193,73 @@ def run(quick: bool = False) -> dict:
         w.close()
         shutil.rmtree(tmp, ignore_errors=True)
     return out
+
+
+def _live(qa, w, tmp: Path, seconds: float, frame_period_s: float = 0.05) -> dict:
+    """A live link at 20 frames/s: the cached scene's clouds written as a UART capture (SDK 3
+    packets, as ``radartune export --format uart``), streamed by the sensor emulator on
+    pseudo-terminals, looped, for ``seconds``; the window connected to it as File → Connect
+    sensor does. Latency: from a frame's last byte written to the data port read by the link to
+    the end of the redraw showing that frame tracked, for every frame drawn so."""
+    from dataclasses import replace
+
+    from core.formats.ti_cfg import write_ti_cfg
+    from core.formats.ti_uart import encode_frame
+    from core.live import LinkSettings
+    from core.live.emulator import Faults, SensorEmulator
+
+    radar = replace(w.scene_model.scene.radar, frame_period_s=frame_period_s)
+    cfg = tmp / "live.cfg"
+    write_ti_cfg(radar, cfg)
+    capture = b"".join(encode_frame(f.cloud, k + 1) for k, f in enumerate(w.cache.frames))
+    probe = Probe()
+    latencies: list[float] = []
+    real_redraw = w.redraw
+
+    def redraw() -> None:
+        real_redraw()
+        received = w.live.received_s.pop(w.playback.frame, None)
+        tracked = w.tracking_model.result
+        if received is not None and tracked is not None and tracked.n_frames > w.playback.frame:
+            latencies.append(time.perf_counter() - received)
+
+    w.redraw = redraw
+    with SensorEmulator(capture, faults=Faults(), loop=True) as em:
+        settings = LinkSettings(cli_port=em.cli_port, data_port=em.data_port, cfg=str(cfg))
+        probe.start()
+        w.live.start(settings, str(tmp / "live.dat"))
+        _wait(qa, lambda: w.live.n_frames > 0, 30)
+        t_start = time.perf_counter()
+        n0 = w.live.n_frames
+        _wait(qa, lambda: False, seconds)
+        elapsed = time.perf_counter() - t_start
+        n_received = w.live.n_frames - n0
+        w.live.stop()
+        _wait(qa, lambda: not w.live.running and w.live.act_connect.isEnabled(), 30)
+        gaps = probe.stop()
+        n_sent = em.n_packets_sent
+    w.redraw = real_redraw
+    lat = sorted(1e3 * x for x in latencies)
+    record = tmp / "live.dat"
+    return {
+        "seconds": round(elapsed, 1),
+        "frame_period_ms": frame_period_s * 1e3,
+        "frames_sent": n_sent,
+        "frames_received": w.live.n_frames,
+        "frames_received_per_s": round(n_received / elapsed, 2),
+        "frames_in_cache": len(w.cache),
+        "dropped": w.live.n_dropped,
+        "damaged": w.live.n_damaged,
+        "frames_drawn_tracked": len(lat),
+        "latency_ms": {
+            "median": round(statistics.median(lat), 1) if lat else None,
+            "p90": round(lat[int(0.9 * (len(lat) - 1))], 1) if lat else None,
+            "max": round(lat[-1], 1) if lat else None,
+        },
+        "record_bytes": record.stat().st_size if record.exists() else 0,
+        "max_gap_ms": gaps["max_gap_ms"],
+        "errors": list(w.errors),
+    }
 
 
 def main(argv: list[str] | None = None) -> int:

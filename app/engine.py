@@ -418,19 +418,11 @@ def track_frame(ft) -> TrackFrame:
     """
     n = len(ft.ids)
     state = np.asarray(ft.state, dtype=float)
-    # no track (a recording that opens with empty frames): a (0, 4) state, not a reshape of
-    # an empty array whose width cannot be inferred
-    state = (
-        state.reshape(n, -1)
-        if n
-        else np.zeros((0, max(4, state.shape[-1] if state.ndim == 2 else 4)))
-    )
-    dim = state.shape[1]
-    cov = (
-        np.asarray(ft.covariance, dtype=float).reshape(n, dim, dim)
-        if n
-        else np.zeros((0, dim, dim))
-    )
+    # the state dimension from the array itself: reshape(0, -1) cannot infer it for a frame
+    # without tracks (a recording that starts with empty frames)
+    d = state.shape[-1] if state.ndim == 2 else (state.size // n if n else 4)
+    state = state.reshape(n, d)
+    cov = np.asarray(ft.covariance, dtype=float).reshape(n, d, d)
     n_assoc = getattr(ft, "n_associated", None)
     nis = getattr(ft, "nis", None)
     return TrackFrame(

@@ -141,6 +141,9 @@ class MainWindow(QtWidgets.QMainWindow):
 
         self.views_control = ViewsController(self)
         self.record = RecordController(self)
+        from app.live import LiveController  # File → Connect sensor … (a live TI sensor)
+
+        self.live = LiveController(self)
 
         # ---- wiring ----------------------------------------------------------------------------
         self.scene_control.info_changed.connect(self._on_scene_info)
@@ -442,8 +445,8 @@ class MainWindow(QtWidgets.QMainWindow):
     def _on_frames_added(self, n: int) -> None:
         if n == 1:  # the radar chain is compiled: now the tracker kernel (priority order)
             self.tracker.start_warm_up()
-        if n == 1 or n % RETRACK_EVERY_N_FRAMES == 0:
-            self.tracker.request()
+        if (n == 1 or n % RETRACK_EVERY_N_FRAMES == 0) and not self.live.running:
+            self.tracker.request()  # (a live sensor's frames come tracked: app/live.py)
         if self.playback.frame >= n - 1:
             self._dirty = True
 
@@ -674,6 +677,7 @@ class MainWindow(QtWidgets.QMainWindow):
         """Stop timers and workers (close, tests)."""
         self._draw_timer.stop()
         self.playback_control.stop()
+        self.live.shutdown()
         self.scene_control.stop()
         self.sim.wait()
         self.tracker.wait()

@@ -14,7 +14,8 @@
 - :mod:`~core.tracking.inputs` — measurement frames validated once, derived constants
 - :mod:`~core.tracking.results` — :class:`TrackerResult`, :class:`FrameTracks`, the kernel's
   :class:`~core.tracking.results.TrackRecord`
-- :mod:`~core.tracking.tracker` — :func:`run_tracker` (readable reference, every track)
+- :mod:`~core.tracking.tracker` — :func:`run_tracker` (readable reference, every track) and
+  :class:`~core.tracking.tracker.StreamTracker` (the same, one frame at a time: a live sensor)
 - :mod:`~core.tracking.kernel` — the same algorithm compiled with numba (hot path); the
   ``@njit`` code itself in :mod:`~core.tracking.kernel_jit`
 - :mod:`~core.tracking.batch` — :func:`track_dataset` over a :class:`core.dataset.Dataset`

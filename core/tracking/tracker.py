@@ -24,7 +24,7 @@ from core.tracking.inputs import Frames, TrackerConstants, frame_slices
 from core.tracking.params import TrackerParams
 from core.tracking.results import FrameTracks, TrackerResult
 
-__all__ = ["run_tracker", "gate_ellipses_xy"]
+__all__ = ["run_tracker", "gate_ellipses_xy", "StreamTracker"]
 
 
 @dataclass(slots=True)
@@ -193,6 +193,24 @@ def _step(
     return tracks, next_id
 
 
+def _frame_tracks(tracks: list[_Track], d: int, estimate: int) -> FrameTracks:
+    """The live tracks after a frame as the result type (struct of arrays)."""
+    n = len(tracks)
+    return FrameTracks(
+        ids=np.array([t.id for t in tracks], dtype=np.int64),
+        state=np.array([t.x for t in tracks]).reshape(n, d),
+        covariance=np.array([t.P for t in tracks]).reshape(n, d, d),
+        psi=np.array([t.psi for t in tracks]),
+        confirmed=np.array([t.confirmed for t in tracks], dtype=bool),
+        gate_center_xy=np.array([t.gate_center for t in tracks]).reshape(n, 2),
+        gate_shape_xy=np.array([t.gate_shape for t in tracks]).reshape(n, 2, 2),
+        birth_frame=np.array([t.birth for t in tracks], dtype=np.int64),
+        n_associated=np.array([t.n_associated for t in tracks], dtype=np.int64),
+        nis=np.array([t.nis for t in tracks], dtype=np.float64),
+        estimate=estimate,
+    )
+
+
 def run_tracker(
     frames: Frames,
     params: TrackerParams,
@@ -264,22 +282,7 @@ def run_tracker(
             est_x[f] = t.x
             est_P[f] = t.P
         if keep_tracks:
-            n = len(tracks)
-            kept.append(
-                FrameTracks(
-                    ids=ids,
-                    state=np.array([t.x for t in tracks]).reshape(n, d),
-                    covariance=np.array([t.P for t in tracks]).reshape(n, d, d),
-                    psi=psi,
-                    confirmed=conf,
-                    gate_center_xy=np.array([t.gate_center for t in tracks]).reshape(n, 2),
-                    gate_shape_xy=np.array([t.gate_shape for t in tracks]).reshape(n, 2, 2),
-                    birth_frame=np.array([t.birth for t in tracks], dtype=np.int64),
-                    n_associated=np.array([t.n_associated for t in tracks], dtype=np.int64),
-                    nis=np.array([t.nis for t in tracks], dtype=np.float64),
-                    estimate=b,
-                )
-            )
+            kept.append(_frame_tracks(tracks, d, b))
     return TrackerResult(
         estimate_xy=est_xy,
         has_estimate=has,
@@ -292,6 +295,46 @@ def run_tracker(
         n_confirmed=n_conf,
         frames=tuple(kept) if keep_tracks else None,
     )
+
+
+class StreamTracker:
+    """Tracks frames one at a time, for a stream whose end is not known (a live sensor).
+
+    Mutable: it holds the live tracks between frames. Each :meth:`step` is the frame step of
+    :func:`run_tracker` (``engine="numpy"``); fed a run's frames one by one it returns the same
+    :class:`FrameTracks` as ``run_tracker`` over the whole run.
+
+    Parameters
+    ----------
+    params
+        Tracker parameters.
+    frame_period_s
+        Time step T between frames (s), validated as :func:`~core.tracking.run_tracker` does.
+    """
+
+    def __init__(self, params: TrackerParams, frame_period_s: float) -> None:
+        self.params = params
+        self._c = TrackerConstants.build(params, frame_period_s)
+        self._tracks: list[_Track] = []
+        self._next_id = 0
+        self.n_frames = 0
+
+    def step(self, z: np.ndarray) -> FrameTracks:
+        """Track one frame of measurements ``z`` (m, 3) ``[r (m), az (rad), vr (m/s)]``."""
+        z = np.asarray(z, dtype=np.float64).reshape(-1, 3)
+        if not np.all(np.isfinite(z)):
+            raise InputError(f"a measurement of frame {self.n_frames} contains NaN or Inf")
+        self._tracks, self._next_id = _step(
+            self._tracks, z, self.params, self._c, self._next_id, self.n_frames
+        )
+        self.n_frames += 1
+        tracks = self._tracks
+        best = management.best_confirmed(
+            np.array([t.psi for t in tracks]),
+            np.array([t.id for t in tracks], dtype=np.int64),
+            np.array([t.confirmed for t in tracks], dtype=bool),
+        )
+        return _frame_tracks(tracks, self.params.state_dim, best)
 
 
 def gate_ellipses_xy(tracks: FrameTracks, n_points: int = 48) -> np.ndarray:
