@@ -32,6 +32,7 @@ COMMANDS = {
     "report": "core.cli.report",
     "import": "core.cli.imports",
     "export": "core.cli.export",
+    "export-cfg": "core.cli.export_cfg",
     "bench": "core.cli.bench",
     "gui": "core.cli.gui",
 }

@@ -1,0 +1,13 @@
+"""TI's people tracker (gtrack), rebuilt from TI's documentation beside the paper's IPDA.
+
+- :mod:`~core.tracking.gtrack.params` — :class:`GtrackParams` and the one mapping to and from
+  the ``.cfg`` tracker lines
+- :mod:`~core.tracking.gtrack.geometry` — sensor pose, constant-acceleration model, spherical
+  measurement and Jacobian (shares :mod:`core.tracking.ekf`)
+- :mod:`~core.tracking.gtrack.tracker` — :func:`run_gtrack`, the readable tracker
+"""
+
+from core.tracking.gtrack.params import GtrackParams, cfg_lines, params_from_cfg
+from core.tracking.gtrack.tracker import GtrackResult, run_gtrack
+
+__all__ = ["GtrackParams", "GtrackResult", "cfg_lines", "params_from_cfg", "run_gtrack"]

@@ -1,0 +1,366 @@
+"""gtrack: states and counters, allocation and gating thresholds, geometry, cfg lines."""
+
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from core.cli import main
+from core.errors import InputError
+from core.formats.ti_cfg import TRACKER_COMMAND_FIELDS, parse_ti_cfg, replace_tracker_lines
+from core.tracking import ekf
+from core.tracking.gtrack import GtrackParams, cfg_lines, params_from_cfg, run_gtrack
+from core.tracking.gtrack import geometry as geo
+from core.tracking.gtrack.synthetic import people_frames
+from core.tracking.gtrack.tracker import ACTIVE, DETECT, GtrackTracker, _Track
+
+RESOURCE = Path(__file__).resolve().parents[3] / "resources/gtrack/ti_people_counting_isk.cfg"
+
+
+def cluster(p: GtrackParams, c, v, n=25, spread=0.05, snr=5.0):
+    """n points (r, az, el, vr, snr) of a body at world centre c moving at world velocity v."""
+    M = geo.pose_matrix(p.sensor_azimuth_tilt_deg, p.sensor_elevation_tilt_deg)
+    k = np.arange(n)
+    offs = spread * np.column_stack([np.cos(k), np.sin(k), np.cos(2 * k)]) * (k % 3 == 1)[:, None]
+    w = np.asarray(c, float) + offs
+    ps = (w - [0, 0, p.sensor_height_m]) @ M
+    r = np.linalg.norm(ps, axis=1)
+    vs = M.T @ np.asarray(v, float)
+    return np.column_stack(
+        [
+            r,
+            np.arctan2(ps[:, 0], ps[:, 1]),
+            np.arcsin(ps[:, 2] / r),
+            ps @ vs / r,
+            np.full(n, snr),
+        ]  # fmt: skip
+    )
+
+
+def step(tr: GtrackTracker, pts: np.ndarray):
+    pts = np.asarray(pts, float).reshape(-1, 5)
+    return tr.step(pts[:, 0], pts[:, 1], pts[:, 2], pts[:, 3], pts[:, 4])
+
+
+def walk(p, n_frames, v=(0.0, 0.5, 0.0), start=(0.0, 3.0, 1.0), present=None):
+    """Frames of one walker (offsets for run_gtrack); ``present[f]`` False: no points."""
+    T = p.frame_period_s
+    frames = []
+    for f in range(n_frames):
+        c = np.asarray(start) + np.asarray(v) * f * T
+        ok = present is None or present[f]
+        frames.append(cluster(p, c, v) if ok else np.zeros((0, 5)))
+    off = np.concatenate(([0], np.cumsum([len(x) for x in frames])))
+    return np.concatenate(frames), off
+
+
+# -- states and counters -------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("det2act", [1, 2, 4])
+def test_active_after_det2act_consecutive_hits(det2act):
+    p = replace(GtrackParams(), det2act=det2act)
+    pts, off = walk(p, 6)
+    res = run_gtrack(pts, off, p)
+    assert [len(ft) for ft in res.frames] == [1] * 6  # one track from the first frame on
+    # allocation is the first hit: ACTIVE from frame det2act − 1 on
+    assert [bool(ft.confirmed[0]) for ft in res.frames] == [f >= det2act - 1 for f in range(6)]
+
+
+def test_detect_freed_after_det2free_misses():
+    p = replace(GtrackParams(), det2act=10, det2free=3)
+    present = [True, True] + [False] * 5
+    pts, off = walk(p, 7, present=present)
+    res = run_gtrack(pts, off, p)
+    # frames 2, 3 miss (kept), frame 4 is the third miss: freed
+    assert [len(ft) for ft in res.frames] == [1, 1, 1, 1, 0, 0, 0]
+
+
+@pytest.mark.parametrize(
+    ("in_static_box", "expected_misses"), [(False, 4), (True, 9)]
+)  # exit2free outside the static box, active2free inside it (moving: obscured)
+def test_active_freed_after_misses_depends_on_static_box(in_static_box, expected_misses):
+    p = replace(GtrackParams(), det2act=2, exit2free=4, active2free=9, static2free=30)
+    if not in_static_box:
+        p = replace(p, static_y_min_m=6.0, static_y_max_m=7.5)
+    n = 3 + 12
+    present = [True] * 3 + [False] * 12
+    pts, off = walk(p, n, present=present)
+    res = run_gtrack(pts, off, p)
+    alive = [len(ft) for ft in res.frames]
+    assert res.frames[2].confirmed[0]
+    # the k-th miss frame (k = 1..) is frame 2 + k: freed at k = expected_misses
+    assert alive[: 3 + expected_misses - 1] == [1] * (3 + expected_misses - 1)
+    assert alive[3 + expected_misses - 1 :] == [0] * (n - 3 - expected_misses + 1)
+
+
+def _still_track(tr: GtrackTracker, pos, vel) -> _Track:
+    d = tr.dims
+    x = np.zeros(3 * d)
+    x[:d], x[d : 2 * d] = pos, vel
+    return _Track(id=0, x=x, P=tr.P0.copy(), D=np.zeros(tr.m), state=ACTIVE, birth=0)
+
+
+@pytest.mark.parametrize(
+    ("pos", "vel", "limit"),
+    [
+        ((0.0, 3.0, 1.0), (0.0, 0.05, 0.0), "static2free"),  # still, in the static box
+        ((0.0, 3.0, 1.0), (0.0, 0.5, 0.0), "active2free"),  # moving in it: obscured
+        ((3.5, 3.0, 1.0), (0.0, 0.05, 0.0), "exit2free"),  # outside it
+    ],
+)
+def test_active_miss_rules_on_constructed_tracks(pos, vel, limit):
+    p = replace(GtrackParams(), active2free=7, static2free=11, exit2free=3)
+    tr = GtrackTracker(p)
+    t = _still_track(tr, pos, vel)
+    n = getattr(p, limit)
+    kept = [tr._transition(t, 0, np.zeros(0, bool)) for _ in range(n)]
+    assert kept == [True] * (n - 1) + [False]
+
+
+def test_sleep2free_counts_static_only_hits_in_static_box_and_a_moving_hit_resets():
+    p = replace(GtrackParams(), sleep2free=5)
+    tr = GtrackTracker(p)
+    t = _still_track(tr, (0.0, 3.0, 1.0), (0.0, 0.0, 0.0))
+    static, moving = np.ones(3, bool), np.array([True, False])
+    assert [tr._transition(t, 3, static) for _ in range(4)] == [True] * 4
+    assert tr._transition(t, 2, moving) and t.sleeps == 0  # a moving point resets the count
+    assert [tr._transition(t, 3, static) for _ in range(5)] == [True] * 4 + [False]
+    outside = _still_track(tr, (3.5, 3.0, 1.0), (0.0, 0.0, 0.0))
+    assert all(tr._transition(outside, 3, static) for _ in range(20))
+
+
+# -- allocation thresholds -------------------------------------------------------------------
+
+
+def _allocated(p, pts) -> int:
+    tr = GtrackTracker(p)
+    ft, _, _ = step(tr, pts)
+    return len(ft)
+
+
+def test_allocation_point_count_threshold_exact():
+    p = GtrackParams()
+    c, v = (0.0, 3.0, 1.0), (0.0, 0.5, 0.0)
+    assert _allocated(p, cluster(p, c, v, n=p.alloc_points)) == 1
+    assert _allocated(p, cluster(p, c, v, n=p.alloc_points - 1)) == 0
+
+
+def test_allocation_snr_threshold_exact():
+    p = replace(GtrackParams(), alloc_points=20, alloc_snr=40.0)
+    c, v = (0.0, 3.0, 1.0), (0.0, 0.5, 0.0)
+    assert _allocated(p, cluster(p, c, v, n=20, snr=2.0)) == 1  # sum 40.0
+    assert _allocated(p, cluster(p, c, v, n=20, snr=1.999)) == 0
+
+
+def test_allocation_velocity_threshold_exact():
+    p = replace(GtrackParams(), alloc_velocity_mps=0.1)
+    pts = cluster(p, (0.0, 3.0, 1.0), (0.0, 0.0, 0.0), n=25)
+    pts[:, 3] = 0.1
+    assert _allocated(p, pts) == 1
+    pts[:, 3] = 0.0999
+    assert _allocated(p, pts) == 0
+
+
+def test_allocation_distance_threshold_exact():
+    p = replace(GtrackParams(), alloc_points=20, alloc_distance_m2=0.5)
+    base = cluster(p, (0.0, 3.0, 1.0), (0.0, 0.5, 0.0), n=19, spread=0.0)
+    for factor, expected in ((0.999, 1), (1.001, 0)):
+        # the 20th point √0.5·factor from the others along world x
+        far = cluster(p, (np.sqrt(0.5) * factor, 3.0, 1.0), (0.0, 0.5, 0.0), n=1, spread=0.0)
+        far[:, 3] = base[0, 3]
+        assert _allocated(p, np.vstack([base, far])) == expected
+
+
+def test_allocation_velocity_spread_threshold():
+    p = replace(GtrackParams(), alloc_points=20, alloc_velocity_spread_mps=0.3)
+    pts = cluster(p, (0.0, 3.0, 1.0), (0.0, 0.5, 0.0), n=20, spread=0.0)
+    pts[:, 3] = 0.5
+    pts[-1, 3] = 0.5 + 0.299
+    assert _allocated(p, pts) == 1
+    pts[-1, 3] = 0.5 + 0.301
+    assert _allocated(p, pts) == 0
+
+
+def test_obscured_snr_threshold_behind_a_track():
+    p = replace(GtrackParams(), alloc_points=20, alloc_snr=40.0, alloc_snr_obscured=100.0)
+    v = (0.0, 0.5, 0.0)
+    near = cluster(p, (0.0, 2.0, 1.0), v, n=25, snr=5.0)
+    for snr, expected in ((4.0, 1), (5.0, 2)):  # sums 80 (< 100) and 100
+        tr = GtrackTracker(p)
+        step(tr, near)
+        behind = cluster(p, (0.0, 4.5, 1.0), v, n=20, snr=snr)
+        near2 = cluster(p, (0.0, 2.0 + 0.5 * p.frame_period_s, 1.0), v, n=25, snr=5.0)
+        ft, _, _ = step(tr, np.vstack([near2, behind]))
+        assert len(ft) == expected
+        # the same set beside the track (not behind it) needs only alloc_snr
+    tr = GtrackTracker(p)
+    step(tr, near)
+    beside = cluster(p, (2.5, 4.5, 1.0), v, n=20, snr=4.0)
+    ft, _, _ = step(tr, np.vstack([near2, beside]))
+    assert len(ft) == 2
+
+
+def test_static_points_never_start_a_track():
+    p = GtrackParams()
+    pts = cluster(p, (0.0, 3.0, 1.0), (0.0, 0.0, 0.0), n=60, snr=50.0)
+    assert np.all(pts[:, 3] == 0.0)
+    assert _allocated(replace(p, alloc_velocity_mps=0.0), pts) == 0
+
+
+# -- gating ----------------------------------------------------------------------------------
+
+
+def _probe_setup(p):
+    tr = GtrackTracker(p)
+    step(tr, cluster(p, (0.0, 3.0, 1.0), (0.0, 0.5, 0.0), n=25))
+    t = tr.tracks[0]
+    x_pred, P_pred = ekf.predict(t.x, t.P, tr.F, tr.Q)
+    H = geo.jacobian(x_pred, p.dims, tr.M, tr.h)
+    zp = geo.measure(x_pred, p.dims, tr.M, tr.h)
+    C = H @ P_pred @ H.T + tr.R + np.diag(t.D)
+    return tr, x_pred, zp, C
+
+
+@pytest.mark.parametrize(("factor", "taken"), [(0.999, True), (1.001, False)])
+def test_gate_gain_threshold_exact(factor, taken):
+    p = replace(GtrackParams(), gating_width_m=50, gating_depth_m=50, gating_height_m=50)
+    tr, _, zp, C = _probe_setup(p)
+    e = np.array([1.0, 0.0, 0.0, 0.0])  # along range
+    s = p.gating_gain / np.sqrt(e @ np.linalg.inv(C) @ e) * factor
+    z = zp + s * e
+    _, owner, _ = step(tr, np.array([[z[0], z[1], z[2], z[3], 5.0]]))
+    assert (owner[0] == tr.tracks[0].id) == taken
+
+
+@pytest.mark.parametrize(("factor", "taken"), [(1.001, True), (0.999, False)])
+def test_gate_depth_limit_exact(factor, taken):
+    p = replace(GtrackParams(), gating_gain=50.0)
+    tr, x_pred, zp, _ = _probe_setup(p)
+    z = zp + np.array([0.3, 0.0, 0.0, 0.0])
+    pw = geo.sensor_to_world(geo.spherical_to_sensor(z[0], z[1], z[2])[None], tr.M, tr.h)[0]
+    dy = abs(pw[1] - x_pred[1])
+    assert abs(pw[0] - x_pred[0]) < 0.5 and abs(pw[2] - x_pred[2]) < 0.5
+    tr.p = replace(p, gating_depth_m=2 * dy * factor)
+    _, owner, _ = step(tr, np.array([[z[0], z[1], z[2], z[3], 5.0]]))
+    assert (owner[0] == tr.tracks[0].id) == taken
+
+
+def test_points_outside_boundary_box_are_not_used():
+    p = GtrackParams()
+    pts = cluster(p, (0.0, 3.0, 1.0), (0.0, 0.5, 0.0), n=30)
+    assert _allocated(replace(p, boundary_y_max_m=2.5), pts) == 0
+    assert _allocated(p, pts) == 1
+
+
+# -- geometry and the whole tracker ----------------------------------------------------------
+
+
+@pytest.mark.parametrize("dims", [2, 3])
+def test_jacobian_matches_finite_differences(dims):
+    M = geo.pose_matrix(10.0, 15.0 if dims == 3 else 0.0)
+    h = 2.0 if dims == 3 else 0.0
+    rng = np.random.default_rng(1)
+    x = rng.normal(0, 1, 3 * dims)
+    x[1] += 4.0
+    H = geo.jacobian(x, dims, M, h)
+    num = np.zeros_like(H)
+    for i in range(3 * dims):
+        dx = np.zeros(3 * dims)
+        dx[i] = 1e-6
+        num[:, i] = (geo.measure(x + dx, dims, M, h) - geo.measure(x - dx, dims, M, h)) / 2e-6
+    np.testing.assert_allclose(H, num, atol=1e-6)
+
+
+def test_measurement_inverts_the_pose():
+    p = GtrackParams()
+    M = geo.pose_matrix(p.sensor_azimuth_tilt_deg, p.sensor_elevation_tilt_deg)
+    x = np.array([0.7, 3.2, 1.1, 0, 0, 0, 0, 0, 0])
+    z = geo.measure(x, 3, M, p.sensor_height_m)
+    back = geo.sensor_to_world(geo.spherical_to_sensor(z[0], z[1], z[2])[None], M, 2.0)[0]
+    np.testing.assert_allclose(back, x[:3], atol=1e-12)
+    # boresight of a sensor tilted 15° down at 2 m meets the floor at 2 / tan 15°
+    floor = geo.sensor_to_world(geo.spherical_to_sensor(2 / np.sin(np.radians(15)), 0, 0)[None],
+                                M, 2.0)[0]  # fmt: skip
+    np.testing.assert_allclose(floor, [0, 2 / np.tan(np.radians(15)), 0], atol=1e-12)
+
+
+def test_four_walkers_give_four_active_tracks_on_them():
+    p = GtrackParams()
+    pts, off, truth = people_frames(
+        np.random.default_rng(3), p, n_frames=60, n_people=4, points_per_person=25,
+        static_points=50, speed_mps=0.5,
+    )  # fmt: skip
+    res = run_gtrack(pts, off, p)
+    assert np.all(res.n_active[5:] == 4)
+    for f in range(5, 60):
+        ft = res.frames[f]
+        xy = ft.state[ft.confirmed, :2]
+        d = np.linalg.norm(xy[:, None] - truth[f][None, :, :2], axis=2)
+        assert d.min(axis=0).max() < 0.25
+    assert DETECT != ACTIVE
+
+
+# -- cfg lines -----------------------------------------------------------------------------
+
+
+def test_resource_cfg_is_the_default_params():
+    cmds = parse_ti_cfg(RESOURCE.read_text(), str(RESOURCE))
+    assert params_from_cfg(cmds, str(RESOURCE)) == GtrackParams()
+
+
+def test_cfg_round_trip_keeps_other_lines_and_values():
+    base = "% head\nsensorStop\nchannelCfg 15 7 0\n" + RESOURCE.read_text() + "sensorStart\n"
+    p = replace(GtrackParams(), gating_gain=2.5, det2act=7, alloc_distance_m2=0.812345,
+                max_radial_velocity_mps=5.3, frame_period_s=0.1, static_y_max_m=6.25)  # fmt: skip
+    text = replace_tracker_lines(base, cfg_lines(p))
+    assert params_from_cfg(parse_ti_cfg(text)) == replace(p, max_radial_velocity_mps=5.3)
+
+    def others(t):
+        return [ln for ln in t.splitlines() if ln.split()[0] not in TRACKER_COMMAND_FIELDS]
+
+    assert others(text) == others(base) and "channelCfg 15 7 0" in others(text)
+    assert "gatingParam 2.5 2 2 2 4" in text and "allocationParam 40 100 0.1 20 0.812345 20" in text
+    # without changes: the same lines back
+    again = replace_tracker_lines(base, cfg_lines(params_from_cfg(parse_ti_cfg(base))))
+    assert again == base
+
+
+def test_export_cfg_cli_round_trip(tmp_path):
+    base = tmp_path / "base.cfg"
+    base.write_text("sensorStop\nchannelCfg 15 7 0\n" + RESOURCE.read_text() + "sensorStart\n")
+    out = tmp_path / "out.cfg"
+    assert main(["export-cfg", "--cfg", str(base), "--out", str(out)]) == 0
+    assert out.read_text() == base.read_text()
+    pj = tmp_path / "p.json"
+    pj.write_text('{"gating_gain": 4.5, "exit2free": 9}')
+    assert main(["export-cfg", "--cfg", str(base), "--params", str(pj), "--out", str(out)]) == 0
+    got = params_from_cfg(parse_ti_cfg(out.read_text()))
+    assert got == replace(GtrackParams(), gating_gain=4.5, exit2free=9)
+
+
+@pytest.mark.parametrize(
+    ("line", "needle"),
+    [
+        ("gatingParam 3 2 x 2 4", "gatingParam field 3 'depthLimit'"),
+        ("stateParam 0 3 12 500 5 6000", "stateParam field 1 'det2actThre'"),
+        ("allocationParam 40 100 0.1 20 0.5", "field 6 'maxVelThre' missing"),
+        ("allocationParam 40 100 0.1 2.5 0.5 20", "allocationParam field 4 'pointsThre'"),
+        ("boundaryBox -4 -5 0 8 0 3", "boundaryBox field"),
+        ("maxAcceleration 0.1 nan 0.1", "maxAcceleration field 2 'maxAccelY'"),
+    ],
+)
+def test_bad_tracker_line_one_line_exit_2(tmp_path, capsys, line, needle):
+    base = tmp_path / "bad.cfg"
+    base.write_text("sensorStop\n" + line + "\nsensorStart\n")
+    out = tmp_path / "o.cfg"
+    assert main(["export-cfg", "--cfg", str(base), "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "bad.cfg:2" in err and needle in err
+    assert not out.exists()
+
+
+def test_params_json_unknown_key_is_refused():
+    with pytest.raises(InputError, match="unknown gtrack parameter"):
+        GtrackParams.from_dict({"gain": 3})
