@@ -22,6 +22,12 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--cfg", metavar="CFG", help="TI .cfg the recording was made with")
     p.add_argument("--truth", metavar="CSV", help="ground truth: time_s,person,x_m,y_m per line")
     p.add_argument("--format", choices=tuple(FORMATS), help="skip detection: read as this format")
+    p.add_argument(
+        "--columns",
+        metavar="MAP",
+        help="a plain CSV's column map: frame=COL,x=COL,y=COL[,z=,doppler=,snr=,time=] "
+        "(header names; implies --format csv)",
+    )
     p.add_argument("--out", required=True, metavar="DATASET.npz", help="data set to write")
     p.set_defaults(func=run)
 
@@ -36,7 +42,7 @@ def run(args: argparse.Namespace) -> int:
     t0 = time.perf_counter()
     check_output_path(args.out, what="data set")
     truth = read_truth_csv(args.truth) if args.truth else None
-    rec = read_recording(args.file, fmt=args.format, cfg=args.cfg)
+    rec = read_recording(args.file, fmt=args.format, cfg=args.cfg, columns=args.columns)
     ds = to_dataset(rec, truth=truth, source_name=str(args.file))
     ds.save(args.out)
     for line in rec.notes:

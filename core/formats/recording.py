@@ -55,6 +55,11 @@ class Recording:
     radar: RadarConfig
     notes: tuple[str, ...] = ()
     meta: dict = field(default_factory=dict)
+    #: TI's own tracks, when the recording has them: ``frame`` (index into the frames),
+    #: ``track_id``, ``x_m``, ``y_m``, ``z_m``, ``vx_mps``, ``vy_mps``, one entry per track row.
+    ref_tracks: dict[str, np.ndarray] | None = None
+    #: Per point of ``cloud``, the id of TI's track the firmware gave it (-1: none).
+    ref_point_track: np.ndarray | None = None
 
     @property
     def n_frames(self) -> int:
