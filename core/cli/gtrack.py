@@ -42,7 +42,7 @@ def run_track(args: argparse.Namespace) -> int:
     params = load_params(getattr(args, "cfg", None), args.params)
     ds = Dataset.load(args.data)
     t0 = time.perf_counter()
-    est, results = gtrack_dataset(ds, params)
+    est, results = gtrack_dataset(ds, params, engine=args.engine)
     elapsed = time.perf_counter() - t0
     n = len(est.frame_index)
     active = est.n_confirmed

@@ -29,10 +29,23 @@ def dataset_points(dataset: Dataset) -> np.ndarray:
 
 
 def gtrack_dataset(
-    dataset: Dataset, params: GtrackParams, *, trajectories: Sequence[int] | None = None
+    dataset: Dataset,
+    params: GtrackParams,
+    *,
+    trajectories: Sequence[int] | None = None,
+    engine: str = "numba",
 ) -> tuple[DatasetEstimates, list[GtrackResult]]:
     """Run gtrack on every selected trajectory; estimates as :func:`core.tracking.track_dataset`
-    (ACTIVE tracks are the confirmed ones, the estimate the ACTIVE track with most points)."""
+    (ACTIVE tracks are the confirmed ones, the estimate the ACTIVE track with most points).
+    ``engine``: ``"numba"`` (compiled, default) or ``"numpy"`` (the readable form)."""
+    from core.errors import InputError
+
+    if engine == "numba":
+        from core.tracking.gtrack.compiled import run_gtrack_compiled as run
+    elif engine == "numpy":
+        run = run_gtrack
+    else:
+        raise InputError(f"engine must be 'numba' or 'numpy', got engine={engine!r}")
     k_all = dataset.n_trajectories
     sel = np.arange(k_all) if trajectories is None else np.asarray(trajectories, dtype=np.int64)
     pts = dataset_points(dataset)
@@ -40,7 +53,7 @@ def gtrack_dataset(
     results = []
     for k in sel:
         a, b = int(t_off[k]), int(t_off[k + 1])
-        results.append(run_gtrack(pts[f_off[a] : f_off[b]], f_off[a : b + 1] - f_off[a], params))
+        results.append(run(pts[f_off[a] : f_off[b]], f_off[a : b + 1] - f_off[a], params))
     frames = [ft for res in results for ft in res.frames]
     n = len(frames)
     cap = params.max_tracks

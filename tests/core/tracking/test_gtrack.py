@@ -364,3 +364,35 @@ def test_bad_tracker_line_one_line_exit_2(tmp_path, capsys, line, needle):
 def test_params_json_unknown_key_is_refused():
     with pytest.raises(InputError, match="unknown gtrack parameter"):
         GtrackParams.from_dict({"gain": 3})
+
+
+# -- the compiled form ---------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    ("dims", "seed", "overrides"),
+    [
+        (3, 1, {}),
+        (3, 2, {"det2act": 1, "max_tracks": 5, "alloc_points": 8, "exit2free": 2}),
+        (2, 3, {"sensor_azimuth_tilt_deg": 10.0, "gating_velocity_mps": 0.0}),
+    ],
+)
+def test_compiled_equals_readable(dims, seed, overrides):
+    from core.tracking.gtrack.compiled import run_gtrack_compiled
+
+    p = replace(GtrackParams(), dims=dims, **overrides)
+    pts, off, _ = people_frames(
+        np.random.default_rng(seed), p, n_frames=80, n_people=4, points_per_person=25,
+        static_points=40,
+    )  # fmt: skip
+    a, b = run_gtrack_compiled(pts, off, p), run_gtrack(pts, off, p)
+    np.testing.assert_array_equal(a.point_track, b.point_track)
+    np.testing.assert_array_equal(a.presence, b.presence)
+    assert len(a.frames) == len(b.frames) == 80
+    assert sum(len(ft) for ft in b.frames) > 80  # tracks to compare
+    for fa, fb in zip(a.frames, b.frames):
+        for k in ("ids", "confirmed", "birth_frame", "n_associated"):
+            np.testing.assert_array_equal(getattr(fa, k), getattr(fb, k))
+        for k in ("state", "covariance", "gate_center_xy", "gate_shape_xy", "nis"):
+            np.testing.assert_allclose(getattr(fa, k), getattr(fb, k), rtol=1e-9, atol=1e-9)
+        assert fa.estimate == fb.estimate
