@@ -122,6 +122,41 @@ def _measure_jac(x, d, M, h, zp, H):
 
 
 @njit(cache=True)
+def _chol_inv(A, Ai):
+    """Ai = A⁻¹ of a symmetric positive-definite A (Cholesky A = L Lᵀ); returns ln det A."""
+    m = A.shape[0]
+    L = np.zeros((m, m))
+    logdet = 0.0
+    for i in range(m):
+        for j in range(i + 1):
+            acc = A[i, j]
+            for k in range(j):
+                acc -= L[i, k] * L[j, k]
+            if i == j:
+                L[i, i] = math.sqrt(acc)
+                logdet += 2.0 * math.log(L[i, i])
+            else:
+                L[i, j] = acc / L[j, j]
+    # L⁻¹ (lower), then A⁻¹ = L⁻ᵀ L⁻¹
+    Li = np.zeros((m, m))
+    for i in range(m):
+        Li[i, i] = 1.0 / L[i, i]
+        for j in range(i):
+            acc = 0.0
+            for k in range(j, i):
+                acc -= L[i, k] * Li[k, j]
+            Li[i, j] = acc / L[i, i]
+    for i in range(m):
+        for j in range(i + 1):
+            acc = 0.0
+            for k in range(i, m):
+                acc += Li[k, i] * Li[k, j]
+            Ai[i, j] = acc
+            Ai[j, i] = acc
+    return logdet
+
+
+@njit(cache=True)
 def _sym(A):
     return 0.5 * (A + A.T)
 
@@ -211,8 +246,7 @@ def gtrack_kernel(pts, off, M, F, Q, R, P0, fp, ip, boundary, static_box, presen
             for k in range(m):
                 C[k, k] += D[i, k]
             Cs[i] = _sym(C)
-            Cis[i] = np.linalg.inv(Cs[i])
-            logdet[i] = math.log(np.linalg.det(Cs[i]))
+            logdet[i] = _chol_inv(Cs[i], Cis[i])
         # gate and associate
         owner = np.full(k_pts, -1, np.int64)
         best = np.full(k_pts, np.inf)
@@ -281,7 +315,8 @@ def gtrack_kernel(pts, off, M, F, Q, R, P0, fp, ip, boundary, static_box, presen
             Rc = Rc / cnt
             H = Hs[i]
             S = _sym(H @ Pp[i] @ H.T + Rc)
-            Si = np.linalg.inv(S)
+            Si = np.zeros((m, m))
+            _chol_inv(S, Si)
             K = Pp[i] @ H.T @ Si
             X[i] = xp[i] + K @ nu_bar
             IKH = eye - K @ H
