@@ -396,3 +396,44 @@ def test_compiled_equals_readable(dims, seed, overrides):
         for k in ("state", "covariance", "gate_center_xy", "gate_shape_xy", "nis"):
             np.testing.assert_allclose(getattr(fa, k), getattr(fb, k), rtol=1e-9, atol=1e-9)
         assert fa.estimate == fb.estimate
+
+
+def test_track_cli_gtrack_runs_and_refuses_bad_cfg(tmp_path, capsys):
+    import json
+
+    from core.tracking.synthetic import synthetic_dataset
+
+    data = synthetic_dataset(0, 1, classes="a", n_frames=40).save(tmp_path / "d.npz")
+    out = tmp_path / "r.json"
+    args = ["track", "--data", str(data), "--tracker", "gtrack", "--engine", "numpy"]
+    assert main([*args, "--cfg", str(RESOURCE), "--out", str(out)]) == 0
+    doc = json.loads(out.read_text())
+    assert doc["tracker"] == "gtrack" and doc["params"]["gating_gain"] == 3.0
+    # one point a frame never reaches TI's 20-point allocation: no track, and it says so
+    assert max(doc["active_per_frame"]) == 0
+    bad = tmp_path / "bad.cfg"
+    bad.write_text("allocationParam 40 100 0.1 twenty 0.5 20\n")
+    capsys.readouterr()
+    assert main([*args, "--cfg", str(bad)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "bad.cfg:1" in err and "'pointsThre'" in err
+    assert main(["track", "--data", str(data), "--cfg", str(RESOURCE)]) == 2
+
+
+def test_gtrack_search_space_rows_are_params_fields_with_ti_defaults():
+    from dataclasses import fields
+
+    from core.tracking.space import GTRACK, SEARCH_SPACE, search_space
+
+    rows = search_space(GTRACK)
+    names = {f.name: f for f in fields(GtrackParams)}
+    default = GtrackParams()
+    assert len(rows) == 20 and len({r.name for r in rows}) == 20
+    for r in rows:
+        assert r.name in names and r.models == (GTRACK,)
+        assert r.default == getattr(default, r.name)  # TI's default lines
+        assert r.low <= r.default <= r.high
+        assert r.integer == (names[r.name].type == "int")
+    # the paper's rows are not among them, and theirs not among the paper's
+    assert not {r.name for r in rows} & {p.name for p in SEARCH_SPACE}
+    assert [p.name for p in search_space("cv")][:3] == ["q_coeff", "r11", "r22"]
