@@ -33,6 +33,7 @@ __all__ = [
     "SEARCH_SPACE",
     "P0_NAMES",
     "check_model",
+    "check_tuned",
     "parameter",
     "search_space",
     "p0_names",
@@ -188,6 +189,13 @@ def check_model(model: str) -> str:
     """Return ``model`` if it is a known motion model, else raise :class:`InputError`."""
     if model not in MODELS:
         raise InputError(f"model must be one of {', '.join(MODELS)}, got {model!r}")
+    return model
+
+
+def check_tuned(model: str) -> str:
+    """``model`` if it names a table of the search space (a motion model or ``"gtrack"``)."""
+    if model != GTRACK:
+        check_model(model)
     return model
 
 

@@ -437,3 +437,62 @@ def test_gtrack_search_space_rows_are_params_fields_with_ti_defaults():
     # the paper's rows are not among them, and theirs not among the paper's
     assert not {r.name for r in rows} & {p.name for p in SEARCH_SPACE}
     assert [p.name for p in search_space("cv")][:3] == ["q_coeff", "r11", "r22"]
+
+
+def _walker_dataset(path, n_traj=5, n_frames=30):
+    """A data set of walkers seen as gtrack sees people (25 points each a frame), with truth."""
+    import json
+
+    from core.dataset import Dataset
+
+    p = GtrackParams()
+    cols: dict[str, list] = {k: [] for k in ("frame", "r", "az", "el", "vr", "snr")}
+    truth, traj = [], []
+    f0 = 0
+    for k in range(n_traj):
+        pts, off, tr = people_frames(
+            np.random.default_rng(10 + k), p, n_frames=n_frames, n_people=1,
+            points_per_person=25, speed_mps=0.6,
+        )  # fmt: skip
+        cols["frame"].append(f0 + np.repeat(np.arange(n_frames), np.diff(off)))
+        for i, key in enumerate(("r", "az", "el", "vr", "snr")):
+            cols[key].append(pts[:, i])
+        truth.append(tr[:, :, :2])
+        traj += [k] * n_frames
+        f0 += n_frames
+    c = {k: np.concatenate(v) for k, v in cols.items()}
+    xyz = geo.spherical_to_sensor(c["r"], c["az"], c["el"])
+    t = np.concatenate(truth)
+    ds = Dataset(
+        frame=c["frame"].astype(np.int64), range_m=c["r"], azimuth_rad=c["az"],
+        elevation_rad=c["el"], radial_velocity_mps=c["vr"], snr_db=10 * np.log10(c["snr"]),
+        x_m=xyz[:, 0], y_m=xyz[:, 1], z_m=xyz[:, 2], source=np.zeros(len(c["r"]), np.int64),
+        trajectory=np.asarray(traj, np.int64),
+        truth_t_s=np.arange(f0) * p.frame_period_s, truth_xy_m=t,
+        truth_v_mps=np.zeros_like(t), trajectory_class=np.array(list("abcde"[:n_traj])),
+        scene_json="{}", radar_json=json.dumps({"frame_period_s": p.frame_period_s}),
+    )  # fmt: skip
+    return ds.save(path)
+
+
+def test_tune_tracker_gtrack_runs_a_study_and_gives_gtrack_params(tmp_path, capsys):
+    import json
+
+    data = _walker_dataset(tmp_path / "w.npz")
+    storage = f"sqlite:///{tmp_path / 's.db'}"
+    code = main(["tune", "--tracker", "gtrack", "--dataset", str(data), "--trials", "4",
+                 "--storage", storage, "--pruner", "none", "--no-progress"])  # fmt: skip
+    assert code == 0
+    out = json.loads(capsys.readouterr().out.strip().splitlines()[-1])
+    got = GtrackParams.from_dict({**GtrackParams().to_dict(), **out["params"]})
+    assert isinstance(got.det2act, int) and isinstance(got.alloc_points, int)
+    assert np.isfinite(out["best_loss"]) and out["best_loss"] > 0
+    # the chosen parameters track the walkers: the loss is the one gtrack gives them
+    from core.dataset import Dataset
+    from core.evaluation import evaluate
+    from core.tracking.gtrack.batch import gtrack_dataset
+
+    ds = Dataset.load(data)
+    ev = evaluate(ds, gtrack_dataset(ds, got)[0])
+    assert ev.loss_total == pytest.approx(out["best_loss"], rel=1e-9)
+    assert main(["tune", "--tracker", "gtrack", "--model", "cv", "--dataset", str(data)]) == 2
