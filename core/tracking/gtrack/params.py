@@ -21,6 +21,7 @@ from pathlib import Path
 from core.errors import InputError
 from core.files import read_json, write_json_atomic
 from core.formats.ti_cfg import TRACKER_COMMAND_FIELDS, TiCommand, tracker_fields
+from core.limits import FRAME_PERIOD_RANGE_S, MAX_TRACKS
 
 __all__ = ["GtrackParams", "CFG_MAP", "params_from_cfg", "cfg_lines", "BOX_NAMES"]
 
@@ -30,6 +31,10 @@ BOX_NAMES = {
     "static": "staticBoundaryBox",
     "presence": "presenceBoundaryBox",
 }
+#: Upper bound of the counters and point counts (frames or points).
+MAX_COUNT = 1_000_000
+#: Upper bound of the lengths, speeds and accelerations (m, m/s, m/s²): far beyond any room.
+MAX_SCALE = 1e4
 _BOX_SUFFIX = ("x_min_m", "x_max_m", "y_min_m", "y_max_m", "z_min_m", "z_max_m")
 
 
@@ -180,6 +185,24 @@ class GtrackParams:
         ):
             if getattr(self, name) < 0:
                 raise InputError(f"{name} must be >= 0, got {name}={getattr(self, name)}")
+        if self.max_tracks > MAX_TRACKS:
+            raise InputError(
+                f"max_tracks must be <= {MAX_TRACKS}, got max_tracks={self.max_tracks}"
+            )
+        for name in ("max_points", "det2act", "det2free", "active2free", "static2free",
+                     "exit2free", "sleep2free", "alloc_points"):  # fmt: skip
+            if getattr(self, name) > MAX_COUNT:
+                raise InputError(f"{name} must be <= {MAX_COUNT}, got {name}={getattr(self, name)}")
+        lo, hi = FRAME_PERIOD_RANGE_S
+        if not lo <= self.frame_period_s <= hi:
+            raise InputError(f"frame_period_s must be in [{lo}, {hi}] s, got {self.frame_period_s}")
+        for name in ("sensor_height_m", "gating_width_m", "gating_depth_m", "gating_height_m",
+                     "gating_velocity_mps", "max_radial_velocity_mps",
+                     "radial_velocity_resolution_mps", "alloc_velocity_mps",
+                     "alloc_velocity_spread_mps", "max_accel_x_mps2", "max_accel_y_mps2",
+                     "max_accel_z_mps2", "range_sigma_m", "doppler_sigma_mps"):  # fmt: skip
+            if getattr(self, name) > MAX_SCALE:
+                raise InputError(f"{name} must be <= {MAX_SCALE:g}, got {getattr(self, name)}")
         if not -90.0 < self.sensor_elevation_tilt_deg < 90.0:
             raise InputError(
                 "sensor_elevation_tilt_deg must be in (-90, 90), "

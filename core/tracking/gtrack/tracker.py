@@ -144,9 +144,9 @@ class GtrackTracker:
         p, d = self.p, self.dims
         n = len(r)
         z = self._meas(r, az, el, vr)
-        pw = geo.sensor_to_world(geo.spherical_to_sensor(r, az, el), self.M, self.h)
-        if d == 2:
-            pw = geo.sensor_to_world(geo.spherical_to_sensor(r, az, np.zeros_like(el)), self.M, 0)
+        # 2-D: the points in the horizontal plane (no elevation, no height)
+        el_w = el if d == 3 else np.zeros_like(el)
+        pw = geo.sensor_to_world(geo.spherical_to_sensor(r, az, el_w), self.M, self.h)
         usable = _in_box(pw, p.box("boundary"), d)
         static = np.abs(vr) < 0.5 * p.radial_velocity_resolution_mps
         half = np.array([p.gating_width_m, p.gating_depth_m, p.gating_height_m])[:d] / 2.0

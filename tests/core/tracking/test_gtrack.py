@@ -496,3 +496,18 @@ def test_tune_tracker_gtrack_runs_a_study_and_gives_gtrack_params(tmp_path, caps
     ev = evaluate(ds, gtrack_dataset(ds, got)[0])
     assert ev.loss_total == pytest.approx(out["best_loss"], rel=1e-9)
     assert main(["tune", "--tracker", "gtrack", "--model", "cv", "--dataset", str(data)]) == 2
+
+
+@pytest.mark.parametrize(
+    ("line", "needle"),
+    [
+        ("stateParam 3 3 12 500 5 60000000000", "'sleep2freeThre': sleep2free must be <="),
+        ("trackingCfg 1 2 800 99999 46 96 55", "'maxNumTracks': max_tracks must be <="),
+        ("trackingCfg 1 2 800 30 46 96 0", "'deltaT': frame_period_s must be"),
+        ("sensorPosition 2 0 95", "'elevationTilt'"),
+    ],
+)
+def test_out_of_range_tracker_fields_name_line_and_field(line, needle):
+    with pytest.raises(InputError) as exc:
+        params_from_cfg(parse_ti_cfg("% x\n" + line + "\n"), "t.cfg")
+    assert needle in str(exc.value) and "t.cfg:2" in str(exc.value)
