@@ -283,7 +283,65 @@ def run(quick: bool = False) -> dict:
             **gui,
         }
     out["jipda"] = jipda_bench(ds, quick)
+    out["gtrack"] = gtrack_bench(quick)
     return out
+
+
+#: gtrack's benchmark frames: four walkers of 25 points and 50 static points (150 a frame).
+GTRACK_PEOPLE, GTRACK_POINTS, GTRACK_STATIC, GTRACK_FRAMES = 4, 25, 50, 1000
+
+
+def gtrack_bench(quick: bool = False) -> dict:
+    """gtrack (compiled, TI's default lines) on 150-point frames with four walkers, against the
+    paper's tracker (compiled JIPDA, CV defaults) on the same points' [r, az, vr] in the same
+    run: CPU time of a pass, best of repeats, and the ratio; the readable gtrack once."""
+    from core.tracking import TrackerParams
+    from core.tracking.gtrack import GtrackParams, run_gtrack
+    from core.tracking.gtrack.compiled import run_gtrack_compiled
+    from core.tracking.gtrack.synthetic import people_frames
+    from core.tracking.kernel import track_frames
+
+    n_frames = 200 if quick else GTRACK_FRAMES
+    gp = GtrackParams()
+    pts, off, _ = people_frames(
+        np.random.default_rng(0),
+        gp,
+        n_frames=n_frames,
+        n_people=GTRACK_PEOPLE,
+        points_per_person=GTRACK_POINTS,
+        static_points=GTRACK_STATIC,
+    )
+    repeats = 3 if quick else 15
+    t0 = time.perf_counter()
+    res = run_gtrack_compiled(pts, off, gp, frames=False)  # loads (or compiles) the kernel
+    first = time.perf_counter() - t0
+    _, c_g = _best_of(lambda: run_gtrack_compiled(pts, off, gp, frames=False), repeats)
+    z = np.ascontiguousarray(pts[:, [0, 1, 3]])
+    t_off = np.array([0, n_frames], dtype=np.int64)
+    sel = np.zeros(1, dtype=np.int64)
+    pp = TrackerParams.default("cv")
+    track_frames(z, off, t_off, sel, pp, gp.frame_period_s, record=False)
+    _, c_p = _best_of(
+        lambda: track_frames(z, off, t_off, sel, pp, gp.frame_period_s, record=False), repeats
+    )
+    n_read = min(n_frames, 100)
+    c0 = time.process_time()
+    run_gtrack(pts[: off[n_read]], off[: n_read + 1], gp)
+    c_r = time.process_time() - c0
+    return {
+        "frames": n_frames,
+        "points_per_frame": float(off[-1] / n_frames),
+        "scene": "core.tracking.gtrack.synthetic.people_frames: 4 walkers x 25 points, 50 "
+        "static points, seed 0; gtrack with TI's default lines (GtrackParams())",
+        "first_call_s": first,
+        "gtrack_frames_per_s": n_frames / c_g,
+        "gtrack_us_per_frame": 1e6 * c_g / n_frames,
+        "paper_jipda_frames_per_s": n_frames / c_p,
+        "ratio_gtrack_to_paper_time": c_g / c_p,
+        "readable_gtrack_frames_per_s": n_read / c_r,
+        "compiled_over_readable": (n_read / c_r and (n_frames / c_g) / (n_read / c_r)),
+        "mean_active_tracks": float(np.mean(res.n_active)),
+    }
 
 
 #: People in the cost-against-people measurement.
@@ -416,4 +474,14 @@ def summary(result: dict) -> str:
                 f"{r['jipda_mean_confirmed']:.2f}"
             )
         lines.append(f"plot: {j['plot']}")
+    g = result.get("gtrack")
+    if g:
+        lines.append(
+            f"gtrack ({g['frames']} frames, {g['points_per_frame']:.0f} points a frame, "
+            f"{g['mean_active_tracks']:.2f} ACTIVE tracks): {g['gtrack_frames_per_s']:.0f} "
+            f"frames/s ({g['gtrack_us_per_frame']:.0f} µs a frame, CPU); the paper's JIPDA on "
+            f"the same points {g['paper_jipda_frames_per_s']:.0f} frames/s (gtrack takes "
+            f"{g['ratio_gtrack_to_paper_time']:.2f}x its time); readable gtrack "
+            f"{g['readable_gtrack_frames_per_s']:.0f} frames/s ({g['compiled_over_readable']:.0f}x)"
+        )
     return "\n".join(lines)

@@ -33,6 +33,7 @@ COMMANDS = {
     "import": "core.cli.imports",
     "export": "core.cli.export",
     "live": "core.cli.live",
+    "export-cfg": "core.cli.export_cfg",
     "bench": "core.cli.bench",
     "gui": "core.cli.gui",
 }

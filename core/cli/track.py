@@ -47,6 +47,13 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         help="data association: joint IPDA over tracks sharing measurements, or independent "
         "IPDA per track (default: the parameters' 'association', jipda)",
     )
+    p.add_argument(
+        "--tracker",
+        choices=("paper", "gtrack"),
+        default="paper",
+        help="the paper's (J)IPDA, or TI's people tracker rebuilt (gtrack); default: paper",
+    )
+    p.add_argument("--cfg", help="gtrack: take the tracker lines of this TI .cfg")
     p.set_defaults(func=run)
 
 
@@ -64,6 +71,12 @@ def run(args: argparse.Namespace) -> int:
     from core.tracking import TrackerParams, track_dataset
     from core.tracking.warm import load_compiled
 
+    if args.tracker == "gtrack":
+        from core.cli.gtrack import run_track
+
+        return run_track(args)
+    if args.cfg:
+        raise InputError("--cfg sets gtrack's tracker lines: use it with --tracker gtrack")
     if args.params and args.model:
         raise InputError("give either --params or --model, not both")
     for out_path, what in ((args.out, "--out"), (args.tracks, "--tracks")):

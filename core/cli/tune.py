@@ -37,7 +37,14 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         epilog=epilog("tune"),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    p.add_argument("--model", required=True, help="motion model: cv or ca")
+    p.add_argument("--model", help="motion model: cv or ca (the paper's tracker)")
+    p.add_argument(
+        "--tracker",
+        choices=("paper", "gtrack"),
+        default="paper",
+        help="paper: the (J)IPDA with --model; gtrack: TI's people tracker rebuilt, its own "
+        "parameter table (default: paper)",
+    )
     p.add_argument("--trials", type=int, default=300, help="total trials (all workers)")
     p.add_argument("--jobs", type=int, default=1, help="worker processes (default: %(default)s)")
     p.add_argument("--storage", default=DEFAULT_STORAGE, help="storage URL (default: %(default)s)")
@@ -153,6 +160,14 @@ def run(args: argparse.Namespace) -> int:
     from core.optimization.study import StudySettings
     from core.optimization.validation import TOP_K, VALIDATION_SEED, check_same_radar
 
+    if args.tracker == "gtrack":
+        if args.model not in (None, "gtrack"):
+            raise InputError(
+                "--model is the paper tracker's motion model: not with --tracker gtrack"
+            )
+        args.model = "gtrack"
+    elif args.model is None:
+        raise InputError("--model is required (cv or ca), or give --tracker gtrack")
     if args.repeats < 1:
         raise InputError(f"--repeats must be >= 1, got {args.repeats}")
     top_k = TOP_K if args.top_k is None else args.top_k

@@ -420,3 +420,112 @@ def ti_cfg_text(radar: RadarConfig, comment: str = "") -> str:
 def write_ti_cfg(radar: RadarConfig, path: str | os.PathLike, comment: str = "") -> None:
     """Write ``radar`` as a TI ``.cfg`` file (atomically: temporary name, then rename)."""
     write_text_atomic(path, ti_cfg_text(radar, comment))
+
+
+#: TI's tracker lines (3-D people counting demo; docs/tracking/gtrack.md cites the syntax):
+#: command -> its fields in order, (name, int or float). Extra trailing fields (a later SDK's
+#: ``trackingCfg`` boresight filter flag) are kept as they are when lines are rewritten.
+TRACKER_COMMAND_FIELDS: dict[str, tuple[tuple[str, type], ...]] = {
+    "trackingCfg": (
+        ("enable", int),
+        ("paramSet", int),
+        ("maxNumPoints", int),
+        ("maxNumTracks", int),
+        ("maxRadialVelocity", float),
+        ("radialVelocityResolution", float),
+        ("deltaT", float),
+    ),
+    "sensorPosition": (("sensorHeight", float), ("azimuthTilt", float), ("elevationTilt", float)),
+    **{
+        box: tuple((n, float) for n in ("xMin", "xMax", "yMin", "yMax", "zMin", "zMax"))
+        for box in ("boundaryBox", "staticBoundaryBox", "presenceBoundaryBox")
+    },
+    "gatingParam": (
+        ("gain", float),
+        ("widthLimit", float),
+        ("depthLimit", float),
+        ("heightLimit", float),
+        ("velocityLimit", float),
+    ),
+    "stateParam": (
+        ("det2actThre", int),
+        ("det2freeThre", int),
+        ("active2freeThre", int),
+        ("static2freeThre", int),
+        ("exit2freeThre", int),
+        ("sleep2freeThre", int),
+    ),
+    "allocationParam": (
+        ("snrThre", float),
+        ("snrThreObscured", float),
+        ("velocityThre", float),
+        ("pointsThre", int),
+        ("maxDistanceThre", float),
+        ("maxVelThre", float),
+    ),
+    "maxAcceleration": (("maxAccelX", float), ("maxAccelY", float), ("maxAccelZ", float)),
+}
+
+
+def tracker_fields(
+    commands: list[TiCommand], source: str = "<cfg>"
+) -> dict[str, tuple[TiCommand, tuple[float | int, ...]]]:
+    """The tracker lines of parsed TI commands, each field converted (int or finite number).
+
+    A line given twice: the last one counts (as on the device). Raises :class:`InputError`
+    naming file, line and field of a missing or malformed field.
+    """
+    out: dict[str, tuple[TiCommand, tuple[float | int, ...]]] = {}
+    for cmd in commands:
+        spec = TRACKER_COMMAND_FIELDS.get(cmd.name)
+        if spec is None:
+            continue
+        where = f"{source}:{cmd.line}"
+        if len(cmd.args) < len(spec):
+            missing = spec[len(cmd.args)][0]
+            raise InputError(
+                f"{cmd.name} needs {len(spec)} fields, got {len(cmd.args)} "
+                f"(field {len(cmd.args) + 1} {missing!r} missing)",
+                where,
+            )
+        values: list[float | int] = []
+        for i, ((name, kind), text) in enumerate(zip(spec, cmd.args), start=1):
+            try:
+                value: float | int = int(text, 10) if kind is int else float(text)
+            except ValueError:
+                what = "an integer" if kind is int else "a number"
+                raise InputError(
+                    f"{cmd.name} field {i} {name!r}: expected {what}, got {text!r}", where
+                ) from None
+            if isinstance(value, float) and not math.isfinite(value):
+                raise InputError(f"{cmd.name} field {i} {name!r}: not finite, got {text!r}", where)
+            values.append(value)
+        out[cmd.name] = (cmd, tuple(values))
+    return out
+
+
+def replace_tracker_lines(text: str, lines: dict[str, str]) -> str:
+    """``text`` with each tracker line of ``lines`` (command -> full line) put in place.
+
+    Every other line is kept as it was (comments, blank lines, line order). An existing line is
+    replaced where it stands, keeping its extra trailing fields; a line ``text`` lacks goes
+    before ``sensorStart`` (or at the end).
+    """
+    out: list[str] = []
+    done: set[str] = set()
+    for raw in text.splitlines():
+        stripped = raw.strip()
+        name = stripped.split()[0] if stripped and not stripped.startswith("%") else ""
+        if name in lines:
+            old = stripped.split()[1:]
+            extra = old[len(TRACKER_COMMAND_FIELDS[name]) :]
+            out.append(" ".join([lines[name], *extra]))
+            done.add(name)
+        elif name == "sensorStart":
+            out += [lines[n] for n in lines if n not in done]
+            done.update(lines)
+            out.append(raw)
+        else:
+            out.append(raw)
+    out += [lines[n] for n in lines if n not in done]
+    return "\n".join(out) + "\n"

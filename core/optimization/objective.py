@@ -29,7 +29,13 @@ import numpy as np
 from core.errors import InputError
 from core.evaluation.loss import NO_CONFIRMATION_LOSS
 from core.evaluation.robust import OBJECTIVES, aggregate, check_objective
-from core.optimization.space import P0_NAMES, check_model, search_space, tracker_params_dict
+from core.optimization.space import (
+    GTRACK,
+    P0_NAMES,
+    check_tuned,
+    search_space,
+    tracker_params_dict,
+)
 
 
 class TrajectoryScore(NamedTuple):
@@ -176,6 +182,41 @@ class TrackerLosses:
         ]
 
 
+class GtrackLosses(TrackerLosses):
+    """The paper's loss (and its multi-person form) of gtrack (:mod:`core.tracking.gtrack`,
+    compiled) on a cached data set; ``base_params`` are GtrackParams JSON keys not tuned (the
+    pose, the boxes, the frame period), the trial's parameters override them."""
+
+    def warm_up(self, model: str) -> None:
+        """Load the compiled gtrack before the first trial."""
+        import numpy as np
+
+        from core.tracking.gtrack import GtrackParams
+        from core.tracking.gtrack.compiled import run_gtrack_compiled
+
+        params = GtrackParams.from_dict(self.base_params)
+        run_gtrack_compiled(np.zeros((0, 5)), np.zeros(2, dtype=np.int64), params)
+
+    def losses(self, params: dict[str, Any], ks: Sequence[int]) -> list[TrajectoryScore]:
+        from core.evaluation import trajectory_loss_terms
+        from core.evaluation.robust import trajectory_capped_losses
+        from core.tracking.gtrack import GtrackParams
+        from core.tracking.gtrack.batch import gtrack_dataset
+
+        if not len(ks):
+            return []
+        gp = GtrackParams.from_dict({**self.base_params, **params})
+        est, _ = gtrack_dataset(self.dataset, gp, trajectories=list(ks))
+        terms = trajectory_loss_terms(self.dataset, est)
+        capped = (
+            trajectory_capped_losses(self.dataset, est) if self.capped else [math.nan] * len(terms)
+        )
+        return [
+            TrajectoryScore(float(value), float(mse), int(n_c), c)
+            for (value, mse, n_c), c in zip(terms, capped, strict=True)
+        ]
+
+
 @dataclass(frozen=True, slots=True, kw_only=True)
 class TrialResult:
     """Outcome of evaluating one parameter set on all (or a pruned prefix of) trajectories.
@@ -305,10 +346,14 @@ def uses_capped(loss: str) -> bool:
 def make_losses(objective: str, model: str, dataset: Any = None, **kwargs: Any) -> TrajectoryLosses:
     """Loss source by name: ``"tracker"`` (needs ``dataset``; ``capped=False`` skips the capped
     loss) or ``"quadratic"`` (tests)."""
-    check_model(model)
+    check_tuned(model)
     if objective == "tracker":
         if dataset is None:
             raise InputError("objective 'tracker' needs a data set")
+        if model == GTRACK:
+            return GtrackLosses(
+                dataset, kwargs.get("base_params"), capped=bool(kwargs.get("capped", True))
+            )
         return TrackerLosses(
             dataset, kwargs.get("base_params"), capped=bool(kwargs.get("capped", True))
         )
@@ -323,6 +368,7 @@ def make_losses(objective: str, model: str, dataset: Any = None, **kwargs: Any) 
 
 __all__ = [
     "NO_CONFIRMATION_LOSS",
+    "GtrackLosses",
     "QuadraticLosses",
     "TrackerLosses",
     "TrajectoryLosses",

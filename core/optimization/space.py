@@ -14,12 +14,14 @@ from typing import Any, Protocol
 
 from core.errors import InputError
 from core.tracking.space import (
+    GTRACK,
     MODELS,
     P0_NAMES,
     SEARCH_SPACE,
     STATE_DIM,
     Parameter,
     check_model,
+    check_tuned,
     p0_names,
     search_space,
 )
@@ -30,6 +32,7 @@ __all__ = [
     "SEARCH_SPACE",
     "Parameter",
     "check_model",
+    "check_tuned",
     "flat_params",
     "search_space",
     "suggest_params",
@@ -42,11 +45,17 @@ class SuggestsFloats(Protocol):
 
     def suggest_float(self, name: str, low: float, high: float, *, log: bool = False) -> float: ...
 
+    def suggest_int(self, name: str, low: int, high: int, *, log: bool = False) -> int: ...
+
 
 def suggest_params(trial: SuggestsFloats, model: str) -> dict[str, float]:
-    """Sample one point of the space with the trial's sampler; flat dict by Optuna name."""
+    """Sample one point of the space with the trial's sampler; flat dict by Optuna name
+    (whole numbers for integer rows: gtrack's counters and point threshold)."""
     return {
-        b.name: trial.suggest_float(b.name, b.low, b.high, log=b.log) for b in search_space(model)
+        b.name: trial.suggest_int(b.name, int(b.low), int(b.high), log=b.log)
+        if b.integer
+        else trial.suggest_float(b.name, b.low, b.high, log=b.log)
+        for b in search_space(model)
     }
 
 
@@ -60,6 +69,11 @@ def tracker_params_dict(flat: dict[str, Any], model: str) -> dict[str, Any]:
     missing = [n for n in names if n not in flat]
     if missing:
         raise InputError(f"parameters missing for model {model}: {', '.join(missing)}")
+    if model == GTRACK:  # GtrackParams JSON: the rows by name, counters as integers
+        return {
+            b.name: int(round(float(flat[b.name]))) if b.integer else float(flat[b.name])
+            for b in search_space(model)
+        }
     out: dict[str, Any] = {"model": model}
     for n in names:
         if n not in P0_NAMES:
@@ -74,12 +88,22 @@ def flat_params(params: dict[str, Any]) -> dict[str, float]:
     Used to enqueue known parameters (``study.enqueue_trial``); values outside the bounds are an
     error naming the field.
     """
+    if "model" not in params and any(b.name in params for b in search_space(GTRACK)):
+        flat: dict[str, float] = {}
+        for b in search_space(GTRACK):
+            if b.name not in params:
+                raise InputError(f"parameter {b.name} missing")
+            value = float(params[b.name])
+            if not b.low <= value <= b.high:
+                raise InputError(f"{b.name} must be in [{b.low}, {b.high}], got {value}")
+            flat[b.name] = value
+        return flat
     model = check_model(str(params.get("model", "cv")))
     p0 = list(params.get("p0", []))
     n_p0 = STATE_DIM[model]
     if len(p0) != n_p0:
         raise InputError(f"p0 must have {n_p0} entries for model {model}, got {len(p0)}")
-    flat: dict[str, float] = {}
+    flat = {}
     for b in search_space(model):
         if b.name in P0_NAMES:
             value = float(p0[P0_NAMES.index(b.name)])

@@ -44,7 +44,7 @@ import numpy as np
 from core.errors import InputError
 from core.evaluation.robust import DEFAULT_OBJECTIVE, check_objective
 from core.optimization.objective import evaluate, make_losses, uses_capped
-from core.optimization.space import check_model, suggest_params, tracker_params_dict
+from core.optimization.space import check_tuned, suggest_params, tracker_params_dict
 from core.optimization.storage import (
     DEFAULT_STORAGE,
     absolute_url,
@@ -74,7 +74,7 @@ class StudySettings:
     Parameters
     ----------
     model
-        Motion model, ``"cv"`` or ``"ca"``.
+        Motion model, ``"cv"`` or ``"ca"``, or ``"gtrack"`` (TI's tracker, its own table).
     n_trials
         Total number of counted (COMPLETE + PRUNED) trials over all workers and runs.
     n_jobs
@@ -116,7 +116,7 @@ class StudySettings:
     loss: str = DEFAULT_OBJECTIVE
 
     def __post_init__(self) -> None:
-        check_model(self.model)
+        check_tuned(self.model)
         if int(self.n_trials) < 1:
             raise InputError(f"n_trials must be >= 1, got {self.n_trials}")
         if int(self.n_jobs) < 1:

@@ -26,11 +26,14 @@ from core.errors import InputError
 
 __all__ = [
     "MODELS",
+    "GTRACK",
+    "GTRACK_SPACE",
     "STATE_DIM",
     "Parameter",
     "SEARCH_SPACE",
     "P0_NAMES",
     "check_model",
+    "check_tuned",
     "parameter",
     "search_space",
     "p0_names",
@@ -39,6 +42,8 @@ __all__ = [
 
 #: Motion models: constant velocity and constant acceleration.
 MODELS = ("cv", "ca")
+#: The key of TI's tracker's table (:data:`GTRACK_SPACE`), beside the motion models.
+GTRACK = "gtrack"
 #: State dimension per motion model: CV [x, y, vx, vy], CA [x, y, vx, vy, ax, ay].
 STATE_DIM = {"cv": 4, "ca": 6}
 
@@ -63,9 +68,11 @@ class Parameter:
     log
         Sampled on a log scale (the interval spans a decade or more).
     models
-        The motion models that use it.
+        The motion models that use it (``("gtrack",)``: a row of gtrack's table).
     default
         The default value (docs/decisions/tracker-03), inside ``[low, high]``.
+    integer
+        Takes whole numbers only (gtrack's counters and point threshold).
     """
 
     name: str
@@ -77,14 +84,17 @@ class Parameter:
     log: bool
     models: tuple[str, ...] = MODELS
     default: float
+    integer: bool = False
 
     def __post_init__(self) -> None:
         if not self.low < self.high:
             raise InputError(f"{self.name}: low must be < high, got {self.low}, {self.high}")
         if self.log and self.low <= 0:
             raise InputError(f"{self.name}: a log scale needs low > 0, got {self.low}")
-        if not self.models or not set(self.models) <= set(MODELS):
-            raise InputError(f"{self.name}: models must be some of {MODELS}, got {self.models}")
+        if not self.models or not set(self.models) <= {*MODELS, GTRACK}:
+            raise InputError(
+                f"{self.name}: models must be some of {(*MODELS, GTRACK)}, got {self.models}"
+            )
         if not (math.isfinite(self.default) and self.low <= self.default <= self.high):
             raise InputError(
                 f"{self.name}: default must lie in [{self.low}, {self.high}], got {self.default}"
@@ -132,6 +142,43 @@ SEARCH_SPACE: tuple[Parameter, ...] = (
 )
 # fmt: on
 
+
+def _g(name: str, meaning: str, unit: str, low: float, high: float, default: float, *,
+       log: bool = False, integer: bool = False) -> Parameter:  # fmt: skip
+    return Parameter(name=name, symbol=name, meaning=meaning, unit=unit, low=low, high=high,
+                     log=log, models=(GTRACK,), default=default, integer=integer)  # fmt: skip
+
+
+#: gtrack's tuned parameters (core.tracking.gtrack.GtrackParams fields; the cfg lines in
+#: docs/tracking/gtrack.md). Defaults: TI's published people-counting lines. TI documents the
+#: defaults and meanings, not search intervals: the intervals are RadarTune's, a decade or more
+#: around TI's default where TI's tuning advice moves the value.
+# fmt: off
+GTRACK_SPACE: tuple[Parameter, ...] = (
+    _g("gating_gain", "gating gain", "", 1.0, 10.0, 3.0, log=True),
+    _g("gating_width_m", "gating width limit", "m", 0.5, 4.0, 2.0),
+    _g("gating_depth_m", "gating depth limit", "m", 0.5, 4.0, 2.0),
+    _g("gating_height_m", "gating height limit", "m", 0.5, 4.0, 2.0),
+    _g("gating_velocity_mps", "gating velocity limit", "m/s", 0.5, 20.0, 4.0, log=True),
+    _g("det2act", "DETECT to ACTIVE hits", "", 1, 20, 3, integer=True),
+    _g("det2free", "DETECT to FREE misses", "", 1, 20, 3, integer=True),
+    _g("active2free", "ACTIVE to FREE misses", "", 1, 100, 12, log=True, integer=True),
+    _g("static2free", "static to FREE misses", "", 10, 2000, 500, log=True, integer=True),
+    _g("exit2free", "exit to FREE misses", "", 1, 50, 5, log=True, integer=True),
+    _g("sleep2free", "sleep to FREE frames", "", 50, 10000, 6000, log=True, integer=True),
+    _g("alloc_snr", "allocation SNR sum", "", 5.0, 1000.0, 40.0, log=True),
+    _g("alloc_snr_obscured", "obscured allocation SNR sum", "", 10.0, 2000.0, 100.0, log=True),
+    _g("alloc_velocity_mps", "allocation radial velocity", "m/s", 0.0, 1.0, 0.1),
+    _g("alloc_points", "allocation points", "", 2, 50, 20, integer=True),
+    _g("alloc_distance_m2", "allocation squared distance", "m²", 0.05, 4.0, 0.5, log=True),
+    _g("alloc_velocity_spread_mps", "allocation velocity spread", "m/s", 0.2, 20.0, 20.0,
+       log=True),
+    _g("max_accel_x_mps2", "maximum acceleration x", "m/s²", 0.01, 10.0, 0.1, log=True),
+    _g("max_accel_y_mps2", "maximum acceleration y", "m/s²", 0.01, 10.0, 0.1, log=True),
+    _g("max_accel_z_mps2", "maximum acceleration z", "m/s²", 0.01, 10.0, 0.1, log=True),
+)
+# fmt: on
+
 _BY_NAME = {p.name: p for p in SEARCH_SPACE}
 
 #: The initial standard deviations, in state order (``p0_ii`` is entry ``i`` of ``p0``).
@@ -145,6 +192,13 @@ def check_model(model: str) -> str:
     return model
 
 
+def check_tuned(model: str) -> str:
+    """``model`` if it names a table of the search space (a motion model or ``"gtrack"``)."""
+    if model != GTRACK:
+        check_model(model)
+    return model
+
+
 def parameter(name: str) -> Parameter:
     """The row of ``name``; :class:`InputError` naming it if it is not optimised."""
     try:
@@ -154,7 +208,9 @@ def parameter(name: str) -> Parameter:
 
 
 def search_space(model: str) -> tuple[Parameter, ...]:
-    """The rows ``model`` uses, in table order (CV: 12, CA: 14)."""
+    """The rows ``model`` uses, in table order (CV: 12, CA: 14; ``"gtrack"``: gtrack's 20)."""
+    if model == GTRACK:
+        return GTRACK_SPACE
     check_model(model)
     return tuple(p for p in SEARCH_SPACE if model in p.models)
 

@@ -359,6 +359,47 @@ def test_mutated_shipped_cfgs(data, path: Path) -> None:
     radar(data.draw(byte_mutations(path.read_bytes())), "cfg mutated")
 
 
+# ---- TI .cfg: gtrack's tracker lines (export-cfg) ------------------------------------------
+
+GTRACK_CFG = ROOT / "resources" / "gtrack" / "ti_people_counting_isk.cfg"
+TRACKER_LINES = [
+    "trackingCfg", "sensorPosition", "boundaryBox", "staticBoundaryBox", "presenceBoundaryBox",
+    "gatingParam", "stateParam", "allocationParam", "maxAcceleration",
+]  # fmt: skip
+
+
+def export_cfg(data: bytes, label: str) -> None:
+    def write(folder: Path) -> list[str]:
+        (folder / "base.cfg").write_bytes(data)
+        return ["export-cfg", "--cfg", str(folder / "base.cfg"), "--out", str(folder / "o.cfg")]
+
+    check(run_input(write, label=label))
+
+
+@FUZZ_SETTINGS
+@given(
+    edits=st.lists(
+        st.tuples(st.sampled_from(TRACKER_LINES), st.lists(cfg_words, max_size=9)),
+        min_size=1,
+        max_size=4,
+    ),
+)
+def test_generated_tracker_lines(edits: list) -> None:
+    """TI's default tracker lines with lines replaced by generated fields."""
+    lines = GTRACK_CFG.read_text().splitlines()
+    for name, words in edits:
+        line = " ".join([name, *words])
+        hits = [i for i, ln in enumerate(lines) if ln.split()[:1] == [name]]
+        lines[hits[0]] = line
+    export_cfg(("\n".join(lines) + "\n").encode("utf-8", "surrogatepass"), "tracker cfg generated")
+
+
+@FUZZ_SETTINGS
+@given(data=st.data())
+def test_mutated_tracker_lines(data) -> None:
+    export_cfg(data.draw(byte_mutations(GTRACK_CFG.read_bytes())), "tracker cfg mutated")
+
+
 # ---- parameter JSON: track -----------------------------------------------------------------
 
 
