@@ -75,8 +75,17 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         "--loss",
         default=None,
         help="what trials minimise: trimmed (default for a new study: L_t without the largest "
-        "10 %% of the trajectory losses), paper (L_t, eq. 14), capped or median (docs/tuning.md; "
-        "the paper's L_t is always recorded; a resumed study keeps its own)",
+        "10 %% of the trajectory losses), paper (L_t, eq. 14), capped or median; without "
+        "positions (recordings): count, fragmentation (default with a head count) or nis "
+        "(default without) (docs/tuning.md; the paper's L_t is recorded where there is truth; a "
+        "resumed study keeps its own)",
+    )
+    p.add_argument(
+        "--people",
+        type=int,
+        default=None,
+        help="people in every frame of the data sets (a recording without truth): the head "
+        "count of the count and fragmentation objectives",
     )
     p.add_argument(
         "--validation",
@@ -158,6 +167,8 @@ def run(args: argparse.Namespace) -> int:
     top_k = TOP_K if args.top_k is None else args.top_k
     if top_k < 1:
         raise InputError(f"--top-k must be >= 1, got {top_k}")
+    if args.people is not None and args.people < 0:
+        raise InputError(f"--people must be >= 0, got {args.people}")
     if args.loss is None:
         args.loss = _default_loss(args)
     check_objective(args.loss)
@@ -174,6 +185,7 @@ def run(args: argparse.Namespace) -> int:
         objective=args.objective,
         objective_options=_options(args.objective_option),
         loss=args.loss,
+        people=args.people,
     )
     # every data set is resolved and checked before any study is touched
     plans: list[tuple[StudySettings, str | None]] = []
@@ -187,7 +199,7 @@ def run(args: argparse.Namespace) -> int:
         sets = _training_sets(args)
         paths = [resolve_dataset(d, person_model=args.person_model) for d in sets]
         for train_path in dict.fromkeys(paths):
-            require_truth(train_path)
+            require_truth(train_path, args.loss, args.people)
         val_arg = args.validation
         if val_arg is None and _paper_seed(args.dataset) is not None:
             val_arg = f"paper:{VALIDATION_SEED}:{_paper_model(args)}"
@@ -201,7 +213,7 @@ def run(args: argparse.Namespace) -> int:
             if args.person_model is None:
                 val_arg = like_training(val_arg, paths[0])
             validation = resolve_dataset(val_arg, person_model=args.person_model)
-            require_truth(validation)
+            require_truth(validation, args.loss, args.people)
             if validation in paths:
                 raise InputError(f"--validation {val_arg!r} is a training set of this run")
             check_same_radar(paths[0], validation, "validation")
@@ -250,11 +262,27 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _default_loss(args: argparse.Namespace) -> str:
-    """The objective when ``--loss`` is not given (:func:`core.optimization.loss_of_study`)."""
+    """The objective when ``--loss`` is not given (:func:`core.optimization.loss_of_study`); for
+    a new study on a data-set file without truth: ``fragmentation`` with ``--people``, else
+    ``nis`` (said on stderr)."""
+    from core.evaluation.robust import DEFAULT_OBJECTIVE
     from core.optimization.study import loss_of_study
 
     name = args.study or f"radartune-{args.model}"
-    return loss_of_study(args.storage, f"{name}-r0" if args.repeats > 1 else name)
+    loss = loss_of_study(args.storage, f"{name}-r0" if args.repeats > 1 else name)
+    if loss != DEFAULT_OBJECTIVE or _paper_seed(args.dataset) is not None:
+        return loss
+    if args.objective == "tracker" and not _file_has_truth(args.dataset):
+        loss = "fragmentation" if args.people is not None else "nis"
+        print(f"the data set has no truth: the study minimises --loss {loss}", file=sys.stderr)
+    return loss
+
+
+def _file_has_truth(path: str) -> bool:
+    from core.dataset import Dataset
+    from core.formats.recording import has_truth
+
+    return has_truth(Dataset.load(path))
 
 
 def _repeat(base: StudySettings, i: int, n: int, *, dataset: str | None) -> StudySettings:
@@ -375,16 +403,23 @@ def exit_code(
     return EXIT_WORKER_LOST
 
 
-def require_truth(path: str) -> None:
-    """A study scores tracks against ground truth: refuse a data set without any (an imported
-    recording without ``--truth``) with one line."""
+def require_truth(path: str, loss: str = "paper", people: int | None = None) -> None:
+    """What the objective ``loss`` needs of a data set (:data:`core.evaluation.robust.
+    OBJECTIVE_NEEDS`): refuse, with one line, a data set without truth for an objective on
+    positions, or without a head count (``--people`` or the truth) for count and fragmentation."""
     from core.dataset import Dataset
     from core.errors import InputError
+    from core.evaluation.robust import OBJECTIVE_NEEDS
     from core.formats.recording import has_truth
 
+    need = OBJECTIVE_NEEDS[loss]
+    if not need or (need == "head count" and people is not None):
+        return
     if not has_truth(Dataset.load(path)):
         raise InputError(
-            "the data set has no ground truth (imported without --truth?): a study needs "
-            "truth to score; import it again with --truth CSV",
+            f"the data set has no ground truth (imported without --truth?): --loss {loss} needs "
+            f"{'positions' if need == 'truth' else 'a head count'}; import it again with --truth "
+            "CSV, or tune without positions: --loss count|fragmentation with --people N, or "
+            "--loss nis",
             str(path),
         )

@@ -43,6 +43,7 @@ __all__ = [
     "head_counts",
     "nis_samples",
     "recording_scores",
+    "trajectory_terms",
 ]
 
 #: Block length of the count's bootstrap (s): longer than a ghost's or a lost track's life.
@@ -275,4 +276,67 @@ def recording_scores(
         )
     return RecordingScores(
         count=count, nis=consistency_stat(nis_samples(estimates), NIS_DOF), people=source
+    )
+
+
+def trajectory_terms(
+    kind: str, estimates: Any, counts: np.ndarray | None
+) -> list[tuple[float, float]]:
+    """Per tracked trajectory, the value of a study objective without positions and its weight.
+
+    ``kind`` (see docs/tuning.md):
+
+    - ``"count"``: mean_f |n̂_f − n_f| over the trajectory's frames; weight: its frames.
+    - ``"fragmentation"``: ``(Σ_f |n̂_f − n_f| + max(N_ids − max_f n_f, 0)) / Σ_f n_f``, the
+      complement of a positionless MOTA (missed and false tracks per frame, and every confirmed
+      id beyond one per person as an identity switch); weight: the person-frames Σ_f n_f (a
+      run without persons weighs 1 and scores its false tracks per frame).
+    - ``"nis"``: the fraction of the confirmed tracks' NIS samples outside the χ²₃ band (a
+      consistent filter: 5 %); weight: the samples. A trajectory without a sample scores 1
+      with weight 1 (a tracker that confirms nothing is not consistent, it is silent).
+
+    Parameters
+    ----------
+    kind
+        ``"count"``, ``"fragmentation"`` or ``"nis"``.
+    estimates
+        :class:`core.tracking.DatasetEstimates` (with its ``record`` unless ``kind`` is count).
+    counts
+        (F_sel,) head count of every output frame (None only for ``"nis"``).
+    """
+    off = np.asarray(estimates.offsets, dtype=np.int64)
+    spans = [slice(off[i], off[i + 1]) for i in range(len(off) - 1)]
+    if kind == "nis":
+        from core.evaluation.consistency import chi2_band
+
+        lo, hi = chi2_band(NIS_DOF)
+        rec = estimates.record
+        if rec is None:
+            raise ValueError("the nis objective needs every track: with_tracks=True")
+        cap = rec.ids.shape[1]
+        live = np.arange(cap)[None, :] < np.asarray(rec.n_tracks)[:, None]
+        v = np.where(live & rec.confirmed, rec.nis, np.nan)
+        out = []
+        for s in spans:
+            x = v[s][np.isfinite(v[s])]
+            out.append(
+                (float(np.mean((x < lo) | (x > hi))), float(x.size)) if x.size else (1.0, 1.0)
+            )
+        return out
+    if counts is None:
+        raise InputError(f"the {kind} objective needs a head count (--people N, or truth)")
+    d = np.abs(np.asarray(estimates.n_confirmed, np.int64) - np.asarray(counts, np.int64))
+    if kind == "count":
+        return [(float(np.mean(d[s])) if d[s].size else 0.0, float(d[s].size)) for s in spans]
+    if kind == "fragmentation":
+        ids = confirmed_ids(estimates)
+        out = []
+        for s in spans:
+            n = np.asarray(counts[s], np.int64)
+            extra = max(int(np.unique(ids[s][ids[s] >= 0]).size) - int(n.max(initial=0)), 0)
+            person_frames = max(float(n.sum()), 1.0)
+            out.append(((float(d[s].sum()) + extra) / person_frames, person_frames))
+        return out
+    raise InputError(
+        f"objective without positions must be count, fragmentation or nis, got {kind!r}"
     )

@@ -43,7 +43,7 @@ import numpy as np
 
 from core.errors import InputError
 from core.evaluation.robust import DEFAULT_OBJECTIVE, check_objective
-from core.optimization.objective import evaluate, make_losses, uses_capped
+from core.optimization.objective import evaluate, make_losses, uses_capped, without_positions
 from core.optimization.space import check_model, suggest_params, tracker_params_dict
 from core.optimization.storage import (
     DEFAULT_STORAGE,
@@ -100,6 +100,9 @@ class StudySettings:
         recorded beside it on every trial (user attribute ``paper_loss``).
     objective_options
         Options of the quadratic objective (``n_trajectories``, ``delay_s``).
+    people
+        Head count in every frame of the data set (``--people N``) for the objectives without
+        positions (``count``, ``fragmentation``); None: the truth's.
     """
 
     model: str = "cv"
@@ -114,9 +117,12 @@ class StudySettings:
     objective: str = "tracker"
     objective_options: dict[str, float] = field(default_factory=dict)
     loss: str = DEFAULT_OBJECTIVE
+    people: int | None = None
 
     def __post_init__(self) -> None:
         check_model(self.model)
+        if self.people is not None and (isinstance(self.people, bool) or int(self.people) < 0):
+            raise InputError(f"people must be a whole number >= 0, got {self.people!r}")
         if int(self.n_trials) < 1:
             raise InputError(f"n_trials must be >= 1, got {self.n_trials}")
         if int(self.n_jobs) < 1:
@@ -380,9 +386,16 @@ def prepare_study(settings: StudySettings, *, dataset_path: str | None = None) -
         "loss": settings.loss,
         "space": "paper-eq15",
     }
+    if settings.people is not None:
+        attrs["people"] = int(settings.people)
     study = load_existing_study(storage, settings.name)
     if study is not None:
         old = study.user_attrs
+        if old.get("people") != attrs.get("people"):
+            raise InputError(
+                f"study {settings.name!r} in {redact(settings.storage)} has people="
+                f"{old.get('people')!r}, asked {attrs.get('people')!r}; use another --study name"
+            )
         for key in ("model", "objective", "sampler", "pruner", "loss"):
             # a study made before robust objectives existed minimised the paper's loss
             if old.get(key, "paper" if key == "loss" else None) != attrs[key]:
@@ -520,11 +533,14 @@ def run_worker(
         sampler=sampler_for(0),
         pruner=make_pruner(attrs["pruner"]),
     )
+    loss = str(attrs.get("loss", "paper"))
     losses = make_losses(
         attrs["objective"],
         model,
         load_dataset_for(attrs, dataset_path),
-        capped=uses_capped(str(attrs.get("loss", "paper"))),
+        capped=uses_capped(loss),
+        without_positions=without_positions(loss),
+        people=attrs.get("people"),
         **dict(attrs.get("objective_options") or {}),
     )
     if hasattr(losses, "warm_up"):
@@ -590,7 +606,8 @@ def run_worker(
                 ) from None
             continue
         failures = 0
-        if attrs.get("loss", "paper") != "paper":  # else the trial's value is L_t itself
+        if attrs.get("loss", "paper") != "paper" and math.isfinite(result.paper_value):
+            # else the trial's value is L_t itself, or the data set has no truth for it
             trial.set_user_attr("paper_loss", result.paper_value)
         if result.pruned:
             study.tell(trial, state=TrialState.PRUNED)
