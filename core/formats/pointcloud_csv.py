@@ -32,7 +32,13 @@ import numpy as np
 from core.config import PAPER_RADAR, RadarConfig
 from core.errors import InputError
 from core.files import decode_utf8, read_bytes
-from core.formats.recording import Recording, frames_from_numbers, points_to_cloud
+from core.formats.recording import (
+    Recording,
+    frames_from_numbers,
+    point_tracks_from_indices,
+    points_to_cloud,
+)
+from core.formats.ti_uart import linear_snr_db, peak_db
 from core.limits import FRAME_PERIOD_RANGE_S
 
 #: Names of the three CSV rows of :data:`core.recordings.FORMATS`.
@@ -49,9 +55,6 @@ MAP_OPTIONAL = ("z", "doppler", "snr", "time")
 #: Candidate steps of the vendor CSV's SNR (``snr · snrUnit``), largest first; see
 #: :func:`_unsigned_snr`.
 SNR_UNITS = (1.0, 0.5, 0.25, 0.125, 0.1, 0.05, 0.04, 0.025, 0.02, 0.01)
-#: The target-index values of TLV 1011 that are not a track id (TI: 253 SNR too weak,
-#: 254 outside the boundary box, 255 not associated).
-TARGET_INDEX_NONE = 253
 
 
 def _first_line(head: bytes) -> str:
@@ -335,14 +338,10 @@ def read_oob(path: Path, radar: RadarConfig | None) -> Recording:
     slot, t_s, trajectory, cfg, notes = _frame_grid(numbers, times, radar, src, "out-of-box CSV")
     pts = ~placeholder
     if extra >= 1:
-        intensity = a[:, 6]
-        with np.errstate(divide="ignore", invalid="ignore"):
-            snr = np.where(
-                intensity > 0, 10.0 * np.log10(np.where(intensity > 0, intensity, 1.0)), np.nan
-            )
+        snr = peak_db(a[:, 6])
         notes.append(
-            "SNR: 10·log10(Intensity), the linear peak value on a dB scale (the noise level is "
-            "not in the file: it ranks points, it is not the demo's SNR)"
+            "SNR: 20·log10(Intensity), the linear peak value on a dB scale (the noise level is "
+            "not in the file: it ranks points, it is not an SNR)"
         )
     else:
         snr = np.full(n_rows, np.nan)
@@ -474,8 +473,7 @@ def read_people(path: Path, radar: RadarConfig | None) -> Recording:
     else:
         doppler, order_note = c2, "Doppler before range"
     snr_lin, snr_note = _unsigned_snr(snr_raw)
-    with np.errstate(divide="ignore"):
-        snr_db = np.where(snr_lin > 0, 10.0 * np.log10(np.where(snr_lin > 0, snr_lin, 1.0)), np.nan)
+    snr_db = linear_snr_db(snr_lin)
     notes.insert(
         0,
         f"{src}: {len(rows['v6'])} points (v6, {order_note} in this file), "
@@ -485,7 +483,14 @@ def read_people(path: Path, radar: RadarConfig | None) -> Recording:
     notes.append("SNR: the firmware's linear SNR as 10·log10(snr)" + snr_note)
 
     ref = _tracks(rows["v7"], lines["v7"], v7_names, src)
-    point_track = _point_track(rows["v8"], lines["v8"], slot_of["v8"], slot_of["v6"], src)
+    point_track, matched = _point_track(
+        rows["v8"], lines["v8"], slot_of["v8"], slot_of["v6"], len(t_s), src
+    )
+    if rows["v8"]:
+        notes.append(
+            f"target indices: {matched} of {len(rows['v8'])} v8 rows match the previous frame's "
+            "point count and label its points (the rest are not used)"
+        )
     rec = _recording(
         PEOPLE_CSV, x, y, z, doppler, snr_db, slot_of["v6"], t_s, trajectory, cfg, notes, {}
     )
@@ -591,33 +596,27 @@ def _tracks(rows: list[str], lines: list[int], names: list[str], src: str) -> di
 
 
 def _point_track(
-    rows: list[str], lines: list[int], v8_slot: np.ndarray, v6_slot: np.ndarray, src: str
-) -> np.ndarray:
-    """Per point, the id of TI's track it was given to (-1: none). A ``v8`` row of frame f
-    indexes the points of the frame before it (the firmware associates the previous frame's
-    cloud); values >= 253 (weak, outside the box, not associated) are -1. A row whose length
-    does not match the previous frame's points is skipped (its points stay -1)."""
-    out = np.full(len(v6_slot), -1, dtype=np.int64)
-    if not rows:
-        return out
-    starts = np.searchsorted(v6_slot, np.arange(int(v6_slot.max(initial=-1)) + 2))
+    rows: list[str],
+    lines: list[int],
+    v8_slot: np.ndarray,
+    v6_slot: np.ndarray,
+    n_frames: int,
+    src: str,
+) -> tuple[np.ndarray, int]:
+    """Per point, the id of TI's track it was given to (-1: none), from the ``v8`` rows (see
+    :func:`core.formats.recording.point_tracks_from_indices`)."""
+    indices: list[tuple[int, np.ndarray]] = []
     for text, n, f in zip(rows, lines, v8_slot):
         s = text.strip().strip('"').strip()
         if not (s.startswith("[") and s.endswith("]")):
             raise InputError("a v8 row must hold a quoted list [i, j, ...]", f"{src}:{n}")
         inner = s[1:-1].strip()
-        try:
-            idx = np.array([int(c) for c in inner.split(",")] if inner else [], dtype=np.int64)
-        except ValueError:
-            raise InputError("a v8 list must hold integers", f"{src}:{n}") from None
-        prev = int(f) - 1
-        if prev < 0 or prev + 1 >= len(starts):
-            continue
-        lo, hi = starts[prev], starts[prev + 1]
-        if hi - lo != len(idx):
-            continue
-        out[lo:hi] = np.where((idx >= 0) & (idx < TARGET_INDEX_NONE), idx, -1)
-    return out
+        cells = [c.strip() for c in inner.split(",")] if inner else []
+        if not all(c.isascii() and c.isdigit() for c in cells):
+            raise InputError("a v8 list must hold integers >= 0", f"{src}:{n}")
+        indices.append((int(f), np.array([int(c) for c in cells], dtype=np.int64)))
+    counts = np.bincount(v6_slot, minlength=n_frames)
+    return point_tracks_from_indices(counts, indices)
 
 
 # ---- any CSV with a column map ---------------------------------------------------------------

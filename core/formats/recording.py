@@ -11,11 +11,13 @@ The table of formats is :mod:`core.recordings`.
 from __future__ import annotations
 
 import csv
+import dataclasses
 import io
 import json
 import math
 import os
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -131,6 +133,36 @@ def points_to_cloud(
     return cloud, keep
 
 
+#: Target-index values that are not a track id (TI's people-tracking demo: 253 SNR too weak,
+#: 254 outside the boundary box, 255 not associated).
+TARGET_INDEX_NONE = 253
+
+
+def point_tracks_from_indices(
+    counts: np.ndarray, indices: list[tuple[int, np.ndarray]]
+) -> tuple[np.ndarray, int]:
+    """Per point, the firmware's track id from its target-index lists (TLV 1011 / 309, vendor
+    CSV rows v8); -1 for none.
+
+    ``counts[k]``: points of frame (or packet) k, in order; ``indices``: ``(k, index)`` pairs,
+    the index sent with frame k labelling the points of frame k-1 (the firmware associates the
+    previous frame's cloud). Values >= :data:`TARGET_INDEX_NONE` are -1; an index whose length
+    is not the previous frame's point count labels nothing. Returns the ids and how many index
+    lists were used.
+    """
+    counts = np.asarray(counts, dtype=np.int64)
+    out = np.full(int(counts.sum()), -1, dtype=np.int64)
+    starts = np.concatenate(([0], np.cumsum(counts)))
+    used = 0
+    for k, idx in indices:
+        if not 1 <= k <= len(counts) or len(idx) != counts[k - 1]:
+            continue
+        ids = np.asarray(idx, dtype=np.int64)
+        out[starts[k - 1] : starts[k]] = np.where((ids >= 0) & (ids < TARGET_INDEX_NONE), ids, -1)
+        used += 1
+    return out, used
+
+
 # ---- truth ------------------------------------------------------------------------------------
 def read_truth_csv(path: str | os.PathLike) -> np.ndarray:
     """Ground truth ``time_s, person, x_m, y_m`` (a header line naming these columns, then one
@@ -242,7 +274,7 @@ def to_dataset(
         "notes": list(rec.notes),
         **rec.meta,
     }
-    return Dataset.from_cloud(
+    ds = Dataset.from_cloud(
         cloud=rec.cloud,
         counts=rec.counts,
         trajectory=rec.trajectory,
@@ -255,6 +287,34 @@ def to_dataset(
         fidelity="real",
         seed=0,
     )
+    return with_reference(ds, rec.ref_tracks, rec.ref_point_track)
+
+
+def with_reference(
+    ds: Dataset, ref_tracks: dict[str, np.ndarray] | None, point_track: np.ndarray | None
+) -> Dataset:
+    """``ds`` with TI's own tracks as its reference layer (rows sorted by frame, stable) and
+    the per-point track ids; unchanged when both are None."""
+    kw: dict[str, Any] = {}
+    if ref_tracks is not None and len(ref_tracks["frame"]):
+        order = np.argsort(ref_tracks["frame"], kind="stable")
+        kw["ref_frame"] = np.asarray(ref_tracks["frame"], dtype=np.int64)[order]
+        kw["ref_track_id"] = np.asarray(ref_tracks["track_id"], dtype=np.int64)[order]
+        for key in ("x_m", "y_m", "z_m", "vx_mps", "vy_mps"):
+            kw[f"ref_{key}"] = np.asarray(ref_tracks[key], dtype=np.float64)[order]
+        finite = np.ones(len(order), dtype=bool)
+        for key in ("x_m", "y_m", "z_m", "vx_mps", "vy_mps"):
+            finite &= np.isfinite(kw[f"ref_{key}"])
+        if not finite.all():  # a track row with a non-finite value is not a position
+            kw = {k: v[finite] for k, v in kw.items()}
+    if point_track is not None and len(point_track) == len(ds.frame):
+        kw["ref_point_track"] = np.asarray(point_track, dtype=np.int64)
+    if not kw:
+        return ds
+    try:
+        return dataclasses.replace(ds, **kw)
+    except ValueError as exc:
+        raise InputError(f"the recording's reference tracks: {exc}") from None
 
 
 def has_truth(ds: Dataset) -> bool:

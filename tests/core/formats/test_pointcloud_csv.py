@@ -45,7 +45,7 @@ def test_oob_csv_placeholders_gaps_restart_and_period(tmp_path: Path) -> None:
     assert rec.radar.frame_period_s == pytest.approx(0.1)
     # host times; the filled frame 8 halfway between 7 and 9
     np.testing.assert_allclose(rec.t_s, [0.0, 0.1, 0.2, 0.3, 0.4, 5.0, 5.1], atol=1e-9)
-    np.testing.assert_allclose(rec.cloud.snr_db[:3], [20.0, 30.0, 10.0])  # 10·log10(I)
+    np.testing.assert_allclose(rec.cloud.snr_db[:3], [40.0, 60.0, 20.0])  # 20·log10(I)
     assert rec.cloud.range_m[0] == pytest.approx(math.sqrt(1 + 4 + 0.25))
     np.testing.assert_allclose(rec.cloud.radial_velocity_mps, -0.25)
 
