@@ -76,8 +76,9 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         default=None,
         help="what trials minimise: trimmed (default for a new study: L_t without the largest "
         "10 %% of the trajectory losses), paper (L_t, eq. 14), capped or median; without "
-        "positions (recordings): count, fragmentation (default with a head count) or nis "
-        "(default without) (docs/tuning.md; the paper's L_t is recorded where there is truth; a "
+        "positions (recordings): count, fragmentation (default with a head count), nis "
+        "(default without) or reference (agreement with the recording's own tracks) "
+        "(docs/tuning.md; the paper's L_t is recorded where there is truth; a "
         "resumed study keeps its own)",
     )
     p.add_argument(
@@ -415,7 +416,18 @@ def require_truth(path: str, loss: str = "paper", people: int | None = None) -> 
     need = OBJECTIVE_NEEDS[loss]
     if not need or (need == "head count" and people is not None):
         return
-    if not has_truth(Dataset.load(path)):
+    ds = Dataset.load(path)
+    if need == "reference layer":
+        if not ds.has_reference:
+            raise InputError(
+                "the data set has no reference layer (no tracks of the sensor's own): --loss "
+                "reference needs one",
+                str(path),
+            )
+        return
+    if need == "head count" and len(ds.people_count) and bool((ds.people_count >= 0).any()):
+        return
+    if not has_truth(ds):
         raise InputError(
             f"the data set has no ground truth (imported without --truth?): --loss {loss} needs "
             f"{'positions' if need == 'truth' else 'a head count'}; import it again with --truth "

@@ -43,8 +43,9 @@ TRIM_FRACTION = 0.1
 #: lowest median paper loss of the four (docs/decisions/tuning-08-default-objective.md).
 DEFAULT_OBJECTIVE = "trimmed"
 #: Study objectives: name → (per-trajectory loss, aggregation over trajectories). The first
-#: four score positions against the truth; ``count``, ``fragmentation`` and ``nis`` need no
-#: positions (:mod:`core.evaluation.counting`: a head count, or nothing for ``nis``) and are
+#: four score positions against the truth; ``count``, ``fragmentation``, ``nis`` and
+#: ``reference`` need no positions (:mod:`core.evaluation.counting`: a head count, nothing for
+#: ``nis``, a recording's own tracks for ``reference``) and are
 #: aggregated over trajectories weighted by what each trajectory scored (frames, person-frames,
 #: NIS samples), so that a short run of a recording weighs as little as it holds.
 OBJECTIVES: dict[str, tuple[str, str]] = {
@@ -55,6 +56,7 @@ OBJECTIVES: dict[str, tuple[str, str]] = {
     "count": ("count", "weighted"),
     "fragmentation": ("fragmentation", "weighted"),
     "nis": ("nis", "weighted"),
+    "reference": ("reference", "weighted"),
 }
 #: The objectives that score positions against the truth.
 POSITION_OBJECTIVES = ("paper", "capped", "median", "trimmed")
@@ -65,6 +67,7 @@ OBJECTIVE_NEEDS: dict[str, str] = {
     "count": "head count",
     "fragmentation": "head count",
     "nis": "",
+    "reference": "reference layer",
 }
 
 

@@ -136,8 +136,8 @@ class TrackerLosses:
         scores' ``capped`` is NaN. It costs about a tenth of a trial, so a study computes it
         only when its objective uses it (:func:`uses_capped`).
     without_positions
-        ``"count"``, ``"fragmentation"`` or ``"nis"``: also score that objective per trajectory
-        (the scores' ``value`` and ``weight``); ``""``: none.
+        ``"count"``, ``"fragmentation"``, ``"nis"`` or ``"reference"``: also score that
+        objective per trajectory (the scores' ``value`` and ``weight``); ``""``: none.
     people
         Head count in every frame (``--people N``); None: the truth's, if any.
     """
@@ -164,6 +164,11 @@ class TrackerLosses:
             raise InputError(
                 f"the {without_positions} objective needs a head count: give --people N (the "
                 "data set has no truth)"
+            )
+        if without_positions == "reference" and not dataset.has_reference:
+            raise InputError(
+                "the reference objective needs a recording with its own tracks (a reference "
+                "layer: TI's tracks of a people-counting recording)"
             )
 
     @property
@@ -192,7 +197,7 @@ class TrackerLosses:
         # person from the single-person estimate, as ever (the same numbers bit for bit); the
         # track ids and NIS of fragmentation and nis come from the kernel's record of every track
         several = self.dataset.n_persons > 1
-        record = self.without_positions in ("fragmentation", "nis")
+        record = self.without_positions in ("fragmentation", "nis", "reference")
         est = track_dataset(self.dataset, tp, trajectories=list(ks), with_tracks=several or record)
         n = len(est.trajectories)
         nan = [math.nan] * n
@@ -207,7 +212,7 @@ class TrackerLosses:
             from core.evaluation.counting import trajectory_terms
 
             counts = None if self.counts is None else self.counts[est.frame_index]
-            extra = trajectory_terms(self.without_positions, est, counts)
+            extra = trajectory_terms(self.without_positions, est, counts, self.dataset)
         return [
             TrajectoryScore(float(value), float(mse), int(n_c), c, v, w)
             for (value, mse, n_c), c, (v, w) in zip(terms, capped, extra, strict=True)
@@ -350,7 +355,7 @@ def uses_capped(loss: str) -> bool:
 
 def without_positions(loss: str) -> str:
     """The objective's per-trajectory score when it needs no positions (``count``,
-    ``fragmentation``, ``nis``), else ``""``."""
+    ``fragmentation``, ``nis``, ``reference``), else ``""``."""
     kind = OBJECTIVES[check_objective(loss)][0]
     return "" if kind in ("paper", "capped") else kind
 

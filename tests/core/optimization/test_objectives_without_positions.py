@@ -59,7 +59,7 @@ def test_terms_are_the_derived_numbers() -> None:
 def test_registry_and_needs() -> None:
     assert set(OBJECTIVE_NEEDS) == set(OBJECTIVES)
     assert {k for k, v in OBJECTIVE_NEEDS.items() if v != "truth"} == {
-        "count", "fragmentation", "nis"
+        "count", "fragmentation", "nis", "reference"
     }  # fmt: skip
 
 
@@ -105,6 +105,8 @@ def test_tune_on_a_recording_without_truth(tmp_path, capsys) -> None:
     assert "--loss nis" in capsys.readouterr().err
     assert main([*base, "--loss", "count"]) == 2
     assert "head count" in capsys.readouterr().err
+    assert main([*base, "--loss", "reference"]) == 2
+    assert "no reference layer" in capsys.readouterr().err
     code = main([*base, "--people", "1", "--validation", str(val), "--study", "rec"])
     assert code == 0
     captured = capsys.readouterr()
