@@ -103,6 +103,12 @@ class StudySettings:
     people
         Head count in every frame of the data set (``--people N``) for the objectives without
         positions (``count``, ``fragmentation``); None: the truth's.
+    mix
+        Further training data sets, ``(path, weight)`` each (:mod:`core.optimization.mix`); the
+        study's own data set weighs 1.
+    recording_loss
+        The objective of a data set without what ``loss`` needs (a recording without truth, in
+        a mixed study or at validation); ``""``: fragmentation with ``people``, else nis.
     """
 
     model: str = "cv"
@@ -118,9 +124,16 @@ class StudySettings:
     objective_options: dict[str, float] = field(default_factory=dict)
     loss: str = DEFAULT_OBJECTIVE
     people: int | None = None
+    mix: tuple[tuple[str, float], ...] = ()
+    recording_loss: str = ""
 
     def __post_init__(self) -> None:
         check_model(self.model)
+        if self.recording_loss:
+            check_objective(self.recording_loss)
+        for path, weight in self.mix:
+            if not (math.isfinite(weight) and weight > 0):
+                raise InputError(f"mix {path}: weight must be > 0, got {weight}")
         if self.people is not None and (isinstance(self.people, bool) or int(self.people) < 0):
             raise InputError(f"people must be a whole number >= 0, got {self.people!r}")
         if int(self.n_trials) < 1:
@@ -388,9 +401,19 @@ def prepare_study(settings: StudySettings, *, dataset_path: str | None = None) -
     }
     if settings.people is not None:
         attrs["people"] = int(settings.people)
+    if settings.mix:
+        attrs["mix"] = [[str(p), float(w)] for p, w in settings.mix]
+    if settings.recording_loss:
+        attrs["recording_loss"] = settings.recording_loss
     study = load_existing_study(storage, settings.name)
     if study is not None:
         old = study.user_attrs
+        for key in ("mix", "recording_loss"):
+            if old.get(key) != attrs.get(key):
+                raise InputError(
+                    f"study {settings.name!r} in {redact(settings.storage)} has {key}="
+                    f"{old.get(key)!r}, asked {attrs.get(key)!r}; use another --study name"
+                )
         if old.get("people") != attrs.get("people"):
             raise InputError(
                 f"study {settings.name!r} in {redact(settings.storage)} has people="
@@ -480,6 +503,29 @@ def load_dataset_for(attrs: dict[str, Any], dataset_path: str | None) -> Any:
     return Dataset.load(path)
 
 
+def _mixed_objective(attrs: dict[str, Any], main_set: Any, model: str) -> Any:
+    """The study's :class:`~core.optimization.mix.MixedObjective`, or None for a study on one
+    data set."""
+    if not attrs.get("mix"):
+        return None
+    from core.dataset import Dataset
+    from core.optimization.mix import MixedObjective, recording_objective
+
+    people = attrs.get("people")
+    parts = [(main_set, 1.0)]
+    for path, weight in attrs["mix"]:
+        if not Path(path).is_file():
+            raise InputError(f"mixed data set {path!r} (recorded in the study) does not exist here")
+        parts.append((Dataset.load(path), float(weight)))
+    return MixedObjective(
+        parts,
+        model,
+        loss=str(attrs.get("loss", "paper")),
+        recording_loss=str(attrs.get("recording_loss") or recording_objective(people)),
+        people=people,
+    )
+
+
 def run_worker(
     storage: str,
     study_name: str,
@@ -534,15 +580,17 @@ def run_worker(
         pruner=make_pruner(attrs["pruner"]),
     )
     loss = str(attrs.get("loss", "paper"))
+    main_set = load_dataset_for(attrs, dataset_path)
     losses = make_losses(
         attrs["objective"],
         model,
-        load_dataset_for(attrs, dataset_path),
+        main_set,
         capped=uses_capped(loss),
-        without_positions=without_positions(loss),
+        without_positions=without_positions(loss) if not attrs.get("mix") else "",
         people=attrs.get("people"),
         **dict(attrs.get("objective_options") or {}),
     )
+    mixed = _mixed_objective(attrs, main_set, model)
     if hasattr(losses, "warm_up"):
         losses.warm_up(model)
     fail_stale_trials(study)
@@ -578,14 +626,17 @@ def run_worker(
                 study.tell(trial, state=TrialState.FAIL)
                 break
             reports = _RungReports(trial, store)
-            result = evaluate(
-                losses,
-                params,
-                trial=reports,
-                pruner=attrs["pruner"],
-                prune_steps=prune_steps,
-                loss=str(attrs.get("loss", "paper")),
-            )
+            if mixed is not None:
+                result = mixed.evaluate(params)  # scored whole: no pruning
+            else:
+                result = evaluate(
+                    losses,
+                    params,
+                    trial=reports,
+                    pruner=attrs["pruner"],
+                    prune_steps=prune_steps,
+                    loss=str(attrs.get("loss", "paper")),
+                )
             with batched(store, read=False):
                 reports.flush()
         except KeyboardInterrupt:

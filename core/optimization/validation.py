@@ -142,8 +142,19 @@ def validate_study(
     loss = str(attrs.get("loss", "paper"))
     if attrs.get("objective", "tracker") != "tracker":
         raise InputError(f"study {name!r} does not track a data set; nothing to validate")
-    if attrs.get("dataset"):
-        check_same_radar(str(attrs["dataset"]), validation_path, "validation")
+    training = [str(attrs["dataset"])] if attrs.get("dataset") else []
+    training += [str(p) for p, _ in attrs.get("mix") or []]
+    if training:
+        # a mixed study's validation set is made with the radar of one of its training sets
+        errors = []
+        for path in training:
+            try:
+                check_same_radar(path, validation_path, "validation")
+                break
+            except InputError as exc:
+                errors.append(exc)
+        else:
+            raise errors[0]
     record = attrs.get("validation") or {}
     if record.get("dataset") != validation_path or record.get("loss") != loss:
         record = {"dataset": validation_path, "loss": loss, "trials": {}}
@@ -154,7 +165,15 @@ def validate_study(
         if t.state.name == "COMPLETE" and t.value is not None and math.isfinite(t.value)
     ]
     best = sorted(done, key=lambda t: (t.value, t.number))[:top_k]
-    losses = tracker_losses(Dataset.load(validation_path), loss, people=attrs.get("people"))
+    from core.optimization.mix import objective_for, recording_objective
+
+    people = attrs.get("people")
+    val_set = Dataset.load(validation_path)
+    # the study's objective where the validation set has what it needs, else the recording one
+    loss = objective_for(
+        val_set, loss, str(attrs.get("recording_loss") or recording_objective(people)), people
+    )
+    losses = tracker_losses(val_set, loss, people=people)
     out = []
     for t in best:
         params = tracker_params_dict({k: float(v) for k, v in t.params.items()}, model)

@@ -136,3 +136,46 @@ def test_bench_cuts_a_recording_to_its_first_frames() -> None:
 def test_bench_recording_flags_are_for_tune_only(capsys) -> None:
     assert main(["bench", "track", "--people", "1"]) == 2
     assert "for tune only" in capsys.readouterr().err
+
+
+def test_mixed_objective_is_one_at_the_defaults_and_weights_the_parts() -> None:
+    from core.optimization.mix import MixedObjective, parse_mix
+
+    sim = synthetic_dataset(7, 1, classes="abc", n_frames=60)
+    rec = _no_truth(synthetic_dataset(8, 1, classes="ab", n_frames=80))
+    mixed = MixedObjective(
+        [(sim, 1.0), (rec, 3.0)], "cv", loss="trimmed", recording_loss="count", people=1
+    )
+    assert mixed.objectives == ["trimmed", "count"]
+    default = TrackerParams.default("cv").to_dict()
+    # every part divided by its own value at the defaults
+    assert mixed.evaluate(default).value == pytest.approx(1.0, rel=1e-12)
+    other = {**default, "r11": 0.3, "p_d": 0.85}
+    v = mixed.part_values(other)
+    b = mixed.baselines
+    expected = (1.0 * v[0] / b[0] + 3.0 * v[1] / b[1]) / 4.0
+    assert mixed.evaluate(other).value == pytest.approx(expected, rel=1e-12)
+    assert parse_mix("a.npz=0.5").weight == 0.5 and parse_mix("paper:3").weight == 1.0
+    for bad in ("a.npz=x", "a.npz=0", "a.npz=-1"):
+        with pytest.raises(Exception, match="--mix"):
+            parse_mix(bad)
+
+
+def test_tune_mixed_with_a_recording(tmp_path, capsys) -> None:
+    sim = synthetic_dataset(9, 1, classes="ab", n_frames=60).save(tmp_path / "sim.npz")
+    rec = _no_truth(synthetic_dataset(10, 1, classes="ab", n_frames=60)).save(tmp_path / "r.npz")
+    val = _no_truth(synthetic_dataset(11, 1, classes="a", n_frames=60)).save(tmp_path / "v.npz")
+    storage = f"sqlite:///{tmp_path / 's.db'}"
+    code = main(["tune", "--model", "cv", "--trials", "3", "--dataset", str(sim), "--mix",
+                 f"{rec}=2", "--people", "1", "--validation", str(val), "--storage", storage,
+                 "--no-progress"])  # fmt: skip
+    assert code == 0
+    captured = capsys.readouterr()
+    assert "by validation: fragmentation" in captured.err
+    out = json.loads(captured.out.strip().splitlines()[-1])
+    assert out["loss"] == "trimmed" and set(out["params"]) >= {"model", "r11", "p0"}
+    # the same study name with another mix is refused
+    code = main(["tune", "--model", "cv", "--trials", "3", "--dataset", str(sim), "--mix",
+                 f"{rec}=1", "--people", "1", "--validation", str(val), "--storage", storage,
+                 "--no-progress"])  # fmt: skip
+    assert code == 2 and "mix" in capsys.readouterr().err
