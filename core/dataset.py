@@ -352,6 +352,12 @@ class Dataset:
         if kw["scene_json"]:
             parse_json(kw["scene_json"], f"{src} (scene_json)")
         radar = parse_json(kw["radar_json"], f"{src} (radar_json)") if kw["radar_json"] else {}
+        if not isinstance(radar, dict):
+            raise InputError(
+                f"radar_json must be a JSON object (the radar configuration), got "
+                f"{kw['radar_json'][:40]!r}",
+                src,
+            )
         if isinstance(radar, dict) and "frame_period_s" in radar:
             t = radar["frame_period_s"]
             lo, hi = FRAME_PERIOD_RANGE_S

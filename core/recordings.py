@@ -87,7 +87,8 @@ def _read_capture(path: Path, cfg: Path | None) -> Recording:
 
     from core.pipeline.capture import recording_from_capture  # the radar chain: heavy import
 
-    return recording_from_capture(path, cfg)
+    # the partial-frame note is among the recording's notes, which the caller prints: no warning
+    return recording_from_capture(path, cfg, note=lambda line: None)
 
 
 def _write_capture(

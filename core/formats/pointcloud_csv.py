@@ -174,7 +174,11 @@ _BLANK_LINE = re.compile(r"(^|\n)[ \t\r]*(\n|$)")
 
 def _row_lines(body: str, n_rows: int, first_line: int = 2) -> np.ndarray:
     """The file line of each data row of ``body`` (blank lines are skipped by the parser)."""
-    if not _BLANK_LINE.search(body.rstrip("\r\n")):
+    b = body.rstrip("\r\n")
+    maybe_blank = b.startswith(("\n", "\r")) or "\n\n" in b or "\n\r\n" in b
+    if not maybe_blank and ("\n " in b or "\n\t" in b or b[:1] in (" ", "\t")):
+        maybe_blank = bool(_BLANK_LINE.search(b))  # whitespace-only lines: rare, slow check
+    if not maybe_blank:
         return np.arange(n_rows, dtype=np.int64) + first_line
     lines = [k for k, ln in enumerate(body.split("\n"), start=first_line) if ln.strip()]
     return np.asarray(lines[:n_rows], dtype=np.int64)
@@ -520,7 +524,7 @@ def _integers(cells: list[str], lines: np.ndarray, src: str, field: str) -> np.n
 
 
 #: A host time stamp of the vendor CSV.
-_STAMP = re.compile(r"^\d{4}-\d{2}-\d{2}[ T]\d{2}:\d{2}:\d{2}(\.\d{1,9})?$")
+_STAMP = re.compile(r"^\d{4}-\d{2}-\d{2}[ T]\d{2}:\d{2}:\d{2}(\.\d{1,9})?$", re.ASCII)
 
 
 def _timestamps(cells: list[str], lines: np.ndarray, src: str) -> np.ndarray:
