@@ -32,6 +32,7 @@ from core.dataset import Dataset
 from core.errors import InputError
 from core.evaluation.consistency import ConsistencyStat, consistency_stat
 from core.evaluation.intervals import bootstrap_interval
+from core.evaluation.reference import ReferenceComparison, compare_with_reference
 
 __all__ = [
     "COUNT_BLOCK_S",
@@ -43,6 +44,8 @@ __all__ = [
     "head_counts",
     "nis_samples",
     "recording_scores",
+    "reference_agreement",
+    "trajectory_terms",
 ]
 
 #: Block length of the count's bootstrap (s): longer than a ghost's or a lost track's life.
@@ -54,13 +57,17 @@ NIS_DOF = 3
 def head_counts(dataset: Dataset, people: int | None = None) -> np.ndarray | None:
     """(F,) int64 head count of every frame of the data set, or None when nothing gives one.
 
-    ``people`` (``--people N``) holds for every frame; else a data set with truth counts the
-    persons present in each frame; else None.
+    ``people`` (``--people N``) holds for every frame; else the data set's own head count
+    (``people_count``, −1 where unknown: those frames are not scored); else a data set with truth
+    counts the persons present in each frame; else None.
     """
     if people is not None:
         if isinstance(people, bool) or not isinstance(people, (int, np.integer)) or people < 0:
             raise InputError(f"--people must be a whole number >= 0, got {people!r}")
         return np.full(dataset.n_frames, int(people), dtype=np.int64)
+    own = np.asarray(dataset.people_count, dtype=np.int64)
+    if len(own) == dataset.n_frames and dataset.n_frames and np.any(own >= 0):
+        return own
     if dataset.n_persons and np.isfinite(dataset.truth_xy_m).any():
         return np.sum(np.all(np.isfinite(dataset.truth_xy_m), axis=2), axis=1).astype(np.int64)
     return None
@@ -209,18 +216,27 @@ class RecordingScores:
     """The scores of one tracker run that need no positions.
 
     ``count``: None without a head count. ``nis``: always (n = 0 without a confirmed update).
-    ``people``: the head count's source, ``"--people N"``, ``"truth"`` or ``""``.
+    ``people``: the head count's source, ``"--people N"``, ``"people_count"`` (the data set's
+    own), ``"truth"`` or ``""``. ``reference``: the agreement of the confirmed tracks with the
+    recording's reference layer (TI's own tracks; :mod:`core.evaluation.reference`) over the
+    tracked frames, None without one.
     """
 
     count: CountScores | None
     nis: ConsistencyStat
     people: str
+    reference: ReferenceComparison | None = None
 
     def to_dict(self) -> dict[str, Any]:
+        ref = None
+        if self.reference is not None:
+            ref = {k: _num(v) if isinstance(v, float) else v
+                   for k, v in self.reference.to_dict().items()}  # fmt: skip
         return {
             "head_count": self.people or None,
             "count": None if self.count is None else self.count.to_dict(),
             "nis": self.nis.to_dict(),
+            "reference": ref,
         }
 
     def format_lines(self) -> list[str]:
@@ -245,6 +261,13 @@ class RecordingScores:
                 f"fragmentation: {c.n_ids} confirmed track ids over {c.person_minutes:.2f} "
                 f"person-minutes = {c.fragmentation:.2f} per person-minute"
             )
+        r = self.reference
+        if r is not None and len(r.gospa_m):
+            out.append(
+                f"against the recording's own tracks (reference layer): mean GOSPA "
+                f"{r.mean_gospa_m:.3f} m (c = {r.c_m:g} m) over {len(r.gospa_m)} frames; as many "
+                f"confirmed tracks as reference tracks in {r.count_agreement:.3f} of them"
+            )
         s = self.nis
         if s.n == 0:
             out.append("NIS: no confirmed track was updated")
@@ -266,13 +289,130 @@ def recording_scores(
     count = None
     source = ""
     if counts is not None:
-        source = f"--people {people}" if people is not None else "truth"
+        if people is not None:
+            source = f"--people {people}"
+        elif len(dataset.people_count) == dataset.n_frames and np.any(dataset.people_count >= 0):
+            source = "people_count"
+        else:
+            source = "truth"
+        n = counts[estimates.frame_index]
+        known = n >= 0  # frames of unknown head count are not scored
         count = count_scores(
-            estimates.n_confirmed,
-            counts[estimates.frame_index],
-            confirmed_ids(estimates),
+            np.asarray(estimates.n_confirmed)[known],
+            n[known],
+            confirmed_ids(estimates)[known],
             frame_period_s,
         )
     return RecordingScores(
-        count=count, nis=consistency_stat(nis_samples(estimates), NIS_DOF), people=source
+        count=count,
+        nis=consistency_stat(nis_samples(estimates), NIS_DOF),
+        people=source,
+        reference=reference_agreement(dataset, estimates),
+    )
+
+
+def reference_agreement(dataset: Dataset, estimates: Any) -> ReferenceComparison | None:
+    """GOSPA and count difference per tracked frame between the confirmed tracks and the
+    recording's reference layer (:func:`core.evaluation.reference.compare_with_reference`,
+    restricted to ``estimates.frame_index``); None without a reference layer."""
+    if not dataset.has_reference:
+        return None
+    from dataclasses import replace
+
+    rec = estimates.record
+    if rec is None:
+        raise ValueError("the reference agreement needs every track: with_tracks=True")
+    cap = rec.ids.shape[1]
+    live = np.arange(cap)[None, :] < np.asarray(rec.n_tracks)[:, None]
+    rows, slots = np.nonzero(live & rec.confirmed)
+    frames = np.asarray(estimates.frame_index, dtype=np.int64)
+    cmp = compare_with_reference(dataset, frames[rows], rec.state[rows, slots, :2])
+    return replace(
+        cmp,
+        gospa_m=cmp.gospa_m[frames],
+        n_estimated=cmp.n_estimated[frames],
+        n_reference=cmp.n_reference[frames],
+        count_difference=cmp.count_difference[frames],
+    )
+
+
+def trajectory_terms(
+    kind: str, estimates: Any, counts: np.ndarray | None, dataset: Dataset | None = None
+) -> list[tuple[float, float]]:
+    """Per tracked trajectory, the value of a study objective without positions and its weight.
+
+    ``kind`` (see docs/tuning.md):
+
+    - ``"count"``: mean_f |n̂_f − n_f| over the trajectory's frames; weight: its frames.
+    - ``"fragmentation"``: ``(Σ_f |n̂_f − n_f| + max(N_ids − max_f n_f, 0)) / Σ_f n_f``, the
+      complement of a positionless MOTA (missed and false tracks per frame, and every confirmed
+      id beyond one per person as an identity switch); weight: the person-frames Σ_f n_f (a
+      run without persons weighs 1 and scores its false tracks per frame).
+    - ``"nis"``: the fraction of the confirmed tracks' NIS samples outside the χ²₃ band (a
+      consistent filter: 5 %); weight: the samples. A trajectory without a sample scores 1
+      with weight 1 (a tracker that confirms nothing is not consistent, it is silent).
+    - ``"reference"``: the mean GOSPA (m; c = 1 m, p = 2) per frame between the confirmed
+      tracks and the recording's reference layer (TI's own tracks); weight: the frames.
+
+    Frames whose head count is unknown (−1) are left out of count and fragmentation.
+
+    Parameters
+    ----------
+    kind
+        ``"count"``, ``"fragmentation"``, ``"nis"`` or ``"reference"``.
+    estimates
+        :class:`core.tracking.DatasetEstimates` (with its ``record`` unless ``kind`` is count).
+    counts
+        (F_sel,) head count of every output frame (None for ``"nis"`` and ``"reference"``).
+    dataset
+        The data set tracked (``"reference"`` only).
+    """
+    off = np.asarray(estimates.offsets, dtype=np.int64)
+    spans = [slice(off[i], off[i + 1]) for i in range(len(off) - 1)]
+    if kind == "nis":
+        from core.evaluation.consistency import chi2_band
+
+        lo, hi = chi2_band(NIS_DOF)
+        rec = estimates.record
+        if rec is None:
+            raise ValueError("the nis objective needs every track: with_tracks=True")
+        cap = rec.ids.shape[1]
+        live = np.arange(cap)[None, :] < np.asarray(rec.n_tracks)[:, None]
+        v = np.where(live & rec.confirmed, rec.nis, np.nan)
+        out = []
+        for s in spans:
+            x = v[s][np.isfinite(v[s])]
+            out.append(
+                (float(np.mean((x < lo) | (x > hi))), float(x.size)) if x.size else (1.0, 1.0)
+            )
+        return out
+    if kind == "reference":
+        if dataset is None or not dataset.has_reference:
+            raise InputError("the reference objective needs a recording with its own tracks")
+        agreement = reference_agreement(dataset, estimates)
+        assert agreement is not None
+        g = agreement.gospa_m
+        return [(float(np.mean(g[s])) if g[s].size else 0.0, float(g[s].size)) for s in spans]
+    if counts is None:
+        raise InputError(f"the {kind} objective needs a head count (--people N, or truth)")
+    n_all = np.asarray(counts, np.int64)
+    known = n_all >= 0  # frames of unknown head count are not scored
+    d = np.where(known, np.abs(np.asarray(estimates.n_confirmed, np.int64) - n_all), 0)
+    if kind == "count":
+        return [
+            (float(d[s].sum() / known[s].sum()) if known[s].any() else 0.0, float(known[s].sum()))
+            for s in spans
+        ]
+    if kind == "fragmentation":
+        ids = confirmed_ids(estimates)
+        out = []
+        for s in spans:
+            n = np.where(known[s], n_all[s], 0)
+            run_ids = ids[s][known[s]]
+            extra = max(int(np.unique(run_ids[run_ids >= 0]).size) - int(n.max(initial=0)), 0)
+            person_frames = max(float(n.sum()), 1.0)
+            out.append(((float(d[s].sum()) + extra) / person_frames, person_frames))
+        return out
+    raise InputError(
+        f"objective without positions must be count, fragmentation or nis, got {kind!r}"
     )

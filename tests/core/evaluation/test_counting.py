@@ -90,3 +90,56 @@ def test_cli_scores_a_recording_without_truth(tmp_path, capsys) -> None:
     assert doc["count"]["frames"] == ds.n_frames and doc["nis"]["n"] > 0
     assert main(["track", "--data", str(data)]) == 0
     assert "give --people N" in capsys.readouterr().out
+
+
+def _with_reference(ds, xy_offset: float):
+    """The truth as the data set's reference layer, shifted by ``xy_offset`` m along x."""
+    f = np.flatnonzero(np.isfinite(ds.truth_xy_m[:, 0, 0]))
+    xy = ds.truth_xy_m[f, 0]
+    v = ds.truth_v_mps[f, 0]
+    return dataclasses.replace(
+        _without_truth(ds),
+        ref_frame=f.astype(np.int64), ref_track_id=np.zeros(len(f), np.int64),
+        ref_x_m=xy[:, 0] + xy_offset, ref_y_m=xy[:, 1], ref_z_m=np.zeros(len(f)),
+        ref_vx_mps=v[:, 0], ref_vy_mps=v[:, 1],
+    )  # fmt: skip
+
+
+def test_reference_agreement_sees_a_shift_of_the_reference() -> None:
+    from core.evaluation.counting import reference_agreement, trajectory_terms
+
+    base = synthetic_dataset(4, 1, classes="abc", n_frames=120)
+    est = track_dataset(base, TrackerParams.default("cv"), with_tracks=True)
+    near = reference_agreement(_with_reference(base, 0.0), est)
+    far = reference_agreement(_with_reference(base, 0.6), est)
+    assert len(near.gospa_m) == len(est.frame_index)
+    # a one-person frame where both have one track: GOSPA = the distance (below c = 1 m)
+    both = (near.n_estimated == 1) & (near.n_reference == 1)
+    assert both.mean() > 0.8
+    assert np.median(near.gospa_m[both]) < 0.3
+    np.testing.assert_allclose(np.median(far.gospa_m[both]), 0.6, atol=0.15)
+    # the reference objective is the frame-weighted mean of the same GOSPA
+    terms = trajectory_terms("reference", est, None, _with_reference(base, 0.6))
+    v, w = np.array(terms).T
+    assert np.sum(v * w) / np.sum(w) == pytest.approx(far.mean_gospa_m, rel=1e-12)
+    scores = recording_scores(_with_reference(base, 0.6), est, 0.08)
+    assert scores.to_dict()["reference"]["frames"] == len(est.frame_index)
+
+
+def test_the_data_sets_own_head_count_and_unknown_frames() -> None:
+    from core.evaluation.counting import trajectory_terms
+
+    ds = _without_truth(synthetic_dataset(0, 1, classes="ab", n_frames=100))
+    est = track_dataset(ds, TrackerParams.default("cv"), with_tracks=True)
+    own = np.ones(ds.n_frames, np.int64)
+    own[:20] = -1  # unknown at the start
+    counted = dataclasses.replace(ds, people_count=own)
+    np.testing.assert_array_equal(head_counts(counted), own)
+    s = recording_scores(counted, est, 0.08)
+    assert s.people == "people_count" and s.count.n_frames == ds.n_frames - 20
+    right = np.mean(est.n_confirmed[20:] == 1)
+    assert s.count.right == pytest.approx(right)
+    (v0, w0), _ = trajectory_terms("count", est, own[est.frame_index])
+    assert w0 == ds.trajectory_offsets[1] - 20
+    # --people overrides the data set's count
+    assert recording_scores(counted, est, 0.08, people=2).people == "--people 2"
