@@ -247,6 +247,9 @@ def run(quick: bool = False) -> dict:
         "exact_person_detected_fraction": person_found,
     }
     result["walking_body"] = walking_case(quick)
+    from core.benchmarks import chains
+
+    result["detection_chains"] = chains.run(quick)
     result["stages_ms"] = _stage_profile(radar, settings, antenna, frames[: 50 if quick else 300])
     result["dataset"] = _time_dataset(quick)
     return result
@@ -577,6 +580,10 @@ def summary(result: dict) -> str:
             f"{wb['fast_over_exact_walking_per_pass']['max']:.1f}x; goal >= 10x); reflectors "
             f"{wb['reflectors_ms_per_frame_walking']:.3f} ms/frame"
         )
+    if "detection_chains" in result:
+        from core.benchmarks import chains
+
+        lines += chains.summary_lines(result["detection_chains"])
     stages = result.get("stages_ms")
     if stages:
         lines.append(
