@@ -414,7 +414,7 @@ class OobSettings:
     a second point at the same range and Doppler (None: off).
     """
 
-    range_cfar: DbCfarSettings = DbCfarSettings(method="ca", n_train=8, n_guard=4)
+    range_cfar: DbCfarSettings = DbCfarSettings(method="caso", n_train=8, n_guard=4)
     doppler_cfar: DbCfarSettings = DbCfarSettings(method="ca", n_train=4, n_guard=2, cyclic=True)
     static_clutter_removal: bool = False
     min_range_m: float = 0.0
@@ -573,3 +573,16 @@ class ChainConfig:
 
 
 PAPER_CHAIN = ChainConfig()
+
+
+def default_chain(name: str) -> ChainConfig:
+    """The chain ``name`` (one of :data:`CHAINS`) with TI's default settings (the values of
+    ``resources/radar/oob_isk.cfg`` and ``people_counting_isk.cfg`` with static detection on);
+    :class:`InputError` naming the chains for an unknown name."""
+    if name not in CHAINS:
+        raise InputError(f"chain must be one of {list(CHAINS)}, got {name!r}")
+    if name == "oob":
+        return ChainConfig(name="oob", oob=OobSettings())
+    if name == "people-counting":
+        return ChainConfig(name="people-counting", people_counting=PeopleCountingSettings())
+    return PAPER_CHAIN

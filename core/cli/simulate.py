@@ -89,8 +89,7 @@ def run(args: argparse.Namespace) -> int:
 
 def _chain(args: argparse.Namespace) -> ChainConfig:
     """The chain of ``--cfg`` or ``--chain`` (paper when neither); one line naming a bad one."""
-    from core.config import CHAINS, PAPER_CHAIN, OobSettings, PeopleCountingSettings
-    from core.config import ChainConfig as Chain
+    from core.config import default_chain
     from core.errors import InputError
     from core.formats.ti_cfg import read_ti_chain
 
@@ -98,10 +97,7 @@ def _chain(args: argparse.Namespace) -> ChainConfig:
         raise InputError("--cfg selects the chain itself: give --cfg or --chain, not both")
     if args.cfg is not None:
         return read_ti_chain(args.cfg)
-    if args.chain is None or args.chain == "paper":
-        return PAPER_CHAIN
-    if args.chain not in CHAINS:
-        raise InputError(f"--chain must be one of {list(CHAINS)}, got {args.chain!r}")
-    if args.chain == "oob":
-        return Chain(name="oob", oob=OobSettings())
-    return Chain(name="people-counting", people_counting=PeopleCountingSettings())
+    try:
+        return default_chain("paper" if args.chain is None else args.chain)
+    except InputError as exc:
+        raise InputError(f"--{exc.message}") from None

@@ -8,7 +8,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from core.config import AOP_AZIMUTH_POSITIONS, AOP_ELEVATION_POSITIONS, ProcessingSettings
+from core.config import (
+    AOP_AZIMUTH_POSITIONS,
+    AOP_ELEVATION_POSITIONS,
+    ProcessingSettings,
+    default_chain,
+)
 from core.errors import InputError
 from core.formats.ti_cfg import read_ti_cfg, read_ti_chain
 from core.processing.capon import (
@@ -249,6 +254,17 @@ def test_shipped_cfgs_select_their_chains_and_layouts():
     # 394758 = 0x060606: 6 dB back-off on each TX
     assert radar_isk.tx_power_dbm == pytest.approx(6.0)
     assert read_ti_chain(RADAR_DIR / "paper.cfg").name == "paper"
+
+
+def test_default_chains_are_the_shipped_cfgs():
+    oob = read_ti_chain(RADAR_DIR / "oob_isk.cfg").oob
+    default = default_chain("oob").oob
+    assert (default.range_cfar, default.doppler_cfar) == (oob.range_cfar, oob.doppler_cfar)
+    assert default.multi_object_threshold == oob.multi_object_threshold
+    pc = read_ti_chain(RADAR_DIR / "people_counting_isk_static.cfg").people_counting
+    assert default_chain("people-counting").people_counting == pc
+    with pytest.raises(InputError, match="chain must be one of"):
+        default_chain("pplcount")
 
 
 @pytest.mark.parametrize(
