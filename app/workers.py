@@ -59,7 +59,9 @@ class SimulationWorker(QtCore.QThread):
 
     def run(self) -> None:  # worker thread
         try:
-            frames = self._engine.simulate(self._scene, fidelity=self.fidelity, chain=self.chain)
+            # the chain only when one was chosen (engines without chains keep working)
+            extra = {} if self.chain is None else {"chain": self.chain}
+            frames = self._engine.simulate(self._scene, fidelity=self.fidelity, **extra)
             t0 = time.perf_counter()
             for frame in frames:
                 t1 = time.perf_counter()
