@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import dataclasses
 import time
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -30,8 +31,9 @@ CHAIN_CFGS = {
 BLOCK = 10
 
 
-def run(quick: bool = False) -> dict:
-    from core.benchmarks.sim import paper_scene_frames
+def run(quick: bool = False, *, scene_frames: Callable[..., list]) -> dict:
+    """Time every chain of :data:`CHAIN_CFGS`; ``scene_frames(radar, n, rng, antenna)`` gives the
+    frames' scatterers (``core.benchmarks.sim.paper_scene_frames``)."""
     from core.config import PAPER_CHAIN
     from core.formats.ti_cfg import read_ti_cfg, read_ti_chain
     from core.simulation import AntennaGain
@@ -48,7 +50,7 @@ def run(quick: bool = False) -> dict:
         settings = dataclasses.replace(ProcessingSettings(), max_range_m=7.5)
         rng = np.random.default_rng(2024)
         antenna = AntennaGain.draw(radar, rng)
-        frames = paper_scene_frames(radar, n_frames, rng, antenna)
+        frames = scene_frames(radar, n_frames, rng, antenna)
         setups[label] = (radar, chain, settings, antenna, frames)
 
     def frame(label: str, i: int, rng: np.random.Generator):

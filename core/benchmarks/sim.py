@@ -249,7 +249,7 @@ def run(quick: bool = False) -> dict:
     result["walking_body"] = walking_case(quick)
     from core.benchmarks import chains
 
-    result["detection_chains"] = chains.run(quick)
+    result["detection_chains"] = chains.run(quick, scene_frames=paper_scene_frames)
     result["stages_ms"] = _stage_profile(radar, settings, antenna, frames[: 50 if quick else 300])
     result["dataset"] = _time_dataset(quick)
     return result

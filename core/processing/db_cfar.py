@@ -2,7 +2,7 @@
 
 The paper's chain sets its CFAR by a false-alarm probability (:mod:`core.processing.cfar`);
 TI's chains set a ratio in dB over the noise estimate instead. Both use the same sliding
-training windows (:func:`core.processing.cfar._side_sums`): ``n`` training cells a side beyond
+training windows (:func:`core.processing.cfar.side_sums`): ``n`` training cells a side beyond
 ``g`` guard cells, combined as the mean of both sides (CA), the smaller (CASO) or the larger
 (CAGO) side mean; where a non-cyclic axis leaves one side incomplete, the complete side alone.
 
@@ -20,7 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from core.config import DbCfarSettings, RaCfarSettings
-from core.processing.cfar import _side_sums
+from core.processing.cfar import side_sums
 
 
 def sided_noise(p: np.ndarray, n_train: int, n_guard: int, method: str, cyclic: bool):
@@ -29,7 +29,7 @@ def sided_noise(p: np.ndarray, n_train: int, n_guard: int, method: str, cyclic: 
     Returns ``(n_cells, ...)`` float64, NaN where no training window fits.
     """
     x = np.asarray(p, dtype=np.float64)
-    left, right, ok_l, ok_r = _side_sums(x, n_train, n_guard, cyclic)
+    left, right, ok_l, ok_r = side_sums(x, n_train, n_guard, cyclic)
     shape = (-1,) + (1,) * (x.ndim - 1)
     both = (ok_l & ok_r).reshape(shape)
     only_l = (ok_l & ~ok_r).reshape(shape)
