@@ -221,12 +221,14 @@ def make_params(model: str, values: dict[str, float], extra: dict | None = None)
 
 
 # ---- simulation -------------------------------------------------------------------------------
-def simulate(scene, *, fidelity: str = "exact") -> Iterator[FrameData]:
+def simulate(scene, *, fidelity: str = "exact", chain=None) -> Iterator[FrameData]:
     """Simulate the scene frame by frame through the radar chain (GUI plan: range-Doppler
-    maps kept), yielding snapshots as they are ready."""
+    maps kept), yielding snapshots as they are ready. ``chain``: a ``ChainConfig`` (None: the
+    paper's)."""
     from core import pipeline
+    from core.config import PAPER_CHAIN
 
-    the_plan = pipeline.plan(scene, fidelity=fidelity, consumer="gui")
+    the_plan = pipeline.plan(scene, fidelity=fidelity, consumer="gui", chain=chain or PAPER_CHAIN)
     settings = pipeline.processing_settings(scene)
     for fr in pipeline.iter_frames(scene, the_plan=the_plan):
         truth = np.asarray(fr.truth_xy_m, dtype=float).reshape(-1, 2)
@@ -474,6 +476,13 @@ def read_ti_cfg(path: str | os.PathLike) -> RadarConfig:
     return _read(path)
 
 
+def read_ti_chain(path: str | os.PathLike):
+    """The detection chain a TI .cfg selects (``core.config.ChainConfig``)."""
+    from core.formats.ti_cfg import read_ti_chain as _read
+
+    return _read(path)
+
+
 # ---- studies ----------------------------------------------------------------------------------
 class StudyProcesses:
     """Handle of a running study (wraps core's ``StudyHandle``)."""
@@ -671,6 +680,7 @@ class Engine:
     warm_up_tracker = staticmethod(warm_up_tracker)
     tracker_compiled = staticmethod(tracker_compiled)
     read_ti_cfg = staticmethod(read_ti_cfg)
+    read_ti_chain = staticmethod(read_ti_chain)
     scene_dataset = staticmethod(scene_dataset)
     start_study = staticmethod(start_study)
     study_progress = staticmethod(study_progress)

@@ -15,7 +15,7 @@ from pathlib import Path
 from PySide6 import QtCore
 
 from app.data import FrameData, ParamSpec, TrackingResult
-from core.config import PAPER_RADAR, RadarConfig
+from core.config import PAPER_CHAIN, PAPER_RADAR, ChainConfig, RadarConfig
 from core.errors import InputError
 from core.files import read_json, write_json_atomic
 
@@ -24,10 +24,22 @@ class RadarModel(QtCore.QObject):
     """The radar configuration (a frozen :class:`RadarConfig`); edits go through ``replace``."""
 
     changed = QtCore.Signal(object)  # RadarConfig
+    chain_changed = QtCore.Signal(object)  # ChainConfig
 
     def __init__(self, radar: RadarConfig = PAPER_RADAR, parent=None) -> None:
         super().__init__(parent)
         self._radar = radar
+        self._chain = PAPER_CHAIN
+
+    @property
+    def chain(self) -> ChainConfig:
+        """The detection chain (``paper``, ``oob``, ``people-counting``) and its settings."""
+        return self._chain
+
+    def set_chain(self, chain: ChainConfig) -> None:
+        if chain != self._chain:
+            self._chain = chain
+            self.chain_changed.emit(chain)
 
     @property
     def radar(self) -> RadarConfig:

@@ -111,10 +111,14 @@ class SceneController(QtCore.QObject):
         """Load a TI .cfg into the radar; on error show it, keep the current radar."""
         try:
             radar = self.engine.read_ti_cfg(path)
+            chain = self.engine.read_ti_chain(path)
         except Exception as exc:  # InputError, or a reader bug: must not crash the app
             self._fail(f"cannot load TI config {path}", exc, str(path))
             return False
+        self.radar_model.set_chain(chain)
         self.radar_model.set_radar(radar)
+        if chain.ignored:
+            self.message.emit(f"chain {chain.name}; ignored: {', '.join(chain.ignored)}")
         return True
 
     def load_cfg_dialog(self) -> None:

@@ -148,6 +148,7 @@ class MainWindow(QtWidgets.QMainWindow):
         # ---- wiring ----------------------------------------------------------------------------
         self.scene_control.info_changed.connect(self._on_scene_info)
         self.processing_panel.fidelity_changed.connect(self.set_fidelity)
+        self.radar_model.chain_changed.connect(self.set_chain)
         self.scene_control.error.connect(self.show_error)
         self.scene_control.message.connect(lambda m: self.statusBar().showMessage(m, 5000))
         self.cache.reset.connect(self._on_cache_reset)
@@ -358,6 +359,12 @@ class MainWindow(QtWidgets.QMainWindow):
             self.processing_panel.show_settings(
                 self.engine.processing_settings(self.scene_model.scene)
             )
+
+    def set_chain(self, chain) -> None:
+        """Simulate the scene again through another detection chain (``ChainConfig``)."""
+        if chain != self.sim.chain:
+            self.sim.chain = chain
+            self.scene_control.resimulate()
 
     def set_fidelity(self, name: str) -> None:
         """Simulate the scene again at another fidelity level (a key of the core registry)."""

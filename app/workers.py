@@ -46,6 +46,8 @@ class SimulationWorker(QtCore.QThread):
         self.generation = generation
         self._stop = threading.Event()
         self.fidelity = "exact"
+        #: detection chain (core.config.ChainConfig; None: the paper's)
+        self.chain = None
         #: seconds per simulated frame (radar chain: synthesis and processing), latest last
         self.frame_times_s: deque[float] = deque(maxlen=50)
         #: (synthesis, processing) seconds of the same frames (NaN where the level does both in
@@ -57,7 +59,9 @@ class SimulationWorker(QtCore.QThread):
 
     def run(self) -> None:  # worker thread
         try:
-            frames = self._engine.simulate(self._scene, fidelity=self.fidelity)
+            # the chain only when one was chosen (engines without chains keep working)
+            extra = {} if self.chain is None else {"chain": self.chain}
+            frames = self._engine.simulate(self._scene, fidelity=self.fidelity, **extra)
             t0 = time.perf_counter()
             for frame in frames:
                 t1 = time.perf_counter()
@@ -90,6 +94,8 @@ class SimulationController(QtCore.QObject):
         self.rate_fps = 0.0
         #: simulator level of the next start (a key of core.simulation.LEVELS)
         self.fidelity = "exact"
+        #: detection chain of the next start (core.config.ChainConfig; None: the paper's)
+        self.chain = None
 
     def start(self, scene) -> None:
         """(Re)simulate ``scene``; a running simulation of an older scene is abandoned."""
@@ -98,6 +104,7 @@ class SimulationController(QtCore.QObject):
         self._cache.clear(expected=info.n_frames, truth_paths=info.truth_paths)
         worker = SimulationWorker(self._engine, scene, self._cache.generation, self)
         worker.fidelity = self.fidelity
+        worker.chain = self.chain
         worker.frame_ready.connect(self._on_frame)
         worker.done.connect(self._on_done)
         worker.failed.connect(self._on_failed)

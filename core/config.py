@@ -15,6 +15,21 @@ BOLTZMANN_J_PER_K = 1.380649e-23
 #: IWR6843ISK virtual array, channel index = tx * 4 + rx, positions in units of lambda/2.
 ISK_AZIMUTH_POSITIONS = (0, 1, 2, 3, 2, 3, 4, 5, 4, 5, 6, 7)
 ISK_ELEVATION_POSITIONS = (0, 0, 0, 0, 1, 1, 1, 1, 0, 0, 0, 0)
+#: IWR6843AOP virtual array (antenna-on-package, 12 channels on a 4 x 4 grid less one 2 x 2
+#: corner), channel index = tx * 4 + rx, units of lambda/2. From TI's people-counting
+#: configuration for the AOP board, ``antGeometry0 -1 -1 0 0 -3 -3 -2 -2 -1 -1 0 0`` (azimuth
+#: index) and ``antGeometry1 -1 0 -1 0 -3 -2 -3 -2 -3 -2 -3 -2`` (elevation index): azimuth
+#: = -antGeometry0, elevation = antGeometry1 - min, the same mapping that turns the ISK's
+#: ``antGeometry0 0 -1 -2 -3 -2 -3 -4 -5 -4 -5 -6 -7`` / ``antGeometry1 -1 -1 -1 -1 0 0 0 0
+#: -1 -1 -1 -1`` into the ISK tuples above (docs/radar-chain.md, "Antenna layouts").
+AOP_AZIMUTH_POSITIONS = (1, 1, 0, 0, 3, 3, 2, 2, 1, 1, 0, 0)
+AOP_ELEVATION_POSITIONS = (2, 3, 2, 3, 0, 1, 0, 1, 0, 1, 0, 1)
+#: Antenna layouts by board: (azimuth positions, elevation positions) of the 12 virtual
+#: channels (3 TX x 4 RX, TDM order TX0, TX1, TX2).
+ANTENNA_LAYOUTS: dict[str, tuple[tuple[int, ...], tuple[int, ...]]] = {
+    "IWR6843ISK": (ISK_AZIMUTH_POSITIONS, ISK_ELEVATION_POSITIONS),
+    "IWR6843AOP": (AOP_AZIMUTH_POSITIONS, AOP_ELEVATION_POSITIONS),
+}
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -336,3 +351,238 @@ def _from_dict(cls, data: dict, source: str | None):
 
 #: The SPEC §3 processing defaults (module-level singleton for argument defaults).
 DEFAULT_PROCESSING = ProcessingSettings()
+
+
+# ---- TI detection chains ------------------------------------------------------------------------
+
+#: The detection chains: the paper's (section 3), TI's out-of-box demo and TI's 3-D people
+#: counting (docs/radar-chain.md, "Chains"). A TI ``.cfg`` selects one (core.formats.ti_cfg).
+CHAINS = ("paper", "oob", "people-counting")
+
+
+def _check_int(obj: object, name: str, low: int) -> None:
+    value = getattr(obj, name)
+    if not (isinstance(value, int) and not isinstance(value, bool) and value >= low):
+        raise InputError(f"{name} must be an integer >= {low}, got {name}={value!r}")
+
+
+def _check_real(obj: object, name: str, low: float, high: float) -> None:
+    value = getattr(obj, name)
+    if not (isinstance(value, int | float) and math.isfinite(value) and low <= value <= high):
+        raise InputError(f"{name} must be in [{low}, {high}], got {name}={value!r}")
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class DbCfarSettings:
+    """One CFAR pass whose threshold is a ratio in dB over the noise estimate (TI's ``cfarCfg``).
+
+    Parameters
+    ----------
+    method
+        ``"ca"``, ``"cago"`` or ``"caso"`` (TI's averageMode 0, 1, 2).
+    n_train, n_guard
+        Training (noiseWin) and guard (guardLen) cells on each side.
+    threshold_db
+        A cell is detected when it exceeds the noise estimate by this many dB.
+    cyclic
+        Wrap around the axis (TI's cyclic mode).
+    peak_grouping
+        Keep only cells not below their two neighbours along this axis.
+    """
+
+    method: str = "ca"
+    n_train: int = 8
+    n_guard: int = 4
+    threshold_db: float = 15.0
+    cyclic: bool = False
+    peak_grouping: bool = True
+
+    def __post_init__(self) -> None:
+        if self.method not in CFAR_METHODS:
+            raise InputError(f"method must be one of {CFAR_METHODS}, got method={self.method!r}")
+        _check_int(self, "n_train", 1)
+        _check_int(self, "n_guard", 0)
+        _check_real(self, "threshold_db", 0.0, 100.0)
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class OobSettings:
+    """TI's out-of-box demo chain (mmWave SDK 3.x ``cfarCfg``, ``cfarFovCfg``, ``aoaFovCfg``,
+    ``multiObjBeamForming``, ``clutterRemoval``). Angles in degrees as in the ``.cfg``.
+
+    ``multi_object_threshold``: a second azimuth peak above this fraction of the first gives
+    a second point at the same range and Doppler (None: off).
+    """
+
+    range_cfar: DbCfarSettings = DbCfarSettings(method="caso", n_train=8, n_guard=4)
+    doppler_cfar: DbCfarSettings = DbCfarSettings(method="ca", n_train=4, n_guard=2, cyclic=True)
+    static_clutter_removal: bool = False
+    min_range_m: float = 0.0
+    max_range_m: float = math.inf
+    min_velocity_mps: float = -math.inf
+    max_velocity_mps: float = math.inf
+    azimuth_fov_deg: tuple[float, float] = (-90.0, 90.0)
+    elevation_fov_deg: tuple[float, float] = (-90.0, 90.0)
+    multi_object_threshold: float | None = 0.5
+
+    def __post_init__(self) -> None:
+        for name in ("range_cfar", "doppler_cfar"):
+            if not isinstance(getattr(self, name), DbCfarSettings):
+                raise InputError(f"{name} must be DbCfarSettings, got {getattr(self, name)!r}")
+        if not self.min_range_m < self.max_range_m:
+            raise InputError(
+                f"min_range_m must be < max_range_m, got {self.min_range_m}, {self.max_range_m}"
+            )
+        if not self.min_velocity_mps < self.max_velocity_mps:
+            raise InputError(
+                "min_velocity_mps must be < max_velocity_mps, got "
+                f"{self.min_velocity_mps}, {self.max_velocity_mps}"
+            )
+        for name in ("azimuth_fov_deg", "elevation_fov_deg"):
+            lo, hi = getattr(self, name)
+            if not -90.0 <= lo < hi <= 90.0:
+                raise InputError(f"{name} must satisfy -90 <= min < max <= 90, got {(lo, hi)}")
+        t = self.multi_object_threshold
+        if t is not None and not (math.isfinite(t) and 0.0 < t <= 1.0):
+            raise InputError(f"multi_object_threshold must be in (0, 1], got {t!r}")
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class RaCfarSettings:
+    """CFAR on a range-angle map (TI people counting ``dynamicRACfarCfg`` / ``staticRACfarCfg``).
+
+    A first pass along range (CASO, ``ref_range`` training and ``guard_range`` guard cells a
+    side, threshold ``range_threshold_db``), confirmed by a second pass along angle (CASO,
+    ``angle_threshold_db``) when ``second_pass``; ``discard_*`` cells at either end of each
+    axis are not tested; a detection below ``sidelobe_threshold`` times the strongest cell of
+    its range bin is dropped.
+    """
+
+    discard_left_range: int = 4
+    discard_right_range: int = 4
+    discard_left_angle: int = 2
+    discard_right_angle: int = 2
+    ref_range: int = 8
+    ref_angle: int = 12
+    guard_range: int = 4
+    guard_angle: int = 8
+    range_threshold_db: float = 5.0
+    angle_threshold_db: float = 8.0
+    sidelobe_threshold: float = 0.4
+    second_pass: bool = True
+
+    def __post_init__(self) -> None:
+        for name in (
+            "discard_left_range",
+            "discard_right_range",
+            "discard_left_angle",
+            "discard_right_angle",
+            "guard_range",
+            "guard_angle",
+        ):
+            _check_int(self, name, 0)
+        _check_int(self, "ref_range", 1)
+        _check_int(self, "ref_angle", 1)
+        _check_real(self, "range_threshold_db", 0.0, 100.0)
+        _check_real(self, "angle_threshold_db", 0.0, 100.0)
+        _check_real(self, "sidelobe_threshold", 0.0, 1.0)
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class PeopleCountingSettings:
+    """TI's 3-D people counting chain (``dynamicRangeAngleCfg``, ``dynamicRACfarCfg``,
+    ``dynamic2DAngleCfg``, ``staticRangeAngleCfg``, ``staticRACfarCfg``, ``fovCfg``).
+
+    Parameters
+    ----------
+    dynamic_cfar, static_cfar
+        CFAR on the moving (clutter-removed, Capon) and static (zero-Doppler, Bartlett) maps.
+    angle_step_deg, diagonal_loading
+        Azimuth grid step of the Capon range-azimuth map and its diagonal loading, relative to
+        the mean channel power (``R + loading * tr(R)/N * I``).
+    elevation_step_deg, elevation_loading
+        Elevation grid step and loading of the per-point Capon elevation search.
+    static_enabled
+        Run the static chain (no clutter removal; points with zero Doppler).
+    static_azimuth_decimation, static_elevation_decimation
+        The static chain's angle grids are these many times coarser.
+    azimuth_fov_deg, elevation_fov_deg
+        Half-widths of the angle grids (``fovCfg``).
+    """
+
+    dynamic_cfar: RaCfarSettings = RaCfarSettings()
+    static_cfar: RaCfarSettings = RaCfarSettings(
+        discard_left_range=6,
+        discard_right_range=2,
+        discard_left_angle=2,
+        discard_right_angle=2,
+        ref_range=8,
+        ref_angle=8,
+        guard_range=6,
+        guard_angle=4,
+        range_threshold_db=8.0,
+        angle_threshold_db=15.0,
+        sidelobe_threshold=0.3,
+        second_pass=False,
+    )
+    angle_step_deg: float = 0.75
+    diagonal_loading: float = 0.001
+    elevation_step_deg: float = 1.5
+    elevation_loading: float = 0.03
+    static_enabled: bool = True
+    static_azimuth_decimation: int = 8
+    static_elevation_decimation: int = 8
+    azimuth_fov_deg: float = 70.0
+    elevation_fov_deg: float = 20.0
+
+    def __post_init__(self) -> None:
+        for name in ("dynamic_cfar", "static_cfar"):
+            if not isinstance(getattr(self, name), RaCfarSettings):
+                raise InputError(f"{name} must be RaCfarSettings, got {getattr(self, name)!r}")
+        _check_real(self, "angle_step_deg", 0.01, 45.0)
+        _check_real(self, "elevation_step_deg", 0.01, 45.0)
+        _check_real(self, "diagonal_loading", 0.0, 1e3)
+        _check_real(self, "elevation_loading", 0.0, 1e3)
+        _check_int(self, "static_azimuth_decimation", 1)
+        _check_int(self, "static_elevation_decimation", 1)
+        _check_real(self, "azimuth_fov_deg", 1.0, 90.0)
+        _check_real(self, "elevation_fov_deg", 0.0, 90.0)
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class ChainConfig:
+    """Which detection chain a radar runs and its settings (one of :data:`CHAINS`).
+
+    ``ignored`` names the ``.cfg`` commands the chain was read with but does not model.
+    """
+
+    name: str = "paper"
+    oob: OobSettings | None = None
+    people_counting: PeopleCountingSettings | None = None
+    ignored: tuple[str, ...] = ()
+
+    def __post_init__(self) -> None:
+        if self.name not in CHAINS:
+            raise InputError(f"chain must be one of {list(CHAINS)}, got chain={self.name!r}")
+        if self.name == "oob" and not isinstance(self.oob, OobSettings):
+            raise InputError("chain 'oob' needs its OobSettings (oob=...)")
+        if self.name == "people-counting" and not isinstance(
+            self.people_counting, PeopleCountingSettings
+        ):
+            raise InputError("chain 'people-counting' needs PeopleCountingSettings")
+
+
+PAPER_CHAIN = ChainConfig()
+
+
+def default_chain(name: str) -> ChainConfig:
+    """The chain ``name`` (one of :data:`CHAINS`) with TI's default settings (the values of
+    ``resources/radar/oob_isk.cfg`` and ``people_counting_isk.cfg`` with static detection on);
+    :class:`InputError` naming the chains for an unknown name."""
+    if name not in CHAINS:
+        raise InputError(f"chain must be one of {list(CHAINS)}, got {name!r}")
+    if name == "oob":
+        return ChainConfig(name="oob", oob=OobSettings())
+    if name == "people-counting":
+        return ChainConfig(name="people-counting", people_counting=PeopleCountingSettings())
+    return PAPER_CHAIN

@@ -6,7 +6,7 @@ from __future__ import annotations
 from PySide6 import QtCore, QtWidgets
 
 from app.models import RadarModel
-from core.config import RadarConfig
+from core.config import CHAINS, RadarConfig, default_chain
 from core.errors import InputError
 
 #: field, label, display unit, SI per display unit, decimals, min, max (display units)
@@ -58,6 +58,17 @@ class RadarPanel(QtWidgets.QWidget):
         outer = QtWidgets.QVBoxLayout(self)
         self.name_label = QtWidgets.QLabel()
         outer.addWidget(self.name_label)
+        chain_row = QtWidgets.QFormLayout()
+        self.chain_combo = QtWidgets.QComboBox()
+        self.chain_combo.setObjectName("chainCombo")
+        self.chain_combo.addItems(list(CHAINS))
+        self.chain_combo.setToolTip(
+            "detection chain: the paper's, TI's out-of-box demo or TI's 3-D people counting "
+            "(TI's default settings; a loaded TI .cfg sets the chain with its own)"
+        )
+        self.chain_combo.currentTextChanged.connect(self._on_chain)
+        chain_row.addRow("detection chain", self.chain_combo)
+        outer.addLayout(chain_row)
         fields = QtWidgets.QGroupBox("Configuration")
         form = QtWidgets.QFormLayout(fields)
         self.spins: dict[str, QtWidgets.QAbstractSpinBox] = {}
@@ -103,7 +114,20 @@ class RadarPanel(QtWidgets.QWidget):
         outer.addLayout(buttons)
         outer.addStretch(1)
         model.changed.connect(self.sync)
+        model.chain_changed.connect(self.sync_chain)
         self.sync()
+        self.sync_chain()
+
+    def _on_chain(self, name: str) -> None:
+        """A chain picked by name: TI's defaults, unless the model already runs that chain
+        (e.g. with a loaded .cfg's settings)."""
+        if name != self.model.chain.name:
+            self.model.set_chain(default_chain(name))
+
+    def sync_chain(self, *_args) -> None:
+        self.chain_combo.blockSignals(True)
+        self.chain_combo.setCurrentText(self.model.chain.name)
+        self.chain_combo.blockSignals(False)
 
     def _on_field(self, name: str, value, scale: float) -> None:
         si = int(value) if isinstance(value, int) else value * scale

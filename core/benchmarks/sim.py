@@ -250,6 +250,9 @@ def run(quick: bool = False) -> dict:
     }
     result["walking_body"] = walking_case(quick)
     result["room"] = room_case(quick)
+    from core.benchmarks import chains
+
+    result["detection_chains"] = chains.run(quick, scene_frames=paper_scene_frames)
     result["stages_ms"] = _stage_profile(radar, settings, antenna, frames[: 50 if quick else 300])
     result["dataset"] = _time_dataset(quick)
     return result
@@ -582,6 +585,10 @@ def summary(result: dict) -> str:
         )
     if result.get("room"):
         lines.append(room_summary_line(result["room"]))
+    if "detection_chains" in result:
+        from core.benchmarks import chains
+
+        lines += chains.summary_lines(result["detection_chains"])
     stages = result.get("stages_ms")
     if stages:
         lines.append(

@@ -26,6 +26,7 @@ BENCHMARKS = (
     "cvca",
     "import",
     "gtrack_ti",
+    "chain_calibration",
 )
 #: benchmark name -> module in core.benchmarks, where the name is a Python keyword
 MODULES = {"import": "import_"}

@@ -13,7 +13,16 @@ import os
 from dataclasses import dataclass
 from pathlib import Path
 
-from core.config import RadarConfig
+import numpy as np
+
+from core.config import (
+    ChainConfig,
+    DbCfarSettings,
+    OobSettings,
+    PeopleCountingSettings,
+    RaCfarSettings,
+    RadarConfig,
+)
 from core.errors import InputError
 from core.files import read_text, write_text_atomic
 
@@ -237,6 +246,9 @@ def radar_from_ti_commands(
 
     az = tuple(ISK_TX_POSITIONS[t][0] + ISK_RX_AZIMUTH[r] for t in tx_order for r in rx_enabled)
     el = tuple(ISK_TX_POSITIONS[t][1] for t in tx_order for _ in rx_enabled)
+    geometry = antenna_geometry(commands, source, len(az))
+    if geometry is not None:
+        az, el = geometry
     ramp_s = pr["rampEndTime"] / 1e6
     sample_rate_hz = pr["digOutSampleRate"] * 1000.0
     # BW = S * Tc, rounded to 1 Hz (TI quantises the slope far more coarsely)
@@ -253,7 +265,7 @@ def radar_from_ti_commands(
             n_samples=int(pr["numAdcSamples"]),
             sample_rate_hz=sample_rate_hz,
             frame_period_s=fr["framePeriodicity"] / 1000.0,
-            tx_power_dbm=TI_MAX_TX_POWER_DBM - pr["txOutPower"],
+            tx_power_dbm=TI_MAX_TX_POWER_DBM - tx_backoff_db(int(pr["txOutPower"]), tx_order),
             receiver_gain_db=float(int(pr["rxGain"]) & 0x3F),
             receiver_bandwidth_hz=sample_rate_hz,
             tx_order=tx_order,
@@ -263,6 +275,19 @@ def radar_from_ti_commands(
         )
     except InputError as exc:
         raise InputError(exc.message, source) from None
+
+
+def tx_backoff_db(code: int, tx_order: tuple[int, ...]) -> float:
+    """The TX power back-off of ``profileCfg``'s txOutPower field, dB.
+
+    The field packs one back-off code per transmitter, 1 dB per step (TI mmWave link API,
+    ``rlProfileCfg_t.txOutPowerBackoffCode``: TX0 in bits 7:0, TX1 in 15:8, TX2 in 23:16; TI's
+    people-counting files write 394758 = 0x060606, 6 dB on each); a value below 256 is the
+    same back-off for every transmitter as before. The mean over the transmitters used.
+    """
+    if code < 256:
+        return float(code)
+    return float(np.mean([(code >> (8 * t)) & 0xFF for t in set(tx_order)]))
 
 
 def read_ti_cfg(path: str | os.PathLike) -> RadarConfig:
@@ -529,3 +554,381 @@ def replace_tracker_lines(text: str, lines: dict[str, str]) -> str:
             out.append(raw)
     out += [lines[n] for n in lines if n not in done]
     return "\n".join(out) + "\n"
+
+
+# ---- chain lines: which detection chain a .cfg runs, and its settings ---------------------------
+
+#: Fields of dynamicRACfarCfg and staticRACfarCfg (TI 3-D people counting).
+_RA_CFAR_FIELDS = (
+    "subFrameIdx",
+    "cfarDiscardLeftRange",
+    "cfarDiscardRightRange",
+    "cfarDiscardLeftAngle",
+    "cfarDiscardRightAngle",
+    "refWinSizeRange",
+    "refWinSizeAngle",
+    "guardWinSizeRange",
+    "guardWinSizeAngle",
+    "rangeThre",
+    "angleThre",
+    "sidelobeThre",
+    "enable2ndPass",
+    "dynamicFlag",
+)
+#: Field names of the chain commands (TI mmWave SDK 3.x user guide for the out-of-box demo; TI's
+#: 3-D people counting demo configuration guide for the rest). Only the leading fields listed
+#: are read; a command may carry more.
+TI_CHAIN_FIELDS: dict[str, tuple[str, ...]] = {
+    "cfarCfg": (
+        "subFrameIdx",
+        "procDirection",
+        "averageMode",
+        "winLen",
+        "guardLen",
+        "noiseDiv",
+        "cyclicMode",
+        "thresholdScale",
+        "peakGroupingEn",
+    ),
+    "cfarFovCfg": ("subFrameIdx", "procDirection", "min", "max"),
+    "aoaFovCfg": (
+        "subFrameIdx",
+        "minAzimuthDeg",
+        "maxAzimuthDeg",
+        "minElevationDeg",
+        "maxElevationDeg",
+    ),
+    "multiObjBeamForming": ("subFrameIdx", "enabled", "threshold"),
+    "clutterRemoval": ("subFrameIdx", "enabled"),
+    "dynamicRACfarCfg": _RA_CFAR_FIELDS,
+    "staticRACfarCfg": _RA_CFAR_FIELDS,
+    "dynamicRangeAngleCfg": (
+        "subFrameIdx",
+        "angleSearchStep",
+        "rangeAngleDiagonalLoading",
+        "rangeAngleEstMethod",
+        "dopplerEstMethod",
+    ),
+    "dynamic2DAngleCfg": ("subFrameIdx", "elevSearchStep", "angleDiagonalLoading"),
+    "staticRangeAngleCfg": (
+        "subFrameIdx",
+        "staticProcEnabled",
+        "staticAzimStepDeciFactor",
+        "staticElevStepDeciFactor",
+    ),
+    "fovCfg": ("subFrameIdx", "azimuthFovDeg", "elevationFovDeg"),
+    "antGeometry0": tuple(f"virtAnt{i}" for i in range(12)),
+    "antGeometry1": tuple(f"virtAnt{i}" for i in range(12)),
+    "antPhaseRot": tuple(f"virtAnt{i}" for i in range(12)),
+}
+_CHAIN_INT_FIELDS = {
+    "subFrameIdx",
+    "procDirection",
+    "averageMode",
+    "winLen",
+    "guardLen",
+    "noiseDiv",
+    "cyclicMode",
+    "peakGroupingEn",
+    "enabled",
+    "cfarDiscardLeftRange",
+    "cfarDiscardRightRange",
+    "cfarDiscardLeftAngle",
+    "cfarDiscardRightAngle",
+    "refWinSizeRange",
+    "refWinSizeAngle",
+    "guardWinSizeRange",
+    "guardWinSizeAngle",
+    "enable2ndPass",
+    "dynamicFlag",
+    "rangeAngleEstMethod",
+    "dopplerEstMethod",
+    "staticProcEnabled",
+    "staticAzimStepDeciFactor",
+    "staticElevStepDeciFactor",
+    *(f"virtAnt{i}" for i in range(12)),
+}
+#: Commands that select the people-counting chain; ``cfarCfg`` selects the out-of-box chain.
+PEOPLE_COUNTING_COMMANDS = (
+    "dynamicRACfarCfg",
+    "staticRACfarCfg",
+    "dynamicRangeAngleCfg",
+    "dynamic2DAngleCfg",
+    "staticRangeAngleCfg",
+)
+#: Commands that start, stop or route the sensor's output: no effect on the points.
+TI_HOUSEKEEPING = frozenset(
+    {
+        "sensorStop",
+        "sensorStart",
+        "flushCfg",
+        "dfeDataOutputMode",
+        "lowPower",
+        "guiMonitor",
+        "lvdsStreamCfg",
+        "adcbufCfg",
+        "CQRxSatMonitor",
+        "CQSigImgMonitor",
+        "analogMonitor",
+        "calibData",
+        "measureRangeBiasAndRxChanPhase",
+    }
+)
+#: Commands RadarTune reads into the radar or the chain; every other one a .cfg uses is named
+#: as ignored (:attr:`ChainConfig.ignored`).
+TI_READ_COMMANDS = frozenset(TI_COMMAND_FIELDS) | frozenset(TI_CHAIN_FIELDS) - {"antPhaseRot"}
+_CFAR_MODES = {0: "ca", 1: "cago", 2: "caso"}
+
+
+def _chain_fields(cmd: TiCommand, source: str) -> dict[str, float | int]:
+    names = TI_CHAIN_FIELDS[cmd.name]
+    where = f"{source}:{cmd.line}"
+    if len(cmd.args) < len(names):
+        raise InputError(
+            f"{cmd.name} needs {len(names)} fields, got {len(cmd.args)} "
+            f"(field {len(cmd.args) + 1} {names[len(cmd.args)]!r} missing)",
+            where,
+        )
+    out: dict[str, float | int] = {}
+    for i, (name, text) in enumerate(zip(names, cmd.args), start=1):
+        try:
+            value = int(text, 0) if name in _CHAIN_INT_FIELDS else float(text)
+        except ValueError:
+            kind = "an integer" if name in _CHAIN_INT_FIELDS else "a number"
+            raise InputError(
+                f"{cmd.name} field {i} {name!r}: expected {kind}, got {text!r}", where
+            ) from None
+        if isinstance(value, float) and not math.isfinite(value):
+            raise InputError(f"{cmd.name} field {i} {name!r}: not finite, got {text!r}", where)
+        out[name] = value
+    return out
+
+
+def _chain_require(cond: bool, cmd: TiCommand, field_name: str, message: str, source: str) -> None:
+    if not cond:
+        index = TI_CHAIN_FIELDS[cmd.name].index(field_name) + 1
+        raise InputError(
+            f"{cmd.name} field {index} {field_name!r}: {message}", f"{source}:{cmd.line}"
+        )
+
+
+def antenna_geometry(
+    commands: list[TiCommand], source: str, n_virtual: int
+) -> tuple[tuple[int, ...], tuple[int, ...]] | None:
+    """Virtual positions from ``antGeometry0`` (azimuth index) and ``antGeometry1`` (elevation
+    index), or None when the .cfg has neither (the IWR6843ISK layout then applies).
+
+    TI lists each virtual antenna's position index (0, -1, -2, ...) in units of lambda/2 in
+    chirp order; RadarTune's positions are ``-antGeometry0`` and ``antGeometry1 - min`` (the
+    mapping that gives the ISK layout from TI's ISK lines, see core.config).
+    """
+    known = {c.name: c for c in commands if c.name in ("antGeometry0", "antGeometry1")}
+    if not known:
+        return None
+    for needed in ("antGeometry0", "antGeometry1"):
+        if needed not in known:
+            raise InputError(f"{needed} missing (the other antGeometry line is given)", source)
+    g0 = _chain_fields(known["antGeometry0"], source)
+    g1 = _chain_fields(known["antGeometry1"], source)
+    if n_virtual != 12:
+        raise InputError(
+            f"antGeometry0 lists 12 virtual antennas, the channel and chirp lines give {n_virtual}",
+            f"{source}:{known['antGeometry0'].line}",
+        )
+    az = [-int(g0[f"virtAnt{i}"]) for i in range(12)]
+    el = [int(g1[f"virtAnt{i}"]) for i in range(12)]
+    az0, el0 = min(az), min(el)
+    return tuple(a - az0 for a in az), tuple(e - el0 for e in el)
+
+
+def _ra_cfar(cmd: TiCommand, source: str) -> RaCfarSettings:
+    f = _chain_fields(cmd, source)
+    try:
+        return RaCfarSettings(
+            discard_left_range=int(f["cfarDiscardLeftRange"]),
+            discard_right_range=int(f["cfarDiscardRightRange"]),
+            discard_left_angle=int(f["cfarDiscardLeftAngle"]),
+            discard_right_angle=int(f["cfarDiscardRightAngle"]),
+            ref_range=int(f["refWinSizeRange"]),
+            ref_angle=int(f["refWinSizeAngle"]),
+            guard_range=int(f["guardWinSizeRange"]),
+            guard_angle=int(f["guardWinSizeAngle"]),
+            range_threshold_db=float(f["rangeThre"]),
+            angle_threshold_db=float(f["angleThre"]),
+            sidelobe_threshold=float(f["sidelobeThre"]),
+            second_pass=bool(f["enable2ndPass"]),
+        )
+    except InputError as exc:
+        raise InputError(f"{cmd.name}: {exc.message}", f"{source}:{cmd.line}") from None
+
+
+def _people_counting(known: dict[str, TiCommand], source: str) -> PeopleCountingSettings:
+    kw: dict = {}
+    for name in ("dynamicRACfarCfg", "staticRACfarCfg"):
+        if name not in known:
+            raise InputError(
+                f"missing command {name!r} (the people-counting chain needs it)", source
+            )
+    kw["dynamic_cfar"] = _ra_cfar(known["dynamicRACfarCfg"], source)
+    kw["static_cfar"] = _ra_cfar(known["staticRACfarCfg"], source)
+    if "dynamicRangeAngleCfg" in known:
+        cmd = known["dynamicRangeAngleCfg"]
+        f = _chain_fields(cmd, source)
+        _chain_require(f["angleSearchStep"] > 0, cmd, "angleSearchStep", "must be > 0", source)
+        _chain_require(
+            f["rangeAngleDiagonalLoading"] >= 0,
+            cmd,
+            "rangeAngleDiagonalLoading",
+            "must be >= 0",
+            source,
+        )
+        kw["angle_step_deg"] = float(f["angleSearchStep"])
+        kw["diagonal_loading"] = float(f["rangeAngleDiagonalLoading"])
+    if "dynamic2DAngleCfg" in known:
+        cmd = known["dynamic2DAngleCfg"]
+        f = _chain_fields(cmd, source)
+        _chain_require(f["elevSearchStep"] > 0, cmd, "elevSearchStep", "must be > 0", source)
+        _chain_require(
+            f["angleDiagonalLoading"] >= 0, cmd, "angleDiagonalLoading", "must be >= 0", source
+        )
+        kw["elevation_step_deg"] = float(f["elevSearchStep"])
+        kw["elevation_loading"] = float(f["angleDiagonalLoading"])
+    if "staticRangeAngleCfg" in known:
+        cmd = known["staticRangeAngleCfg"]
+        f = _chain_fields(cmd, source)
+        for name in ("staticAzimStepDeciFactor", "staticElevStepDeciFactor"):
+            _chain_require(f[name] >= 1, cmd, name, f"must be >= 1, got {f[name]}", source)
+        kw["static_enabled"] = bool(f["staticProcEnabled"])
+        kw["static_azimuth_decimation"] = int(f["staticAzimStepDeciFactor"])
+        kw["static_elevation_decimation"] = int(f["staticElevStepDeciFactor"])
+    if "fovCfg" in known:
+        cmd = known["fovCfg"]
+        f = _chain_fields(cmd, source)
+        _chain_require(
+            1 <= f["azimuthFovDeg"] <= 90, cmd, "azimuthFovDeg", "must be in [1, 90]", source
+        )
+        _chain_require(
+            0 <= f["elevationFovDeg"] <= 90, cmd, "elevationFovDeg", "must be in [0, 90]", source
+        )
+        kw["azimuth_fov_deg"] = float(f["azimuthFovDeg"])
+        kw["elevation_fov_deg"] = float(f["elevationFovDeg"])
+    try:
+        return PeopleCountingSettings(**kw)
+    except InputError as exc:
+        raise InputError(exc.message, source) from None
+
+
+def _oob(commands: list[TiCommand], source: str) -> OobSettings:
+    kw: dict = {}
+    cfar: dict[int, DbCfarSettings] = {}
+    for cmd in commands:
+        if cmd.name == "cfarCfg":
+            f = _chain_fields(cmd, source)
+            direction = int(f["procDirection"])
+            _chain_require(
+                direction in (0, 1),
+                cmd,
+                "procDirection",
+                f"0 or 1 expected, got {direction}",
+                source,
+            )
+            mode = int(f["averageMode"])
+            _chain_require(
+                mode in _CFAR_MODES, cmd, "averageMode", f"0, 1 or 2 expected, got {mode}", source
+            )
+            _chain_require(f["winLen"] >= 1, cmd, "winLen", "must be >= 1", source)
+            _chain_require(f["guardLen"] >= 0, cmd, "guardLen", "must be >= 0", source)
+            _chain_require(
+                0 < f["thresholdScale"] <= 100,
+                cmd,
+                "thresholdScale",
+                f"a threshold in dB in (0, 100] expected (SDK 3.x), got {f['thresholdScale']}",
+                source,
+            )
+            cfar[direction] = DbCfarSettings(
+                method=_CFAR_MODES[mode],
+                n_train=int(f["winLen"]),
+                n_guard=int(f["guardLen"]),
+                threshold_db=float(f["thresholdScale"]),
+                cyclic=bool(f["cyclicMode"]),
+                peak_grouping=bool(f["peakGroupingEn"]),
+            )
+        elif cmd.name == "cfarFovCfg":
+            f = _chain_fields(cmd, source)
+            _chain_require(
+                f["min"] < f["max"], cmd, "max", f"must be > min {f['min']}, got {f['max']}", source
+            )
+            if int(f["procDirection"]) == 0:
+                kw["min_range_m"], kw["max_range_m"] = float(f["min"]), float(f["max"])
+            else:
+                kw["min_velocity_mps"], kw["max_velocity_mps"] = float(f["min"]), float(f["max"])
+        elif cmd.name == "aoaFovCfg":
+            f = _chain_fields(cmd, source)
+            az = (float(f["minAzimuthDeg"]), float(f["maxAzimuthDeg"]))
+            el = (float(f["minElevationDeg"]), float(f["maxElevationDeg"]))
+            _chain_require(
+                -90 <= az[0] < az[1] <= 90, cmd, "maxAzimuthDeg", f"bad interval {az}", source
+            )
+            _chain_require(
+                -90 <= el[0] < el[1] <= 90, cmd, "maxElevationDeg", f"bad interval {el}", source
+            )
+            kw["azimuth_fov_deg"], kw["elevation_fov_deg"] = az, el
+        elif cmd.name == "multiObjBeamForming":
+            f = _chain_fields(cmd, source)
+            _chain_require(0 < f["threshold"] <= 1, cmd, "threshold", "must be in (0, 1]", source)
+            kw["multi_object_threshold"] = float(f["threshold"]) if f["enabled"] else None
+        elif cmd.name == "clutterRemoval":
+            f = _chain_fields(cmd, source)
+            kw["static_clutter_removal"] = bool(f["enabled"])
+    for direction, name in ((0, "range"), (1, "Doppler")):
+        if direction not in cfar:
+            raise InputError(
+                f"missing cfarCfg for the {name} direction (procDirection {direction})", source
+            )
+    kw["range_cfar"], kw["doppler_cfar"] = cfar[0], cfar[1]
+    try:
+        return OobSettings(**kw)
+    except InputError as exc:
+        raise InputError(exc.message, source) from None
+
+
+def chain_from_ti_commands(commands: list[TiCommand], source: str = "<cfg>") -> ChainConfig:
+    """The detection chain a TI .cfg runs, with its settings and the commands it ignores.
+
+    ``cfarCfg`` selects ``oob`` (TI's out-of-box demo), any of
+    :data:`PEOPLE_COUNTING_COMMANDS` selects ``people-counting``, neither ``paper`` (the
+    radar lines alone). Both kinds in one file is an error naming the first line of each.
+    """
+    oob = [c for c in commands if c.name == "cfarCfg"]
+    people = [c for c in commands if c.name in PEOPLE_COUNTING_COMMANDS]
+    if oob and people:
+        raise InputError(
+            f"{oob[0].name} (line {oob[0].line}) is the out-of-box chain's, "
+            f"{people[0].name} (line {people[0].line}) the people-counting chain's: "
+            "one chain per file",
+            source,
+        )
+    ignored = tuple(
+        sorted(
+            {
+                f"{c.name} (line {c.line})"
+                for c in commands
+                if c.name not in TI_READ_COMMANDS and c.name not in TI_HOUSEKEEPING
+            },
+            key=lambda t: int(t.rsplit("line ", 1)[1].rstrip(")")),
+        )
+    )
+    if people:
+        known = {c.name: c for c in commands if c.name in TI_CHAIN_FIELDS}
+        pc = _people_counting(known, source)
+        return ChainConfig(name="people-counting", people_counting=pc, ignored=ignored)
+    if oob:
+        return ChainConfig(name="oob", oob=_oob(commands, source), ignored=ignored)
+    return ChainConfig(name="paper", ignored=ignored)
+
+
+def read_ti_chain(path: str | os.PathLike) -> ChainConfig:
+    """The detection chain of a TI .cfg file (:func:`chain_from_ti_commands`)."""
+    p = Path(path)
+    text = read_text(p, what="TI configuration")
+    return chain_from_ti_commands(parse_ti_cfg(text, str(p)), str(p))

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import functools
 import json
 import math
 import time
@@ -115,6 +116,10 @@ def iter_frames(
     radar = scene.radar
     settings = processing_settings(scene)
     simulate = simulator(p.fidelity)
+    if p.chain.name != "paper":
+        from core.simulation.chain_frame import simulate_frame_chain
+
+        simulate = functools.partial(simulate_frame_chain, chain=p.chain)
     for fi in frame_inputs(scene, p, seed, frames):
         out = simulate(
             radar,
@@ -219,6 +224,7 @@ def simulate_scene(
     from core.simulation.levels import fidelity_level
 
     batch = fidelity_level(p.fidelity).simulate_frames is not None and scene.n_frames > 0
+    batch = batch and p.chain.name == "paper"
     if batch and not p.keep_rd_maps and p.consumer != "study":
         return _simulate_scene_batch(scene, p, seed, progress, t0)
     clouds, maps, n_clutter = [], [], []

@@ -15,7 +15,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
-from core.config import DEFAULT_PROCESSING, ProcessingSettings
+from core.config import DEFAULT_PROCESSING, PAPER_CHAIN, ChainConfig, ProcessingSettings
 from core.errors import InputError
 from core.scene import Scene, expected_clutter_count
 
@@ -43,6 +43,8 @@ class Plan:
     stages: tuple[Stage, ...]
     fidelity: str = "exact"
     consumer: str = "simulate"
+    #: the detection chain (``paper``: section 3; ``oob``, ``people-counting``: TI's)
+    chain: ChainConfig = PAPER_CHAIN
 
     def runs(self, name: str) -> bool:
         """Whether the stage ``name`` runs (KeyError for an unknown stage)."""
@@ -62,7 +64,9 @@ class Plan:
     def explain(self) -> str:
         """One line per stage: ``run``/``skip``, name, needs → produces, reason."""
         width = max(len(s.name) for s in self.stages)
-        lines = [f"plan ({self.consumer}, fidelity {self.fidelity}):"]
+        head = f"plan ({self.consumer}, fidelity {self.fidelity}"
+        head += "):" if self.chain.name == "paper" else f", chain {self.chain.name}):"
+        lines = [head]
         for s in self.stages:
             flow = f"{', '.join(s.needs) or '-'} -> {', '.join(s.produces)}"
             lines.append(
@@ -81,6 +85,7 @@ def plan(
     fidelity: str = "exact",
     consumer: str = "simulate",
     force: Sequence[str] = (),
+    chain: ChainConfig = PAPER_CHAIN,
 ) -> Plan:
     """Decide which stages run for this scene and this consumer.
 
@@ -97,11 +102,19 @@ def plan(
         (an optimisation trial: tracks cached point clouds, simulates nothing).
     force
         Stage names to run even where the plan would skip them (for tests and comparisons).
+    chain
+        The detection chain; TI's chains (``oob``, ``people-counting``) need a baseband cube,
+        so they run on the exact level only.
     """
     # the registry is imported here, not at load: ``import core.pipeline`` stays light
     from core.simulation.levels import fidelity_level
 
     fidelity_level(fidelity)  # InputError for an unknown level
+    if chain.name != "paper" and fidelity != "exact":
+        raise InputError(
+            f"chain {chain.name!r} runs on the exact level only (it needs the baseband cube), "
+            f"got fidelity={fidelity!r}"
+        )
     if consumer not in CONSUMERS:
         raise InputError(f"consumer must be one of {list(CONSUMERS)}, got {consumer!r}")
     keep = keep_rd_maps or consumer == "gui"
@@ -227,7 +240,41 @@ def plan(
     unknown = sorted(set(force) - {s.name for s in stages})
     if unknown:
         raise InputError(f"force: unknown stage(s) {unknown}")
-    return Plan(stages=stages, fidelity=fidelity, consumer=consumer)
+    all_stages: tuple[Stage, ...] = stages
+    if chain.name != "paper":
+        all_stages = _chain_stages(stages, chain, study)
+    return Plan(stages=all_stages, fidelity=fidelity, consumer=consumer, chain=chain)
+
+
+#: What TI's chains run instead of the paper's detection stages (docs/radar-chain.md, "Chains").
+_CHAIN_STAGES = {
+    "oob": (
+        ("static_clutter_removal", "clutterRemoval: subtract the mean over loops"),
+        ("cfar", "cfarCfg: CFAR in dB along range and along Doppler, peak grouping, cfarFovCfg"),
+        ("azimuth", "azimuth FFT at detections; multiObjBeamForming second peaks; aoaFovCfg"),
+    ),
+    "people-counting": (
+        ("static_clutter_removal", "dynamic chain only; the static chain keeps the mean"),
+        ("doppler_fft", "per detected point, of its MVDR beam (not a Doppler cube)"),
+        ("rd_map", "replaced by the Capon range-azimuth map (dynamicRangeAngleCfg)"),
+        ("cfar", "dynamicRACfarCfg on the Capon map; staticRACfarCfg on the static map"),
+        ("azimuth", "Capon range-azimuth map peaks; elevation by Capon (dynamic2DAngleCfg)"),
+    ),
+}
+
+
+def _chain_stages(stages: tuple[Stage, ...], chain: ChainConfig, study: bool) -> tuple[Stage, ...]:
+    why = dict(_CHAIN_STAGES[chain.name])
+    out = []
+    for s in stages:
+        if s.name in why and s.run and not study:
+            run: bool = s.run
+            if s.name == "static_clutter_removal" and chain.oob is not None:
+                run = chain.oob.static_clutter_removal
+            reason = why[s.name] if run else "clutterRemoval is off in the chain's .cfg"
+            s = dataclasses.replace(s, run=run, reason=reason)
+        out.append(s)
+    return tuple(out)
 
 
 def simulator(fidelity: str = "exact") -> FrameSimulator:

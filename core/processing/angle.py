@@ -107,6 +107,41 @@ def tdm_compensate(channels: np.ndarray, doppler_bin: np.ndarray, radar: RadarCo
     return channels * np.exp(1j * phase)
 
 
+def azimuth_power(channels: np.ndarray, radar: RadarConfig, fft_size: int = 64) -> np.ndarray:
+    """Azimuth FFT power over the azimuth row of TDM-compensated channel values.
+
+    Parameters
+    ----------
+    channels
+        ``(n_det, n_virtual)`` complex128, the TDM-MIMO Doppler phase already removed.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(n_det, fft_size)`` float64; index ``k`` (``k < N/2``, else ``k - N``) is at
+        ``u = sin(az) cos(el) = 2 k / N``.
+    """
+    x = np.asarray(channels)
+    row_ch, row_pos = azimuth_row(radar)
+    row = np.zeros((x.shape[0], fft_size), dtype=np.complex128)
+    row[:, row_pos] = x[:, row_ch]
+    # X_k = sum_p x_p exp(-j 2 pi k p / N): peaks at k = N u / 2
+    spec = np.fft.fft(row, axis=1)  # index k <-> k (k < N/2) or k - N
+    return spec.real**2 + spec.imag**2
+
+
+def elevation_sines(channels: np.ndarray, radar: RadarConfig) -> np.ndarray:
+    """``sin(el) = arg(sum x_upper conj(x_lower)) / pi`` over the elevation pairs, clipped to
+    [-1, 1]; zeros when the array has no elevated channel. ``channels``: ``(n_det, n_virtual)``,
+    TDM-compensated."""
+    x = np.asarray(channels)
+    upper, lower = elevation_pairs(radar)
+    if not upper.size:
+        return np.zeros(x.shape[0])
+    z = np.sum(x[:, upper] * np.conj(x[:, lower]), axis=1)
+    return np.clip(np.angle(z) / np.pi, -1.0, 1.0)
+
+
 def estimate_angles(
     channels: np.ndarray,
     doppler_bin: np.ndarray,
@@ -142,12 +177,7 @@ def estimate_angles(
         return np.zeros(0), np.zeros(0)
     if compensate_tdm:
         x = tdm_compensate(x, np.asarray(doppler_bin, dtype=np.float64), radar)
-    row_ch, row_pos = azimuth_row(radar)
-    row = np.zeros((n_det, fft_size), dtype=np.complex128)
-    row[:, row_pos] = x[:, row_ch]
-    # X_k = sum_p x_p exp(-j 2 pi k p / N): peaks at k = N u / 2
-    spec = np.fft.fft(row, axis=1)  # index k <-> k (k < N/2) or k - N
-    power = spec.real**2 + spec.imag**2
+    power = azimuth_power(x, radar, fft_size)
     k = np.argmax(power, axis=1)
     i = np.arange(n_det)
     delta = log_parabolic_offset(
@@ -158,10 +188,7 @@ def estimate_angles(
     u = 2.0 * (k_signed + delta) / fft_size
     el = np.zeros(n_det)
     if elevation:
-        upper, lower = elevation_pairs(radar)
-        if upper.size:
-            # sin(el) = arg(sum x_upper conj(x_lower)) / pi
-            z = np.sum(x[:, upper] * np.conj(x[:, lower]), axis=1)
-            el = np.arcsin(np.clip(np.angle(z) / np.pi, -1.0, 1.0))
+        if elevation_pairs(radar)[0].size:
+            el = np.arcsin(elevation_sines(x, radar))
     az = np.arcsin(np.clip(u / np.cos(el), -1.0, 1.0))
     return az, el

@@ -61,7 +61,7 @@ def _window_indices(size: int, n: int, g: int, cyclic: bool):
     return out
 
 
-def _side_sums(p: np.ndarray, n: int, g: int, cyclic: bool):
+def side_sums(p: np.ndarray, n: int, g: int, cyclic: bool):
     """Left/right training sums along axis 0 of ``p`` (float64) and their validity (N,)."""
     size = p.shape[0]
     l_hi, l_lo, r_hi, r_lo, ok_left, ok_right = _window_indices(size, n, g, cyclic)
@@ -134,7 +134,7 @@ class _SidedCfar:
         """
         p = np.moveaxis(np.asarray(power, dtype=np.float64), axis, 0)
         n = self.n_train
-        left, right, ok_l, ok_r = _side_sums(p, n, self.n_guard, self.cyclic)
+        left, right, ok_l, ok_r = side_sums(p, n, self.n_guard, self.cyclic)
         shape = (-1,) + (1,) * (p.ndim - 1)
         both = (ok_l & ok_r).reshape(shape)
         only_l = (ok_l & ~ok_r).reshape(shape)

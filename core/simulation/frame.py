@@ -98,6 +98,27 @@ def simulate_frame(
         Add receiver noise (switch off only for noise-free tests).
     """
     t0 = time.perf_counter()
+    cube = windowed_cube(radar, scatterers, rng, antenna=antenna, settings=settings, noise=noise)
+    if elevation is None:
+        elevation = needs_elevation(radar, scatterers)
+    t1 = time.perf_counter()
+    out = process_windowed_cube(
+        cube, radar, scatterers, settings=settings, keep_rd_map=keep_rd_map, elevation=elevation
+    )
+    return dataclasses.replace(out, synthesis_s=t1 - t0, processing_s=time.perf_counter() - t1)
+
+
+def windowed_cube(
+    radar: RadarConfig,
+    scatterers: Scatterers,
+    rng: np.random.Generator,
+    *,
+    antenna: AntennaGain,
+    settings: ProcessingSettings = DEFAULT_PROCESSING,
+    noise: bool = True,
+) -> np.ndarray:
+    """The received cube of a frame with the range window applied: what every chain starts
+    from (``[virtual channel, loop, ADC sample]`` complex64, C-contiguous)."""
     cube = synthesize_signal(radar, scatterers, antenna)
     # the range window is applied while the noise is added (one pass over the cube); the
     # transform then runs on the windowed cube
@@ -106,13 +127,7 @@ def simulate_frame(
         add_complex_noise(cube, noise_power_v2(radar), rng, window=w)
     elif settings.range_window != "rect":
         cube *= w
-    if elevation is None:
-        elevation = needs_elevation(radar, scatterers)
-    t1 = time.perf_counter()
-    out = process_windowed_cube(
-        cube, radar, scatterers, settings=settings, keep_rd_map=keep_rd_map, elevation=elevation
-    )
-    return dataclasses.replace(out, synthesis_s=t1 - t0, processing_s=time.perf_counter() - t1)
+    return cube
 
 
 def process_windowed_cube(

@@ -1,0 +1,30 @@
+"""The calibration statistics of the chains' point clouds (the estimator on hand-made frames)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from core.benchmarks.chain_calibration import frame_stats
+
+
+def test_frame_stats_person_spread_and_zero_doppler_by_band():
+    rng = np.random.default_rng(0)
+    frames = []
+    for _ in range(50):
+        # a person of 6 moving points around (1, 3) with sigma 0.1 m, 0.2 m/s; 4 static points
+        # at 5 m; one moving ghost 2.5 m away (outside the 1 m disc)
+        x = np.concatenate([1 + 0.1 * rng.standard_normal(6), [0, 1, -1, 2], [1.0]])
+        y = np.concatenate([3 + 0.1 * rng.standard_normal(6), [5, 5, 5, 4.6], [5.5]])
+        z = np.concatenate([0.05 * rng.standard_normal(6), np.zeros(4), [0.0]])
+        v = np.concatenate([-1 + 0.2 * rng.standard_normal(6), np.zeros(4), [-1.0]])
+        frames.append({"x": x, "y": y, "z": z, "v": v, "snr": np.full(11, 12.0)})
+    s = frame_stats(frames)
+    assert s["person_points_per_frame"]["median"] == 6
+    assert s["points_per_frame"]["median"] == 11
+    # the standard deviation of 6 draws of sigma 0.1 has its median a little below 0.1
+    assert s["spread_x_m"]["median"] == pytest.approx(0.09, abs=0.02)
+    assert s["doppler_spread_mps"]["median"] == pytest.approx(0.18, abs=0.04)
+    assert s["person_snr_db"]["median"] == 12.0
+    zero = s["zero_doppler_fraction"]
+    assert zero["2-4 m"] == 0.0 and zero["4-6 m"] == pytest.approx(4 / 5)
