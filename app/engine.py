@@ -24,19 +24,30 @@ from typing import Any
 import numpy as np
 
 from app.data import FrameData, ParamSpec, TrackFrame, TrackingResult
-from core.config import RadarConfig
+from core.config import (
+    PAPER_CLUTTER_DENSITY_PER_M2,
+    PAPER_MAX_AZIMUTH_DEG,
+    PAPER_MAX_RANGE_M,
+    PAPER_MIN_RANGE_M,
+    RadarConfig,
+)
 from core.errors import InputError
 
 ROOT = Path(__file__).resolve().parents[1]
 PAPER_SCENE_FILE = ROOT / "resources" / "scenes" / "paper_class_c.json"
 
-#: The paper scene (SPEC §6 example, one person of class c): used when the resource is missing.
+#: The paper scene (SPEC §6 example, one person of class c; the area and λ from
+#: :mod:`core.config`): used when the resource is missing.
 PAPER_SCENE_DOCUMENT = {
     "schema_version": 1,
     "radar": "paper",
     "seed": 7,
-    "clutter_density_per_m2": 0.02,
-    "aoi": {"min_range_m": 0.5, "max_range_m": 10.0, "max_azimuth_deg": 60.0},
+    "clutter_density_per_m2": PAPER_CLUTTER_DENSITY_PER_M2,
+    "aoi": {
+        "min_range_m": PAPER_MIN_RANGE_M,
+        "max_range_m": PAPER_MAX_RANGE_M,
+        "max_azimuth_deg": PAPER_MAX_AZIMUTH_DEG,
+    },
     "static_reflectors": [],
     "persons": [{"trajectory": {"class": "c", "seed": 3}}],
 }
@@ -213,11 +224,25 @@ def default_extra() -> dict:
 
 def make_params(model: str, values: dict[str, float], extra: dict | None = None):
     """Flat values + fixed settings → core ``TrackerParams`` (validated; InputError if bad)."""
-    from core.optimization import tracker_params_dict
+    from core.tracking.space import tracker_params_dict
 
-    d = tracker_params_dict(values, model)
-    d.update(extra or {})
-    return _tracker_params_class().from_dict(d)
+    return _tracker_params_class().from_dict(
+        {**tracker_params_dict(values, model), **(extra or {})}
+    )
+
+
+def load_params(path: str | os.PathLike) -> tuple[str, dict[str, float], dict]:
+    """A tracker parameter file read by core (:meth:`TrackerParams.load`: errors name the file)
+    as the tracker panel holds it: the model, the flat search-space values and the
+    non-optimised settings the panel edits (:data:`EXTRA_FIELDS`)."""
+    from core.tracking.space import flat_params
+
+    d = _tracker_params_class().load(path).to_dict()
+    try:
+        values = flat_params(d)
+    except InputError as exc:
+        raise InputError(exc.message, str(path)) from None
+    return d["model"], values, {k: d[k] for k in EXTRA_FIELDS}
 
 
 # ---- simulation -------------------------------------------------------------------------------
@@ -303,17 +328,6 @@ def _people(frames: Sequence[FrameData], track_frames) -> Any:
     return people_run(truth, ConfirmedTracks.from_frames(track_frames))
 
 
-def _ospa_per_frame(frames: Sequence[FrameData], confirmed_xy: Sequence[np.ndarray]) -> np.ndarray:
-    """OSPA (c = 1 m, p = 2) between confirmed tracks and the persons present, per frame."""
-    from core.evaluation import ospa
-
-    out = np.zeros(len(frames))
-    for k, (f, xy) in enumerate(zip(frames, confirmed_xy)):
-        truth = f.truth_xy_m[np.isfinite(f.truth_xy_m).all(axis=1)]
-        out[k] = ospa(xy, truth)
-    return out
-
-
 #: set once the compiled tracker kernel is loaded or compiled (:func:`warm_up_tracker`)
 TRACKER_COMPILED = threading.Event()
 
@@ -351,6 +365,7 @@ def track(
     scenes). ``engine="numpy"``: the readable tracker (the GUI's choice until
     :data:`TRACKER_COMPILED` is set, so that a cold start shows tracks while numba compiles).
     """
+    from core.evaluation import ospa_per_frame, running_trajectory_loss
     from core.tracking import run_tracker
 
     t0 = time.perf_counter()
@@ -388,7 +403,7 @@ def track(
     has = np.asarray(res.has_estimate, dtype=bool)
     est = np.where(has[:, None], np.asarray(res.estimate_xy, dtype=float), np.nan)
     truth0 = _truth0(frames)
-    loss, rmse = running_loss(est, has, truth0)
+    loss, rmse = running_trajectory_loss(est, has, truth0)
     return TrackingResult(
         people=_people(frames, res.frames),
         frames=tuple(tfs),
@@ -396,7 +411,7 @@ def track(
         truth_xy_m=truth0,
         running_loss=loss,
         running_rmse_m=rmse,
-        ospa_m=_ospa_per_frame(frames, conf_list),
+        ospa_m=ospa_per_frame(conf_list, [f.truth_xy_m for f in frames]),
         psi_t_s=psi_t,
         psi_value=psi_v,
         psi_confirmed_t_s=psi_t,
@@ -437,30 +452,6 @@ def track_frame(ft) -> TrackFrame:
         ),
         nis=np.full(n, np.nan) if nis is None else np.asarray(nis, dtype=float),
     )
-
-
-def running_loss(
-    estimate_xy: np.ndarray, has_estimate: np.ndarray, truth_xy: np.ndarray
-) -> tuple[np.ndarray, np.ndarray]:
-    """Eq. (13) and the RMSE over frames ``0..k`` for every k.
-
-    Returns
-    -------
-    loss
-        ``(F,)`` L_k = MSE_k / N_c,k in m² (1.0 m² while N_c,k = 0, as SPEC §5 decides).
-    rmse
-        ``(F,)`` sqrt(MSE_k) in m (NaN while N_c,k = 0).
-    """
-    has = np.asarray(has_estimate, dtype=bool) & np.isfinite(truth_xy).all(axis=1)
-    e = np.where(has[:, None], np.nan_to_num(estimate_xy) - np.nan_to_num(truth_xy), 0.0)
-    # MSE_k = (1/N_c,k) Σ_{j≤k} |x̂_j − x_j|²  over frames with an estimate
-    n_c = np.cumsum(has)
-    sse = np.cumsum(np.sum(e * e, axis=1))
-    with np.errstate(invalid="ignore", divide="ignore"):
-        mse = np.where(n_c > 0, sse / np.maximum(n_c, 1), np.nan)
-        # L_k = MSE_k / N_c,k
-        loss = np.where(n_c > 0, mse / np.maximum(n_c, 1), 1.0)
-    return loss, np.sqrt(mse)
 
 
 # ---- radar files --------------------------------------------------------------------------------
@@ -595,7 +586,8 @@ def failure_reasons(summaries, n_max: int = 5) -> tuple[tuple[str, int], ...]:
 
 
 def enqueue_trial(form, values: dict[str, float], model: str) -> None:
-    from core.optimization import enqueue_params, tracker_params_dict
+    from core.optimization import enqueue_params
+    from core.tracking.space import tracker_params_dict
 
     enqueue_params(
         storage_url(form.storage), form.effective_name, tracker_params_dict(values, model)
@@ -660,6 +652,7 @@ class Engine:
     default_values = staticmethod(default_values)
     default_extra = staticmethod(default_extra)
     make_params = staticmethod(make_params)
+    load_params = staticmethod(load_params)
     simulate = staticmethod(simulate)
     fidelity_levels = staticmethod(fidelity_levels)
     processing_settings = staticmethod(processing_settings)

@@ -385,18 +385,8 @@ class MainWindow(QtWidgets.QMainWindow):
 
     def load_params(self, path: str | Path) -> bool:
         try:
-            from core.files import read_json
-
-            data = read_json(path, what="parameter file")
-            from core.optimization import flat_params
-
-            model = data.get("model", "cv") if isinstance(data, dict) else "cv"
-            params = self.engine.make_params(model, self.engine.default_values(model), {})
-            full = {**params.to_dict(), **data}
-            tp = type(params).from_dict(full, source=str(path))
-            d = tp.to_dict()
-            self.params_model.set_values(flat_params(d), model=d["model"])
-            self.params_model.set_extra(**{k: d[k] for k in self.engine.default_extra()})
+            model, values, extra = self.engine.load_params(path)
+            self.params_model.set_values(values, model=model, extra=extra)
             return True
         except (OSError, json.JSONDecodeError) as exc:
             self.show_error(f"{path}: {exc}")

@@ -9,6 +9,7 @@ from PySide6 import QtCore, QtGui, QtWidgets
 
 from app.models import SceneModel
 from app.person_colours import person_colour
+from core.config import PAPER_CLUTTER_DENSITY_PER_M2
 from core.errors import InputError
 from core.limits import MAX_PERSONS, PERSON_HEIGHT_RANGE_M
 from core.scene.scene import DEFAULT_PERSON_MODEL, PERSON_MODELS, person_model_kind
@@ -434,7 +435,9 @@ class ScenePanel(QtWidgets.QWidget):
             w.blockSignals(True)
         try:
             self.seed.setValue(int(doc.get("seed", 0)))
-            self.clutter.setValue(float(doc.get("clutter_density_per_m2", 0.02)))
+            self.clutter.setValue(
+                float(doc.get("clutter_density_per_m2", PAPER_CLUTTER_DENSITY_PER_M2))
+            )
             aoi = {**self.engine.default_aoi(), **doc.get("aoi", {})}
             self.min_range.setValue(aoi["min_range_m"])
             self.max_range.setValue(aoi["max_range_m"])

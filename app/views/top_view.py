@@ -17,6 +17,7 @@ from app.data import FrameData, TrackFrame, TrackingResult
 from app.geometry import aoi_polyline, ellipse_polyline, trails_polyline
 from app.person_colours import person_colour
 from app.views.axis_cache import cache_axes
+from core.config import PAPER_MAX_AZIMUTH_DEG, PAPER_MAX_RANGE_M, PAPER_MIN_RANGE_M
 from core.limits import MAX_PERSONS
 
 SNR_MIN_DB = 10.0
@@ -137,7 +138,7 @@ class TopView(pg.PlotWidget):
         self.n_draws = 0
         self.last_n_points = 0
         self.last_n_tracks = 0
-        self.set_aoi(0.5, 10.0, 60.0)
+        self.set_aoi(PAPER_MIN_RANGE_M, PAPER_MAX_RANGE_M, PAPER_MAX_AZIMUTH_DEG)
         cache_axes(self.getPlotItem())
         # once the user pans or zooms, the view stays where they put it
         self.getPlotItem().vb.sigRangeChangedManually.connect(self._stop_auto_fit)

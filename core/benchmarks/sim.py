@@ -29,14 +29,16 @@ import time
 
 import numpy as np
 
-from core.config import SPEED_OF_LIGHT_MPS, ProcessingSettings, RadarConfig
-
-AOI_MIN_M, AOI_MAX_M, AOI_AZ_DEG = 0.5, 10.0, 60.0
-CLUTTER_DENSITY_PER_M2 = 0.02
-
-
-def aoi_area_m2() -> float:
-    return np.radians(2 * AOI_AZ_DEG) / 2 * (AOI_MAX_M**2 - AOI_MIN_M**2)
+from core.config import (
+    PAPER_AOI_AREA_M2,
+    PAPER_CLUTTER_DENSITY_PER_M2,
+    PAPER_MAX_AZIMUTH_DEG,
+    PAPER_MAX_RANGE_M,
+    PAPER_MIN_RANGE_M,
+    SPEED_OF_LIGHT_MPS,
+    ProcessingSettings,
+    RadarConfig,
+)
 
 
 def paper_scene_frames(radar: RadarConfig, n_frames: int, rng: np.random.Generator, antenna):
@@ -50,10 +52,10 @@ def paper_scene_frames(radar: RadarConfig, n_frames: int, rng: np.random.Generat
     vres = radar.velocity_resolution_mps
     for f in range(n_frames):
         p = pos + vel * radar.frame_period_s * (f % 100)
-        n_c = rng.poisson(CLUTTER_DENSITY_PER_M2 * aoi_area_m2())
+        n_c = rng.poisson(PAPER_CLUTTER_DENSITY_PER_M2 * PAPER_AOI_AREA_M2)
         # uniform in the AOI sector: r^2 uniform, az uniform
-        r = np.sqrt(rng.uniform(AOI_MIN_M**2, AOI_MAX_M**2, n_c))
-        az = np.radians(rng.uniform(-AOI_AZ_DEG, AOI_AZ_DEG, n_c))
+        r = np.sqrt(rng.uniform(PAPER_MIN_RANGE_M**2, PAPER_MAX_RANGE_M**2, n_c))
+        az = np.radians(rng.uniform(-PAPER_MAX_AZIMUTH_DEG, PAPER_MAX_AZIMUTH_DEG, n_c))
         u = np.column_stack((np.sin(az), np.cos(az), np.zeros(n_c)))
         # |v_r| uniform over [2 bins, v_max], random sign
         vr = rng.uniform(2 * vres, radar.max_velocity_mps, n_c) * rng.choice([-1.0, 1.0], n_c)
@@ -274,7 +276,7 @@ def walking_case(quick: bool = False) -> dict:
             {
                 "schema_version": 1,
                 "seed": 11,
-                "clutter_density_per_m2": CLUTTER_DENSITY_PER_M2,
+                "clutter_density_per_m2": PAPER_CLUTTER_DENSITY_PER_M2,
                 "persons": [
                     {
                         "model": model,

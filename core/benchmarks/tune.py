@@ -41,7 +41,8 @@ def _reference(dataset_path: str, n: int) -> dict[str, float]:
     """The bare objective in this process: a full (unpruned) trial's work, no Optuna."""
     from core.dataset import Dataset
     from core.optimization.objective import TrackerLosses, evaluate
-    from core.optimization.space import search_space, tracker_params_dict
+    from core.optimization.space import search_space
+    from core.tracking.space import tracker_params_dict
 
     ds = Dataset.load(dataset_path)
     losses = TrackerLosses(ds, capped=False)  # the work of a default (paper-loss) trial

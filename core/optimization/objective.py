@@ -29,7 +29,8 @@ import numpy as np
 from core.errors import InputError
 from core.evaluation.loss import NO_CONFIRMATION_LOSS
 from core.evaluation.robust import OBJECTIVES, aggregate, check_objective
-from core.optimization.space import P0_NAMES, check_model, search_space, tracker_params_dict
+from core.optimization.space import P0_NAMES, check_model, search_space
+from core.tracking.space import tracker_params_dict
 
 
 class TrajectoryScore(NamedTuple):
@@ -332,5 +333,4 @@ __all__ = [
     "make_losses",
     "round_robin_order",
     "uses_capped",
-    "tracker_params_dict",
 ]

@@ -44,7 +44,7 @@ import numpy as np
 from core.errors import InputError
 from core.evaluation.robust import DEFAULT_OBJECTIVE, check_objective
 from core.optimization.objective import evaluate, make_losses, uses_capped
-from core.optimization.space import check_model, suggest_params, tracker_params_dict
+from core.optimization.space import check_model, suggest_params
 from core.optimization.storage import (
     DEFAULT_STORAGE,
     absolute_url,
@@ -53,6 +53,7 @@ from core.optimization.storage import (
     open_storage,
     redact,
 )
+from core.tracking.space import tracker_params_dict
 
 SAMPLERS = ("tpe", "random", "cmaes", "gp")
 #: samplers that need a package Optuna does not install itself: sampler -> module

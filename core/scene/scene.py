@@ -13,7 +13,7 @@ from typing import Any
 
 import numpy as np
 
-from core.config import PAPER_RADAR, RadarConfig
+from core.config import PAPER_CLUTTER_DENSITY_PER_M2, PAPER_RADAR, RadarConfig
 from core.errors import InputError
 from core.files import check_text_field, parse_json, read_json, write_text_atomic
 from core.formats.ti_cfg import read_ti_cfg
@@ -46,7 +46,6 @@ from core.scene.walking import (
 )
 
 SCHEMA_VERSION = 1
-PAPER_CLUTTER_DENSITY_PER_M2 = 0.02
 SCENE_KEYS = (
     "schema_version",
     "radar",
@@ -469,7 +468,13 @@ def _parse_scene(data: Any, base_dir: Path) -> Scene:
     radar_spec = data.get("radar", "paper")
     radar = _parse_radar(radar_spec, base_dir)
     seed = _integer(data.get("seed", 0), "seed")
-    density = _number(data.get("clutter_density_per_m2", 0.0), "clutter_density_per_m2", 0, 1)
+    # a file without a clutter density has the paper's, as Scene() and the editor do
+    density = _number(
+        data.get("clutter_density_per_m2", PAPER_CLUTTER_DENSITY_PER_M2),
+        "clutter_density_per_m2",
+        0,
+        1,
+    )
     aoi_d = _check_keys(
         data.get("aoi", {}), ("min_range_m", "max_range_m", "max_azimuth_deg"), "aoi"
     )

@@ -54,9 +54,8 @@ def test_study_data_set_of_a_two_person_scene_gives_finite_losses(tmp_path) -> N
     import numpy as np
 
     from core.dataset import Dataset
-    from core.optimization import tracker_params_dict
     from core.optimization.objective import TrackerLosses
-    from core.tracking.space import defaults
+    from core.tracking.space import defaults, tracker_params_dict
 
     path = engine.ROOT / "resources" / "scenes" / "two_persons.json"
     scene = engine.scene_from_document(json.loads(path.read_text()), path.parent)

@@ -16,10 +16,10 @@ from core.optimization import (
     prepare_study,
     run_worker,
     study_progress,
-    tracker_params_dict,
 )
 from core.optimization.space import search_space
 from core.optimization.study import trial_seed
+from core.tracking.space import tracker_params_dict
 
 
 def settings(tmp_path: Path, **kw) -> StudySettings:
