@@ -38,8 +38,19 @@ from app.workers import SimulationController, TrackingController, freeze_heap
 from core.config import PAPER_RADAR
 from core.errors import InputError
 
+#: Settings stored as JSON text (the tracker panel's state).
+JSON_SETTINGS = ("tracker/values", "tracker/extra")
 DRAW_INTERVAL_MS = 15  # GUI draw timer: at most ~66 redraws per second, stale frames dropped
 RETRACK_EVERY_N_FRAMES = 20  # while the simulation fills the cache
+
+
+def stored_json(settings: QtCore.QSettings, key: str):
+    """A setting stored as JSON text, parsed by core's strict reader (nesting limited):
+    :class:`InputError` naming the settings file and the key; ``{}`` when it is not stored."""
+    from core.files import parse_json
+
+    text = settings.value(key, "", type=str) or "{}"
+    return parse_json(text, f"{settings.fileName()} [{key}]", what="setting")
 
 
 class MainWindow(QtWidgets.QMainWindow):
@@ -641,8 +652,7 @@ class MainWindow(QtWidgets.QMainWindow):
         self._sync_view_options()
         try:
             model = s.value("tracker/model", "cv", type=str)
-            values = json.loads(s.value("tracker/values", "{}", type=str) or "{}")
-            extra = json.loads(s.value("tracker/extra", "{}", type=str) or "{}")
+            values, extra = (stored_json(s, key) for key in JSON_SETTINGS)
             if values:
                 self.params_model.set_values(values, model=model)
             if extra:

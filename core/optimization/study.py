@@ -240,12 +240,21 @@ def make_pruner(kind: str) -> Any:
 
 # ---- worker identity and crash recovery -------------------------------------------------------
 def _start_ticks(pid: int) -> str | None:
-    """Start time of a process in clock ticks (Linux ``/proc``), to tell a reused pid apart."""
+    """Start time of a running process in clock ticks (Linux ``/proc``), to tell a reused pid
+    apart; None when no such process runs.
+
+    A zombie (state ``Z``, or ``X`` while it is removed) has ended: it keeps its ``/proc``
+    entry only until its parent reaps it (``tune`` polls its workers every 0.5 s), and another
+    worker finishing the study in that window must see it dead to free its trial's slot.
+    """
     try:
         stat = Path(f"/proc/{pid}/stat").read_text()
     except OSError:
         return None
-    return stat.rsplit(")", 1)[1].split()[19]
+    fields = stat.rsplit(")", 1)[1].split()  # state, ppid, ... (after the command name)
+    if fields[0] in ("Z", "X"):
+        return None
+    return fields[19]
 
 
 def worker_id() -> str:

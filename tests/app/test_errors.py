@@ -181,6 +181,20 @@ def _gui(*args: str, tmp_path: Path) -> subprocess.CompletedProcess:
     )  # fmt: skip
 
 
+def test_gui_with_a_settings_value_nested_100000_deep_is_one_line_and_exit_2(tmp_path) -> None:
+    path = tmp_path / "s.ini"
+    text = "[tracker]\nmodel=cv\nvalues=" + "[" * 100_000 + "]" * 100_000 + "\n"
+    path.write_text(text)
+    out = _gui("--quit-after", "0", tmp_path=tmp_path)
+    assert out.returncode == 2, out.stderr
+    assert out.stderr.startswith("radartune gui: error: ")
+    line = out.stderr.rstrip("\n")
+    assert one_line_naming(line, str(path)), out.stderr
+    assert "tracker/values" in line and "nested deeper" in line
+    assert "Traceback" not in out.stderr and out.stdout == ""
+    assert path.read_text() == text  # no window: nothing written back
+
+
 @pytest.mark.parametrize("name", ["binary.json", "deep.json", "truncated.json"])
 def test_gui_with_a_bad_scene_is_one_line_and_exit_2(tmp_path, name) -> None:
     bad = tmp_path / name

@@ -252,6 +252,19 @@ def test_scene_work_bounded(capsys, tmp_path, change, needle) -> None:
     assert not (tmp_path / "o.npz").exists()
 
 
+def test_scene_with_a_person_1e300_m_away(capsys, tmp_path) -> None:
+    """Before the fix: accepted and simulated with an overflow warning."""
+    far = {"trajectory": {"initial_position_m": [1e300, 5.0], "initial_velocity_mps": [0.0, 0.0],
+                          "acceleration_mps2": [0.0, 0.0], "frames": 5}}  # fmt: skip
+    path = tmp_path / "s.json"
+    path.write_text(json.dumps({**SCENE, "persons": [far]}))
+    code, _, err = run_cli(
+        capsys, "simulate", "--scene", str(path), "--out", str(tmp_path / "o.npz")
+    )
+    assert_one_line(code, err, "s.json", "persons[0].trajectory.initial_position_m[0]", "1e+300")
+    assert not (tmp_path / "o.npz").exists()
+
+
 # ---- command line ------------------------------------------------------------------------------
 
 
