@@ -117,7 +117,7 @@ class MainWindow(QtWidgets.QMainWindow):
         self._dock("Radar", self.radar_panel, QtCore.Qt.LeftDockWidgetArea)
         self._dock("Tracker", self.tracker_panel, QtCore.Qt.RightDockWidgetArea)
         self._dock("Study", self.study_panel, QtCore.Qt.RightDockWidgetArea)
-        # issue 17: fidelity level, processing settings and timing (app/panels/processing_panel)
+        # fidelity level, processing settings and timing (app/panels/processing_panel)
         self.processing_panel = ProcessingPanel(self.engine.fidelity_levels())
         self._dock("Processing", self.processing_panel, QtCore.Qt.LeftDockWidgetArea)
         self.tabifyDockWidget(self.docks["Radar"], self.docks["Processing"])
@@ -145,7 +145,7 @@ class MainWindow(QtWidgets.QMainWindow):
         self._build_view_bar()
         self._build_menus()
         self._build_status()
-        # ---- radar views, track table, record and export (issue 17; app/views_control.py,
+        # ---- radar views, track table, record and export (app/views_control.py,
         # app/record.py): docks and File-menu entries of their own, drawn from redraw()
         from app.record import RecordController
         from app.views_control import ViewsController

@@ -499,7 +499,7 @@ def _time_dataset(quick: bool) -> dict | None:
 
     The point person at the exact level first (the top-level figures, as before), then both
     person models (``point``, ``walking``) at the ``exact`` and ``fast`` levels, each once in
-    this process (wall clock and process CPU time): issue 13's "data-set generation time for the
+    this process (wall clock and process CPU time): the "data-set generation time for the
     35 trajectories reported for both models". ``quick``: 2 trajectories.
     """
     try:

@@ -20,7 +20,7 @@ loop got just before it (``cpu_share``; with the kernel's per-session scheduling
 one command share one session's slice) are recorded beside it, and CPU time per trial is the
 figure that load disturbs least. The point-person data set's SQLite
 2-job study and references are measured too, for comparison with earlier figures.
-Goal (issue 15): at least 20 trials/s with 2 jobs on SQLite.
+Goal: at least 20 trials/s with 2 jobs on SQLite.
 """
 
 from __future__ import annotations

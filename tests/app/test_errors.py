@@ -19,7 +19,7 @@ from app.errors import install_excepthooks
 
 ROOT = Path(__file__).resolve().parents[2]
 
-#: Files that are not scenes, as a new user might pass them (issue 18's kinds).
+#: Files that are not scenes, as a new user might pass them (the kinds the input fuzzing found).
 BAD_SCENES = {
     "binary.json": b"\x89PNG\r\n\x1a\n\x00\x00\xff\xfe\x00binary",
     "latin1.json": b'{"schema_version": 1, "name": "caf\xe9", "persons": []}',

@@ -41,7 +41,7 @@ def test_persons() -> None:
         InputError, match=f"persons lists 9, more than the limit {limits.MAX_PERSONS}"
     ):
         scene(persons=[profile(2)] * (limits.MAX_PERSONS + 1))
-    # and at least one: a scene of nobody is one line too (issue 14: 1–8 persons)
+    # and at least one: a scene of nobody is one line too (1–8 persons)
     with pytest.raises(
         InputError, match=f"persons lists none; a scene holds 1 to {limits.MAX_PERSONS}"
     ):

@@ -1,7 +1,7 @@
 """Every bad input the CLI reads gets one line on stderr, exit code 2, and nothing written.
 
 One test per kind of input that ended in a traceback, a huge allocation, a run of minutes or a
-``nan`` before (issue 18). The CLI runs in-process (``core.cli.main``)."""
+``nan`` before. The CLI runs in-process (``core.cli.main``)."""
 
 from __future__ import annotations
 
