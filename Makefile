@@ -36,7 +36,7 @@ format: $(STAMP)
 test: lint contracts typecheck
 	QT_QPA_PLATFORM=offscreen $(BIN)/python -m pytest
 
-# the app in the real window: Qt's xcb platform under Xvfb, on the two screens of issue 17 at
+# the app in the real window: Qt's xcb platform under Xvfb, on the two screens the layout was checked on at
 # 100 % and 150 % (tests marked xcb; offscreen they are skipped)
 XCB_SCREENS ?= 1366x768 1920x1080
 test-xcb: $(STAMP)

@@ -92,6 +92,24 @@ def debian_package(soname: str) -> str:
     return f"{name}-{version}" if name[-1].isdigit() else f"{name}{version}"
 
 
+def settings_error(path: str) -> str | None:
+    """Why a ``--settings`` file cannot be used, as one line naming it (and the key); None when
+    it can. Its JSON-valued settings are read as the window reads them (before any window
+    exists, so nothing is written back), so that a bad value is exit 2, never a traceback."""
+    from PySide6 import QtCore
+
+    from app.window import JSON_SETTINGS, stored_json
+    from core.errors import InputError
+
+    settings = QtCore.QSettings(path, QtCore.QSettings.IniFormat)
+    for key in JSON_SETTINGS:
+        try:
+            stored_json(settings, key)
+        except InputError as exc:
+            return str(exc)
+    return None
+
+
 def scene_error(path: str) -> str | None:
     """Why the scene file cannot be opened, as one line naming it; None when it can.
 
@@ -129,6 +147,11 @@ def run(
         except Exception as exc:
             log_exception(f"cannot replay {replay}", exc)
             print(f"radartune gui: error: {one_line(exc, replay)}", file=sys.stderr)
+            return 2
+    if settings_file:
+        problem = settings_error(settings_file)
+        if problem is not None:
+            print(f"radartune gui: error: {problem}", file=sys.stderr)
             return 2
     if scene is not None:
         problem = scene_error(scene)

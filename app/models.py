@@ -168,7 +168,8 @@ class SceneModel(QtCore.QObject):
 class TrackerParamsModel(QtCore.QObject):
     """Tracker parameters as flat search-space values (``q_coeff``, ``p0_00`` …) plus the model.
 
-    ``changed`` fires on every edit; :meth:`params` builds the core ``TrackerParams``.
+    ``changed`` fires on every edit. Every edit builds (and so validates) the core
+    ``TrackerParams`` once; :meth:`params` returns that object.
     """
 
     changed = QtCore.Signal()
@@ -179,6 +180,7 @@ class TrackerParamsModel(QtCore.QObject):
         self._model = "cv"
         self._values: dict[str, float] = engine.default_values("cv")
         self._extra: dict = {}
+        self._params = engine.make_params(self._model, self._values, self._extra)
 
     @property
     def model(self) -> str:
@@ -198,38 +200,36 @@ class TrackerParamsModel(QtCore.QObject):
             return
         defaults = self._engine.default_values(model)
         # keep what both models share, take defaults for the rest (p0_44, p0_55 for CA)
-        self._values = {k: self._values.get(k, v) for k, v in defaults.items()}
-        self._model = model
-        self.changed.emit()
+        self._set(model, {k: self._values.get(k, v) for k, v in defaults.items()}, self._extra)
 
     def set_value(self, name: str, value: float) -> None:
         if name not in self._values:
             raise InputError(f"unknown tracker parameter {name!r}", name)
         value = float(value)
         if value != self._values[name]:
-            trial = dict(self._values)
-            trial[name] = value
-            self._engine.make_params(self._model, trial, self._extra)  # validates
-            self._values = trial
-            self.changed.emit()
+            self._set(self._model, {**self._values, name: value}, self._extra)
 
-    def set_values(self, values: dict[str, float], model: str | None = None) -> None:
+    def set_values(
+        self, values: dict[str, float], model: str | None = None, extra: dict | None = None
+    ) -> None:
+        """Set the flat values (missing ones take the table's defaults), the model and (merged
+        into the current ones) the non-optimised settings, in one edit."""
         model = model or self._model
         full = self._engine.default_values(model)
         unknown = sorted(set(values) - set(full))
         if unknown:
             raise InputError(f"unknown tracker parameter(s) {unknown}", "tracker parameters")
         full.update({k: float(v) for k, v in values.items()})
-        self._engine.make_params(model, full, self._extra)
-        self._model = model
-        self._values = full
-        self.changed.emit()
+        self._set(model, full, self._extra if extra is None else {**self._extra, **extra})
 
     def set_extra(self, **extra) -> None:
         """Non-optimised settings (thresholds, clutter density)."""
-        new = {**self._extra, **extra}
-        self._engine.make_params(self._model, self._values, new)
-        self._extra = new
+        self._set(self._model, self._values, {**self._extra, **extra})
+
+    def _set(self, model: str, values: dict[str, float], extra: dict) -> None:
+        """Build the ``TrackerParams`` (InputError, nothing changed, if invalid), then take it."""
+        params = self._engine.make_params(model, values, extra)
+        self._model, self._values, self._extra, self._params = model, values, extra, params
         self.changed.emit()
 
     @property
@@ -241,11 +241,11 @@ class TrackerParamsModel(QtCore.QObject):
         return {**self._engine.default_extra(), **self._extra}
 
     def reset(self) -> None:
-        self._values = self._engine.default_values(self._model)
-        self.changed.emit()
+        self._set(self._model, self._engine.default_values(self._model), self._extra)
 
     def params(self):
-        return self._engine.make_params(self._model, self._values, self._extra)
+        """The core ``TrackerParams`` of the current values (built at the last edit)."""
+        return self._params
 
     def key(self) -> str:
         return json.dumps([self._model, sorted(self._values.items()), sorted(self._extra.items())])

@@ -38,8 +38,19 @@ from app.workers import SimulationController, TrackingController, freeze_heap
 from core.config import PAPER_RADAR
 from core.errors import InputError
 
+#: Settings stored as JSON text (the tracker panel's state).
+JSON_SETTINGS = ("tracker/values", "tracker/extra")
 DRAW_INTERVAL_MS = 15  # GUI draw timer: at most ~66 redraws per second, stale frames dropped
 RETRACK_EVERY_N_FRAMES = 20  # while the simulation fills the cache
+
+
+def stored_json(settings: QtCore.QSettings, key: str):
+    """A setting stored as JSON text, parsed by core's strict reader (nesting limited):
+    :class:`InputError` naming the settings file and the key; ``{}`` when it is not stored."""
+    from core.files import parse_json
+
+    text = settings.value(key, "", type=str) or "{}"
+    return parse_json(text, f"{settings.fileName()} [{key}]", what="setting")
 
 
 class MainWindow(QtWidgets.QMainWindow):
@@ -106,7 +117,7 @@ class MainWindow(QtWidgets.QMainWindow):
         self._dock("Radar", self.radar_panel, QtCore.Qt.LeftDockWidgetArea)
         self._dock("Tracker", self.tracker_panel, QtCore.Qt.RightDockWidgetArea)
         self._dock("Study", self.study_panel, QtCore.Qt.RightDockWidgetArea)
-        # issue 17: fidelity level, processing settings and timing (app/panels/processing_panel)
+        # fidelity level, processing settings and timing (app/panels/processing_panel)
         self.processing_panel = ProcessingPanel(self.engine.fidelity_levels())
         self._dock("Processing", self.processing_panel, QtCore.Qt.LeftDockWidgetArea)
         self.tabifyDockWidget(self.docks["Radar"], self.docks["Processing"])
@@ -134,7 +145,7 @@ class MainWindow(QtWidgets.QMainWindow):
         self._build_view_bar()
         self._build_menus()
         self._build_status()
-        # ---- radar views, track table, record and export (issue 17; app/views_control.py,
+        # ---- radar views, track table, record and export (app/views_control.py,
         # app/record.py): docks and File-menu entries of their own, drawn from redraw()
         from app.record import RecordController
         from app.views_control import ViewsController
@@ -395,18 +406,8 @@ class MainWindow(QtWidgets.QMainWindow):
 
     def load_params(self, path: str | Path) -> bool:
         try:
-            from core.files import read_json
-
-            data = read_json(path, what="parameter file")
-            from core.optimization import flat_params
-
-            model = data.get("model", "cv") if isinstance(data, dict) else "cv"
-            params = self.engine.make_params(model, self.engine.default_values(model), {})
-            full = {**params.to_dict(), **data}
-            tp = type(params).from_dict(full, source=str(path))
-            d = tp.to_dict()
-            self.params_model.set_values(flat_params(d), model=d["model"])
-            self.params_model.set_extra(**{k: d[k] for k in self.engine.default_extra()})
+            model, values, extra = self.engine.load_params(path)
+            self.params_model.set_values(values, model=model, extra=extra)
             return True
         except (OSError, json.JSONDecodeError) as exc:
             self.show_error(f"{path}: {exc}")
@@ -661,8 +662,7 @@ class MainWindow(QtWidgets.QMainWindow):
         self._sync_view_options()
         try:
             model = s.value("tracker/model", "cv", type=str)
-            values = json.loads(s.value("tracker/values", "{}", type=str) or "{}")
-            extra = json.loads(s.value("tracker/extra", "{}", type=str) or "{}")
+            values, extra = (stored_json(s, key) for key in JSON_SETTINGS)
             if values:
                 self.params_model.set_values(values, model=model)
             if extra:

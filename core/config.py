@@ -211,6 +211,32 @@ class RadarConfig:
 PAPER_RADAR = RadarConfig()
 
 
+# ---- the paper's scene --------------------------------------------------------------------------
+# The one statement of the paper's scene (SPEC §2); the scene's AOI defaults, the synthetic
+# tracker scene, the benchmarks and the app all derive from it.
+
+#: Area of interest: ``PAPER_MIN_RANGE_M <= r <= PAPER_MAX_RANGE_M`` and
+#: ``|az| <= PAPER_MAX_AZIMUTH_DEG`` (radar at the origin, boresight +y, ``az = atan2(x, y)``).
+PAPER_MIN_RANGE_M = 0.5
+PAPER_MAX_RANGE_M = 10.0
+PAPER_MAX_AZIMUTH_DEG = 60.0
+#: Clutter density λ in m⁻²: Poisson clutter points per m² of the area of interest, every frame.
+#: Also the value a scene file without ``clutter_density_per_m2`` takes.
+PAPER_CLUTTER_DENSITY_PER_M2 = 0.02
+
+
+def sector_area_m2(min_range_m: float, max_range_m: float, max_azimuth_deg: float) -> float:
+    """Area of the annular sector ``min_range_m <= r <= max_range_m``, ``|az| <= max_azimuth_deg``
+    in m²: ``A = az_max · (r_max² − r_min²)`` with ``az_max`` in rad (half of the span 2·az_max
+    times ``r_max² − r_min²``)."""
+    # A = (2 az_max)/2 * (r_max^2 - r_min^2)
+    return math.radians(max_azimuth_deg) * (max_range_m**2 - min_range_m**2)
+
+
+#: The paper's area of interest in m² (104.46 m²).
+PAPER_AOI_AREA_M2 = sector_area_m2(PAPER_MIN_RANGE_M, PAPER_MAX_RANGE_M, PAPER_MAX_AZIMUTH_DEG)
+
+
 # ---- processing settings ------------------------------------------------------------------------
 
 #: Window names understood by :func:`core.processing.window`.

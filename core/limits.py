@@ -45,6 +45,10 @@ MAX_PERSON_FRAMES = 20_000
 MAX_SCATTERER_FRAMES = 100_000
 #: Body heights of the walking person model, m.
 PERSON_HEIGHT_RANGE_M = (1.0, 2.2)
+#: Farthest a person may be from the radar, and the largest |component| of an explicit
+#: profile's initial position (m), velocity (m/s) and acceleration (m/s²): far beyond any
+#: radar's range and any walk, small enough that the simulation's squares stay finite.
+MAX_PERSON_DISTANCE_M = 1_000.0
 #: Most static reflectors in one scene.
 MAX_STATIC_REFLECTORS = 1_000
 #: Most samples in one frame's radar cube (virtual channels x loops x ADC samples; the paper's
@@ -82,6 +86,7 @@ LIMITS: dict[str, tuple[object, str]] = {
     "MAX_PERSON_FRAMES": (MAX_PERSON_FRAMES, "persons x frames of one scene"),
     "MAX_SCATTERER_FRAMES": (MAX_SCATTERER_FRAMES, "frames x scatterers of one scene"),
     "PERSON_HEIGHT_RANGE_M": (PERSON_HEIGHT_RANGE_M, "persons[i].height_m (walking model), m"),
+    "MAX_PERSON_DISTANCE_M": (MAX_PERSON_DISTANCE_M, "a person's distance from the radar, m"),
     "MAX_STATIC_REFLECTORS": (MAX_STATIC_REFLECTORS, "static reflectors in one scene"),
     "MAX_CUBE_SAMPLES": (MAX_CUBE_SAMPLES, "virtual channels x loops x samples of one frame"),
     "MAX_SIMULATED_SAMPLES": (MAX_SIMULATED_SAMPLES, "frames x cube samples of one scene"),

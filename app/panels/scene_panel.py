@@ -9,6 +9,7 @@ from PySide6 import QtCore, QtGui, QtWidgets
 
 from app.models import SceneModel
 from app.person_colours import person_colour
+from core.config import PAPER_CLUTTER_DENSITY_PER_M2
 from core.errors import InputError
 from core.limits import MAX_PERSONS, PERSON_HEIGHT_RANGE_M
 from core.scene.scene import DEFAULT_PERSON_MODEL, PERSON_MODELS, person_model_kind
@@ -412,6 +413,7 @@ class ScenePanel(QtWidgets.QWidget):
 
     # ---- model → widgets -------------------------------------------------------------------------
     def sync(self) -> None:
+        """Put the model's document on the widgets (their signals blocked meanwhile)."""
         doc = self.model.document
         if not doc:
             return
@@ -433,69 +435,86 @@ class ScenePanel(QtWidgets.QWidget):
         for w in widgets:
             w.blockSignals(True)
         try:
-            self.seed.setValue(int(doc.get("seed", 0)))
-            self.clutter.setValue(float(doc.get("clutter_density_per_m2", 0.02)))
-            aoi = {**self.engine.default_aoi(), **doc.get("aoi", {})}
-            self.min_range.setValue(aoi["min_range_m"])
-            self.max_range.setValue(aoi["max_range_m"])
-            self.max_az.setValue(aoi["max_azimuth_deg"])
-            self.person_list.clear()
+            self._sync_scene_fields(doc)
             persons = doc.get("persons", [])
-            for k, p in enumerate(persons):
-                t = p.get("trajectory", {})
-                if "class" in t:
-                    desc = f"class {t['class']} (seed {t.get('seed', '–')})"
-                elif "waypoints" in t:
-                    desc = f"drawn, {len(t['waypoints'])} waypoints"
-                else:
-                    desc = "explicit profile"
-                self.person_list.addItem(f"person {k}: {desc}")
-                swatch = QtGui.QPixmap(12, 12)
-                swatch.fill(QtGui.QColor(*person_colour(k)))
-                self.person_list.item(k).setIcon(QtGui.QIcon(swatch))
+            self._sync_person_list(persons)
             sel = self.model.selected_person
             self.person_list.setCurrentRow(sel)
-            person = persons[sel] if persons else {"trajectory": {}}
-            t = person.get("trajectory", {})
-            if "class" in t:
-                self.stack.setCurrentIndex(0)
-                self.class_combo.setCurrentIndex(max(0, list(CLASS_NAMES).index(t["class"])))
-                self.person_seed.setValue(int(t.get("seed", 0)))
-                allowed = self.engine.class_param_names(t["class"])
-                values = dict(t)
-                if "start_m" in t:
-                    values["start_x_m"], values["start_y_m"] = t["start_m"]
-                for name, spin in self.class_params.items():
-                    spin.setValue(float(values[name]) if name in values else spin.minimum())
-                    spin.setEnabled(name in allowed)
-            elif "waypoints" in t:
-                self.stack.setCurrentIndex(1)
-                self.waypoints.set_rows(t["waypoints"])
-            else:
-                self.stack.setCurrentIndex(2)
-            self.fixed_rcs.setChecked("rcs_dbsm" in person)
-            self.rcs.setValue(float(person.get("rcs_dbsm", -8.0)))
-            self.rcs.setEnabled("rcs_dbsm" in person)
-            try:
-                kind = person_model_kind(person.get("model", "point"))
-            except InputError:
-                kind = "point"
-            self.person_model.setCurrentIndex(list(PERSON_MODELS).index(kind))
-            self.height.setValue(float(person.get("height_m", DEFAULT_HEIGHT_M)))
-            self.height.setEnabled(kind == "walking")
+            self._sync_person(persons[sel] if persons else {"trajectory": {}})
             self.reflectors.set_rows(
                 [
                     [r["x_m"], r["y_m"], r.get("rcs_dbsm", 10.0)]
                     for r in doc.get("static_reflectors", [])
                 ]
             )
-            self.remove_button.setEnabled(len(persons) > 1)
-            full = len(persons) >= MAX_PERSONS
-            for b in (self.add_class_button, self.add_wp_button):
-                b.setEnabled(not full)
-                b.setToolTip(f"a scene holds at most {MAX_PERSONS} persons" if full else "")
+            self._sync_person_buttons(len(persons))
         finally:
             for w in widgets:
                 w.blockSignals(False)
         if self.stack.currentIndex() != 1 and self.draw_button.isChecked():
             self.draw_button.setChecked(False)
+
+    def _sync_scene_fields(self, doc: dict) -> None:
+        """Seed, clutter density and area of interest (missing ones: the paper's)."""
+        self.seed.setValue(int(doc.get("seed", 0)))
+        self.clutter.setValue(
+            float(doc.get("clutter_density_per_m2", PAPER_CLUTTER_DENSITY_PER_M2))
+        )
+        aoi = {**self.engine.default_aoi(), **doc.get("aoi", {})}
+        self.min_range.setValue(aoi["min_range_m"])
+        self.max_range.setValue(aoi["max_range_m"])
+        self.max_az.setValue(aoi["max_azimuth_deg"])
+
+    def _sync_person_list(self, persons: list) -> None:
+        """One row per person: how its trajectory is given, with its colour."""
+        self.person_list.clear()
+        for k, p in enumerate(persons):
+            t = p.get("trajectory", {})
+            if "class" in t:
+                desc = f"class {t['class']} (seed {t.get('seed', '–')})"
+            elif "waypoints" in t:
+                desc = f"drawn, {len(t['waypoints'])} waypoints"
+            else:
+                desc = "explicit profile"
+            self.person_list.addItem(f"person {k}: {desc}")
+            swatch = QtGui.QPixmap(12, 12)
+            swatch.fill(QtGui.QColor(*person_colour(k)))
+            self.person_list.item(k).setIcon(QtGui.QIcon(swatch))
+
+    def _sync_person(self, person: dict) -> None:
+        """The selected person's trajectory page, RCS and person model."""
+        t = person.get("trajectory", {})
+        if "class" in t:
+            self.stack.setCurrentIndex(0)
+            self.class_combo.setCurrentIndex(max(0, list(CLASS_NAMES).index(t["class"])))
+            self.person_seed.setValue(int(t.get("seed", 0)))
+            allowed = self.engine.class_param_names(t["class"])
+            values = dict(t)
+            if "start_m" in t:
+                values["start_x_m"], values["start_y_m"] = t["start_m"]
+            for name, spin in self.class_params.items():
+                spin.setValue(float(values[name]) if name in values else spin.minimum())
+                spin.setEnabled(name in allowed)
+        elif "waypoints" in t:
+            self.stack.setCurrentIndex(1)
+            self.waypoints.set_rows(t["waypoints"])
+        else:
+            self.stack.setCurrentIndex(2)
+        self.fixed_rcs.setChecked("rcs_dbsm" in person)
+        self.rcs.setValue(float(person.get("rcs_dbsm", -8.0)))
+        self.rcs.setEnabled("rcs_dbsm" in person)
+        try:
+            kind = person_model_kind(person.get("model", "point"))
+        except InputError:
+            kind = "point"
+        self.person_model.setCurrentIndex(list(PERSON_MODELS).index(kind))
+        self.height.setValue(float(person.get("height_m", DEFAULT_HEIGHT_M)))
+        self.height.setEnabled(kind == "walking")
+
+    def _sync_person_buttons(self, n_persons: int) -> None:
+        """Remove needs two persons; add stops at the limit."""
+        self.remove_button.setEnabled(n_persons > 1)
+        full = n_persons >= MAX_PERSONS
+        for b in (self.add_class_button, self.add_wp_button):
+            b.setEnabled(not full)
+            b.setToolTip(f"a scene holds at most {MAX_PERSONS} persons" if full else "")

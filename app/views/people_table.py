@@ -1,5 +1,5 @@
 """People table: the several-person metrics of the run, one row per person, and the frame shown's
-GOSPA, its decomposition and the people-count error (issue 14). Draws what the engine computed
+GOSPA, its decomposition and the people-count error. Draws what the engine computed
 (:class:`core.evaluation.people.PeopleRun` in :class:`app.data.TrackingResult`), never computes."""
 
 from __future__ import annotations

@@ -17,6 +17,7 @@ from app.data import FrameData, TrackFrame, TrackingResult
 from app.geometry import aoi_polyline, ellipse_polyline, trails_polyline
 from app.person_colours import person_colour
 from app.views.axis_cache import cache_axes
+from core.config import PAPER_MAX_AZIMUTH_DEG, PAPER_MAX_RANGE_M, PAPER_MIN_RANGE_M
 from core.limits import MAX_PERSONS
 
 SNR_MIN_DB = 10.0
@@ -56,6 +57,32 @@ class TopView(pg.PlotWidget):
         self.showGrid(x=True, y=True, alpha=0.2)
         # two columns, translucent: half the height over the plot
         self.addLegend(offset=(5, 5), colCount=2, brush=pg.mkBrush(0, 0, 0, 140))
+        self._make_brushes()
+        self._add_scene_items()
+        self._add_track_items()
+        self._labels: list[pg.TextItem] = []
+        self._stack_items()
+        self.waypoint_line = self.plot(
+            pen=pg.mkPen((255, 0, 255), width=1, style=QtCore.Qt.DashLine), symbol=None
+        )
+        self._waypoint_items: list[pg.TargetItem] = []
+        self._waypoint_rows: list[list[float]] = []
+        self.draw_mode = False
+        self.scene().sigMouseClicked.connect(self._on_click)
+
+        self.colour_by = "snr"  # or "label"
+        self.persistence = 5
+        self.trail_length = 25
+        self.n_draws = 0
+        self.last_n_points = 0
+        self.last_n_tracks = 0
+        self.set_aoi(PAPER_MIN_RANGE_M, PAPER_MAX_RANGE_M, PAPER_MAX_AZIMUTH_DEG)
+        cache_axes(self.getPlotItem())
+        # once the user pans or zooms, the view stays where they put it
+        self.getPlotItem().vb.sigRangeChangedManually.connect(self._stop_auto_fit)
+
+    def _make_brushes(self) -> None:
+        """Brushes made once: SNR colours, labels, identities by ψ."""
         self._snr_brushes = _snr_palette()
         self._label_brushes = {k: pg.mkBrush(*c, 220) for k, c in LABEL_COLOURS.items()}
         self._snr_array = np.empty(N_SNR_COLOURS, dtype=object)
@@ -67,6 +94,8 @@ class TopView(pg.PlotWidget):
         # per identity (app.colours), opacity by ψ: [identity palette index][ψ level]
         self._identity_brushes = [_psi_palette(rgb) for rgb in IDENTITY_PALETTE]
 
+    def _add_scene_items(self) -> None:
+        """The scene: area outline, static reflectors, truth paths."""
         self.aoi = self.plot(pen=pg.mkPen((120, 120, 120), width=1, style=QtCore.Qt.DashLine))
         self.reflectors = pg.ScatterPlotItem(
             symbol="s",
@@ -84,6 +113,9 @@ class TopView(pg.PlotWidget):
         self._selected_person = 0
         self._n_persons = 0
         self._truth_brushes = [pg.mkPen(person_colour(k), width=1.5) for k in range(MAX_PERSONS)]
+
+    def _add_track_items(self) -> None:
+        """Points, trails, gates, truth now, tracks and the estimate."""
         self.points = pg.ScatterPlotItem(size=6, pen=None, name="points")
         self.addItem(self.points)
         self.trails = self.plot(pen=pg.mkPen((0, 220, 90, 150), width=1.5), connect="finite")
@@ -114,8 +146,9 @@ class TopView(pg.PlotWidget):
             symbol="x", size=16, pen=pg.mkPen((255, 40, 40), width=2), brush=None, name="estimate"
         )
         self.addItem(self.estimate)
-        self._labels: list[pg.TextItem] = []
-        # drawing order: gates and tracks under the points, truth and estimate on top
+
+    def _stack_items(self) -> None:
+        """Drawing order: gates and tracks under the points, truth and estimate on top."""
         for z, item in enumerate(
             (self.aoi, self.truth_path, self.trails, self.gates_tentative, self.gates_confirmed,
              self.tracks, self.reflectors, self.points, self.truth_now, self.estimate)
@@ -123,24 +156,6 @@ class TopView(pg.PlotWidget):
             item.setZValue(z)
         for item in self.identity_trails:
             item.setZValue(self.trails.zValue())
-        self.waypoint_line = self.plot(
-            pen=pg.mkPen((255, 0, 255), width=1, style=QtCore.Qt.DashLine), symbol=None
-        )
-        self._waypoint_items: list[pg.TargetItem] = []
-        self._waypoint_rows: list[list[float]] = []
-        self.draw_mode = False
-        self.scene().sigMouseClicked.connect(self._on_click)
-
-        self.colour_by = "snr"  # or "label"
-        self.persistence = 5
-        self.trail_length = 25
-        self.n_draws = 0
-        self.last_n_points = 0
-        self.last_n_tracks = 0
-        self.set_aoi(0.5, 10.0, 60.0)
-        cache_axes(self.getPlotItem())
-        # once the user pans or zooms, the view stays where they put it
-        self.getPlotItem().vb.sigRangeChangedManually.connect(self._stop_auto_fit)
 
     # ---- static content ---------------------------------------------------------------------
     def set_aoi(self, min_range_m: float, max_range_m: float, max_azimuth_deg: float) -> None:

@@ -1,6 +1,6 @@
 """``radartune bench clouds``: person point clouds of each person model against a real recording.
 
-Figures (issue 13), all from :mod:`core.evaluation.clouds`:
+Figures, all from :mod:`core.evaluation.clouds`:
 
 - ``models``: per person model (every entry of :data:`core.scene.scene.PERSON_MODELS`) and per
   fidelity level (exact, fast, measurement), the cloud statistics per range band of the paper

@@ -34,9 +34,10 @@ import numpy as np
 
 from core.dataset import Dataset
 from core.evaluation import paired_comparison, trajectory_losses
-from core.optimization.space import flat_params, search_space, tracker_params_dict
+from core.optimization.space import search_space
 from core.pipeline import paper_dataset
 from core.tracking import TrackerParams, track_dataset
+from core.tracking.space import flat_params, tracker_params_dict
 
 MODELS = ("cv", "ca")
 EARLY_BUDGET = 300

@@ -62,7 +62,7 @@ N_SEEDS = {"exact": 48, "fast": 96, "measurement": 96}
 N_SEEDS_QUICK = {"exact": 2, "fast": 2, "measurement": 4}
 #: noise seed offset between seeds
 OTHER_SEED = 1_000_003
-#: tuned tracker parameters (issue 6: "the same tuned parameters on each level's data set")
+#: tuned tracker parameters (the same tuned parameters on each level's data set)
 TUNED_PARAMS = {
     m: Path(__file__).resolve().parents[2] / "docs" / "report" / f"best_{m}.json"
     for m in ("cv", "ca")

@@ -7,7 +7,7 @@ Figures, each against a reference measured in the same run (the machine is share
   points (TLV 1), their side info (TLV 7), a 256-bin range profile (TLV 2) and the statistics
   (TLV 6), about 1.1 kB a packet like an out-of-box demo at 80 ms; best of 3, by wall clock
   and by this process's CPU time (the machine is shared: the CPU figure is what the code
-  costs). Target ≥ 50 MB/s (issue 16). Reference: a plain loop that only finds each packet and
+  costs). Target ≥ 50 MB/s. Reference: a plain loop that only finds each packet and
   unpacks its points with :mod:`struct` (no checks, no resynchronisation, no arrays), on the
   first quarter of the same bytes; ``ratio`` = reference time / ours (> 1: ours faster).
 - ``csv``: MB/s of the point-cloud CSV readers (:mod:`core.formats.pointcloud_csv`, file →

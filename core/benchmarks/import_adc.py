@@ -9,7 +9,7 @@ blocks of :data:`BLOCK` frames so that both see the same machine load:
 - the capture: each frame read from the ``.bin`` (streamed), decoded to the radar cube and run
   through :func:`core.simulation.frame.process_cube` (the same processing half).
 
-The goal (issue 16): the capture at no less than the exact chain's frames/s. Also timed: the whole
+The goal: the capture at no less than the exact chain's frames/s. Also timed: the whole
 :func:`~core.pipeline.capture.dataset_from_capture` call (cfg, size check, every frame, data set).
 
 ``python -m core.benchmarks.import_adc [--quick] [--out-dir DIR]`` writes ``import_adc.json``.

@@ -31,14 +31,16 @@ import numpy as np
 
 from core.benchmarks.sim_room import run_case as room_case
 from core.benchmarks.sim_room import summary_line as room_summary_line
-from core.config import SPEED_OF_LIGHT_MPS, ProcessingSettings, RadarConfig
-
-AOI_MIN_M, AOI_MAX_M, AOI_AZ_DEG = 0.5, 10.0, 60.0
-CLUTTER_DENSITY_PER_M2 = 0.02
-
-
-def aoi_area_m2() -> float:
-    return np.radians(2 * AOI_AZ_DEG) / 2 * (AOI_MAX_M**2 - AOI_MIN_M**2)
+from core.config import (
+    PAPER_AOI_AREA_M2,
+    PAPER_CLUTTER_DENSITY_PER_M2,
+    PAPER_MAX_AZIMUTH_DEG,
+    PAPER_MAX_RANGE_M,
+    PAPER_MIN_RANGE_M,
+    SPEED_OF_LIGHT_MPS,
+    ProcessingSettings,
+    RadarConfig,
+)
 
 
 def paper_scene_frames(radar: RadarConfig, n_frames: int, rng: np.random.Generator, antenna):
@@ -52,10 +54,10 @@ def paper_scene_frames(radar: RadarConfig, n_frames: int, rng: np.random.Generat
     vres = radar.velocity_resolution_mps
     for f in range(n_frames):
         p = pos + vel * radar.frame_period_s * (f % 100)
-        n_c = rng.poisson(CLUTTER_DENSITY_PER_M2 * aoi_area_m2())
+        n_c = rng.poisson(PAPER_CLUTTER_DENSITY_PER_M2 * PAPER_AOI_AREA_M2)
         # uniform in the AOI sector: r^2 uniform, az uniform
-        r = np.sqrt(rng.uniform(AOI_MIN_M**2, AOI_MAX_M**2, n_c))
-        az = np.radians(rng.uniform(-AOI_AZ_DEG, AOI_AZ_DEG, n_c))
+        r = np.sqrt(rng.uniform(PAPER_MIN_RANGE_M**2, PAPER_MAX_RANGE_M**2, n_c))
+        az = np.radians(rng.uniform(-PAPER_MAX_AZIMUTH_DEG, PAPER_MAX_AZIMUTH_DEG, n_c))
         u = np.column_stack((np.sin(az), np.cos(az), np.zeros(n_c)))
         # |v_r| uniform over [2 bins, v_max], random sign
         vr = rng.uniform(2 * vres, radar.max_velocity_mps, n_c) * rng.choice([-1.0, 1.0], n_c)
@@ -269,36 +271,10 @@ def walking_case(quick: bool = False) -> dict:
     the fast level's frames/s on the walking frames and its speed-up over the exact chain,
     the reflector stage's ms per frame and the mean scatterers and points per frame.
     """
-    from core.pipeline.plan import plan, processing_settings
-    from core.pipeline.reflectors import Reflectors
-    from core.scene import Scene
-    from core.simulation import AntennaGain, simulate_frame
+    from core.simulation import simulate_frame
     from core.simulation.fast import simulate_frames_fast
 
-    def scene(model: str) -> Scene:
-        return Scene.from_dict(
-            {
-                "schema_version": 1,
-                "seed": 11,
-                "clutter_density_per_m2": CLUTTER_DENSITY_PER_M2,
-                "persons": [
-                    {
-                        "model": model,
-                        "trajectory": {"class": "a", "seed": 5, "speed_mps": 1.3},
-                    }
-                ],
-            }
-        )
-
-    built = {}
-    for model in ("walking", "point"):
-        sc = scene(model)
-        antenna = AntennaGain.draw(sc.radar, np.random.default_rng(7))
-        settings = processing_settings(sc)
-        t0 = time.perf_counter()
-        refl = Reflectors.build(sc, plan(sc), sc.seed, antenna, settings)
-        frames, _ = refl.frames()
-        built[model] = (sc.radar, antenna, settings, frames, time.perf_counter() - t0)
+    built = {model: _walking_case_frames(model) for model in ("walking", "point")}
     radar, antenna, settings, walk, t_refl = built["walking"]
     point = built["point"][3]
     n = min(len(walk), len(point))
@@ -340,22 +316,59 @@ def walking_case(quick: bool = False) -> dict:
                 spent[name][2] += len(out)
                 pts[name] += [int(np.sum(o.point_cloud.source == 0)) for o in out]
         per_pass.append((t_pass / (fast_batches * n), (spent["walking"][0] - before) / n))
-    fps = {k: v[2] / v[0] for k, v in spent.items()}
-    fps_cpu = {k: v[2] / v[1] for k, v in spent.items()}
-    fast_fps = fast_batches * reps * n / t_fast
-    pass_ratio = [e / f for f, e in per_pass]
     stages = {
         name: _fast_stage_profile(radar, antenna, settings, frames[:n], reps)
         for name, frames in (("walking", walk), ("point", point))
     }
+    return _walking_case_result(
+        spent, pts, stages, walk[:n], point[:n], n=n, t_refl_s=t_refl / len(walk),
+        fast_frames=fast_batches * reps * n, t_fast=t_fast, c_fast=c_fast, per_pass=per_pass,
+        fast_batches=fast_batches,
+    )  # fmt: skip
+
+
+def _walking_case_frames(model: str) -> tuple:
+    """The walking case's scene with person ``model``: (radar, antenna, settings, scatterers of
+    every frame, seconds the reflector stage took)."""
+    from core.pipeline.plan import plan, processing_settings
+    from core.pipeline.reflectors import Reflectors
+    from core.scene import Scene
+    from core.simulation import AntennaGain
+
+    sc = Scene.from_dict(
+        {
+            "schema_version": 1,
+            "seed": 11,
+            "clutter_density_per_m2": PAPER_CLUTTER_DENSITY_PER_M2,
+            "persons": [
+                {"model": model, "trajectory": {"class": "a", "seed": 5, "speed_mps": 1.3}}
+            ],
+        }
+    )
+    antenna = AntennaGain.draw(sc.radar, np.random.default_rng(7))
+    settings = processing_settings(sc)
+    t0 = time.perf_counter()
+    frames, _ = Reflectors.build(sc, plan(sc), sc.seed, antenna, settings).frames()
+    return sc.radar, antenna, settings, frames, time.perf_counter() - t0
+
+
+def _walking_case_result(
+    spent, pts, stages, walk, point, *, n, t_refl_s, fast_frames, t_fast, c_fast, per_pass,
+    fast_batches,
+) -> dict:  # fmt: skip
+    """The walking case's figures from its timings (see :func:`walking_case`)."""
+    fps = {k: v[2] / v[0] for k, v in spent.items()}
+    fps_cpu = {k: v[2] / v[1] for k, v in spent.items()}
+    fast_fps = fast_frames / t_fast
+    pass_ratio = [e / f for f, e in per_pass]
     return {
         "frames": spent["walking"][2],
         "frames_per_trajectory": n,
-        "scatterers_per_frame_walking": float(np.mean([len(f) for f in walk[:n]])),
-        "scatterers_per_frame_point": float(np.mean([len(f) for f in point[:n]])),
+        "scatterers_per_frame_walking": float(np.mean([len(f) for f in walk])),
+        "scatterers_per_frame_point": float(np.mean([len(f) for f in point])),
         "person_points_per_frame_walking": float(np.mean(pts["walking"])),
         "person_points_per_frame_point": float(np.mean(pts["point"])),
-        "reflectors_ms_per_frame_walking": 1e3 * t_refl / len(walk),
+        "reflectors_ms_per_frame_walking": 1e3 * t_refl_s,
         "exact_fps_walking": fps["walking"],
         "exact_fps_point": fps["point"],
         "exact_point_over_walking": fps["point"] / fps["walking"],
@@ -363,9 +376,9 @@ def walking_case(quick: bool = False) -> dict:
         "exact_fps_cpu_point": fps_cpu["point"],
         "exact_point_over_walking_cpu": fps_cpu["point"] / fps_cpu["walking"],
         "fast_fps_walking": fast_fps,
-        "fast_fps_cpu_walking": fast_batches * reps * n / c_fast,
+        "fast_fps_cpu_walking": fast_frames / c_fast,
         "fast_over_exact_walking": fast_fps / fps["walking"],
-        "fast_over_exact_walking_cpu": (fast_batches * reps * n / c_fast) / fps_cpu["walking"],
+        "fast_over_exact_walking_cpu": (fast_frames / c_fast) / fps_cpu["walking"],
         # the same ratio pass by pass (each pass: its fast batches against its exact frames)
         "fast_over_exact_walking_per_pass": {
             "median": float(np.median(pass_ratio)),
@@ -503,7 +516,7 @@ def _time_dataset(quick: bool) -> dict | None:
 
     The point person at the exact level first (the top-level figures, as before), then both
     person models (``point``, ``walking``) at the ``exact`` and ``fast`` levels, each once in
-    this process (wall clock and process CPU time): issue 13's "data-set generation time for the
+    this process (wall clock and process CPU time): the "data-set generation time for the
     35 trajectories reported for both models". ``quick``: 2 trajectories.
     """
     try:

@@ -20,7 +20,7 @@ loop got just before it (``cpu_share``; with the kernel's per-session scheduling
 one command share one session's slice) are recorded beside it, and CPU time per trial is the
 figure that load disturbs least. The point-person data set's SQLite
 2-job study and references are measured too, for comparison with earlier figures.
-Goal (issue 15): at least 20 trials/s with 2 jobs on SQLite.
+Goal: at least 20 trials/s with 2 jobs on SQLite.
 
 ``radartune bench tune --recording REC.npz [--people N]`` measures instead a study on a
 recording (an imported data set without truth), cut to its first :data:`RECORDING_FRAMES`
@@ -51,7 +51,8 @@ def _reference(
     """The bare objective in this process: a full (unpruned) trial's work, no Optuna."""
     from core.dataset import Dataset
     from core.optimization.objective import evaluate, tracker_losses
-    from core.optimization.space import search_space, tracker_params_dict
+    from core.optimization.space import search_space
+    from core.tracking.space import tracker_params_dict
 
     ds = Dataset.load(dataset_path)
     # the work of a default (paper-loss) trial, or of the recording study's objective

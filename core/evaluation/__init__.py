@@ -41,6 +41,7 @@ from core.evaluation.loss import (
     PeopleLoss,
     people_trajectory_loss,
     person_estimates,
+    running_trajectory_loss,
     tracked_person_xy,
     trajectory_loss,
     trajectory_loss_terms,
@@ -55,6 +56,7 @@ from core.evaluation.metrics import (
     GospaTerms,
     gospa,
     ospa,
+    ospa_per_frame,
 )
 from core.evaluation.people import FrameMetrics, PeopleRun, frame_metrics, people_run
 from core.evaluation.spread import PointSpread, person_point_spread
@@ -93,9 +95,11 @@ __all__ = [
     "loss_breakdown",
     "nees",
     "ospa",
+    "ospa_per_frame",
     "paired_comparison",
     "people_run",
     "people_trajectory_loss",
+    "running_trajectory_loss",
     "person_estimates",
     "person_point_spread",
     "track_with_ids",

@@ -41,6 +41,7 @@ __all__ = [
     "PeopleLoss",
     "people_trajectory_loss",
     "person_estimates",
+    "running_trajectory_loss",
     "tracked_person_xy",
     "trajectory_loss",
     "trajectory_losses",
@@ -103,6 +104,33 @@ def trajectory_loss(
     mse = float(np.sum(e * e) / n_c)
     # L(k) = MSE(k) / N_c(k)   (13)
     return mse / n_c, mse, n_c
+
+
+def running_trajectory_loss(
+    estimate_xy: np.ndarray, has_estimate: np.ndarray, truth_xy: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """Eq. (13) and the RMSE over frames ``0..k`` for every k (the loss as a run unfolds).
+
+    Element ``k`` is :func:`trajectory_loss` of the first ``k + 1`` frames (the same frames
+    scored: an estimate exists and the person is present).
+
+    Returns
+    -------
+    loss
+        ``(F,)`` L_k = MSE_k / N_c,k in m² (:data:`NO_CONFIRMATION_LOSS` while N_c,k = 0).
+    rmse
+        ``(F,)`` sqrt(MSE_k) in m (NaN while N_c,k = 0).
+    """
+    has = np.asarray(has_estimate, dtype=bool) & np.isfinite(truth_xy).all(axis=1)
+    e = np.where(has[:, None], np.nan_to_num(estimate_xy) - np.nan_to_num(truth_xy), 0.0)
+    # MSE_k = (1/N_c,k) Σ_{j≤k} |x̂_j − x_j|²  over frames with an estimate
+    n_c = np.cumsum(has)
+    sse = np.cumsum(np.sum(e * e, axis=1))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        mse = np.where(n_c > 0, sse / np.maximum(n_c, 1), np.nan)
+        # L_k = MSE_k / N_c,k
+        loss = np.where(n_c > 0, mse / np.maximum(n_c, 1), NO_CONFIRMATION_LOSS)
+    return loss, np.sqrt(mse)
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)

@@ -13,6 +13,7 @@ assigned pairs, missed persons and false tracks (:func:`gospa`).
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -26,6 +27,7 @@ __all__ = [
     "GospaTerms",
     "gospa",
     "ospa",
+    "ospa_per_frame",
 ]
 
 #: Distance (m) beyond which a confirmed track counts as far from the person.
@@ -65,6 +67,20 @@ def ospa(tracks_xy: np.ndarray, truth_xy: np.ndarray, c: float = OSPA_C_M, p: in
         rows, cols = linear_sum_assignment(d)
         cost = float(d[rows, cols].sum())
     return float(((cost + c**p * (n - m)) / n) ** (1.0 / p))
+
+
+def ospa_per_frame(
+    tracks_xy: Sequence[np.ndarray],
+    truth_xy: Sequence[np.ndarray],
+    c: float = OSPA_C_M,
+    p: int = OSPA_P,
+) -> np.ndarray:
+    """:func:`ospa` of every frame: ``tracks_xy[k]`` (m_k, 2) against ``truth_xy[k]`` (n_k, 2)
+    in m (NaN rows, absent persons, left out); returns ``(F,)`` in m."""
+    out = np.zeros(len(truth_xy))
+    for k, (a, b) in enumerate(zip(tracks_xy, truth_xy, strict=True)):
+        out[k] = ospa(a, b, c, p)
+    return out
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)

@@ -35,10 +35,8 @@ if TYPE_CHECKING:
         MODELS,
         SEARCH_SPACE,
         Parameter,
-        flat_params,
         search_space,
         suggest_params,
-        tracker_params_dict,
     )
     from core.optimization.storage import DEFAULT_STORAGE, normalize_url, open_storage
     from core.optimization.study import (
@@ -73,10 +71,8 @@ _EXPORTS = {
     "MODELS": "core.optimization.space",
     "SEARCH_SPACE": "core.optimization.space",
     "Parameter": "core.optimization.space",
-    "flat_params": "core.optimization.space",
     "search_space": "core.optimization.space",
     "suggest_params": "core.optimization.space",
-    "tracker_params_dict": "core.optimization.space",
     "DEFAULT_STORAGE": "core.optimization.storage",
     "normalize_url": "core.optimization.storage",
     "open_storage": "core.optimization.storage",
@@ -126,7 +122,6 @@ __all__ = [
     "evaluate",
     "fail_stale_trials",
     "loss_of_study",
-    "flat_params",
     "list_studies",
     "make_losses",
     "make_pruner",
@@ -142,5 +137,4 @@ __all__ = [
     "study_model",
     "study_progress",
     "suggest_params",
-    "tracker_params_dict",
 ]

@@ -29,13 +29,8 @@ import numpy as np
 from core.errors import InputError
 from core.evaluation.loss import NO_CONFIRMATION_LOSS
 from core.evaluation.robust import OBJECTIVES, aggregate, check_objective
-from core.optimization.space import (
-    GTRACK,
-    P0_NAMES,
-    check_tuned,
-    search_space,
-    tracker_params_dict,
-)
+from core.optimization.space import GTRACK, P0_NAMES, check_tuned, search_space
+from core.tracking.space import tracker_params_dict
 
 
 class TrajectoryScore(NamedTuple):
@@ -454,7 +449,6 @@ __all__ = [
     "make_losses",
     "round_robin_order",
     "uses_capped",
-    "tracker_params_dict",
     "tracker_losses",
     "without_positions",
 ]

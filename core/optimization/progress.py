@@ -13,8 +13,8 @@ from dataclasses import dataclass
 from typing import Any
 
 from core.errors import InputError
-from core.optimization.space import flat_params, tracker_params_dict
 from core.optimization.storage import load_existing_study, open_storage, redact
+from core.tracking.space import flat_params, tracker_params_dict
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)

@@ -29,7 +29,8 @@ import numpy as np
 from core.errors import InputError
 from core.optimization.objective import TrajectoryLosses, evaluate
 from core.optimization.progress import TrialSummary
-from core.optimization.space import flat_params, search_space, tracker_params_dict
+from core.optimization.space import search_space
+from core.tracking.space import flat_params, tracker_params_dict
 
 #: The importance evaluator used (see the module docstring for why this one).
 IMPORTANCE_EVALUATOR = "PED-ANOVA"

@@ -44,7 +44,7 @@ import numpy as np
 from core.errors import InputError
 from core.evaluation.robust import DEFAULT_OBJECTIVE, check_objective
 from core.optimization.objective import evaluate, make_losses, uses_capped, without_positions
-from core.optimization.space import check_tuned, suggest_params, tracker_params_dict
+from core.optimization.space import check_tuned, suggest_params
 from core.optimization.storage import (
     DEFAULT_STORAGE,
     absolute_url,
@@ -53,6 +53,7 @@ from core.optimization.storage import (
     open_storage,
     redact,
 )
+from core.tracking.space import tracker_params_dict
 
 SAMPLERS = ("tpe", "random", "cmaes", "gp")
 #: samplers that need a package Optuna does not install itself: sampler -> module
@@ -258,12 +259,21 @@ def make_pruner(kind: str) -> Any:
 
 # ---- worker identity and crash recovery -------------------------------------------------------
 def _start_ticks(pid: int) -> str | None:
-    """Start time of a process in clock ticks (Linux ``/proc``), to tell a reused pid apart."""
+    """Start time of a running process in clock ticks (Linux ``/proc``), to tell a reused pid
+    apart; None when no such process runs.
+
+    A zombie (state ``Z``, or ``X`` while it is removed) has ended: it keeps its ``/proc``
+    entry only until its parent reaps it (``tune`` polls its workers every 0.5 s), and another
+    worker finishing the study in that window must see it dead to free its trial's slot.
+    """
     try:
         stat = Path(f"/proc/{pid}/stat").read_text()
     except OSError:
         return None
-    return stat.rsplit(")", 1)[1].split()[19]
+    fields = stat.rsplit(")", 1)[1].split()  # state, ppid, ... (after the command name)
+    if fields[0] in ("Z", "X"):
+        return None
+    return fields[19]
 
 
 def worker_id() -> str:

@@ -223,8 +223,8 @@ def chosen_params(
     by training objective. Returns (TrackerParams JSON, study, trial number, ``"validation"`` or
     ``"training"``).
     """
-    from core.optimization.space import tracker_params_dict
     from core.optimization.storage import load_existing_study, open_storage, redact
+    from core.tracking.space import tracker_params_dict
 
     store = open_storage(storage, create=False)
     validated: list[tuple[float, str, int, Any]] = []

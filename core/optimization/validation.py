@@ -129,7 +129,7 @@ def validate_study(
         Sorted by validation objective (then trial number); empty when no trial completed.
     """
     from core.dataset import Dataset
-    from core.optimization.space import tracker_params_dict
+    from core.tracking.space import tracker_params_dict
 
     if top_k < 1:
         raise InputError(f"top_k must be >= 1, got {top_k}")

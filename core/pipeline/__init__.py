@@ -11,7 +11,9 @@ One module per job:
 - :mod:`core.pipeline.reflectors`: the reflectors of every frame (persons, bodies, clutter,
   static reflectors);
 - :mod:`core.pipeline.frames`: a scene simulated frame by frame (the GUI) or in one batch call;
-- :mod:`core.pipeline.cache`: data sets, simulated in a process pool and cached by content key.
+- :mod:`core.pipeline.cache`: data sets, simulated in a process pool and cached by content key;
+- :mod:`core.pipeline.views`: what the app's range-profile and micro-Doppler views draw of a
+  frame's map.
 """
 
 from core.pipeline.cache import (

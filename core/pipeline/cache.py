@@ -35,7 +35,7 @@ def default_cache_dir() -> Path:
 
 
 #: Sources whose code determines a simulated data set (their text is part of the cache key).
-_SIMULATION_SOURCES = ("config.py", "pointcloud.py", "dataset.py")
+_SIMULATION_SOURCES = ("config.py", "kinematics.py", "pointcloud.py", "dataset.py")
 _SIMULATION_PACKAGES = ("pipeline", "scene", "simulation", "processing")
 
 

@@ -7,19 +7,26 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from core.config import (
+    PAPER_MAX_AZIMUTH_DEG,
+    PAPER_MAX_RANGE_M,
+    PAPER_MIN_RANGE_M,
+    sector_area_m2,
+)
 from core.errors import InputError
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
 class AOI:
-    """Annular sector ``min_range_m <= r <= max_range_m``, ``|az| <= max_azimuth_deg``.
+    """Annular sector ``min_range_m <= r <= max_range_m``, ``|az| <= max_azimuth_deg`` (defaults:
+    the paper's area, :data:`core.config.PAPER_MIN_RANGE_M` and its neighbours).
 
     Radar at the origin, boresight along +y, ``az = atan2(x, y)``.
     """
 
-    min_range_m: float = 0.5
-    max_range_m: float = 10.0
-    max_azimuth_deg: float = 60.0
+    min_range_m: float = PAPER_MIN_RANGE_M
+    max_range_m: float = PAPER_MAX_RANGE_M
+    max_azimuth_deg: float = PAPER_MAX_AZIMUTH_DEG
 
     def __post_init__(self) -> None:
         for name in ("min_range_m", "max_range_m", "max_azimuth_deg"):
@@ -43,9 +50,8 @@ class AOI:
 
     @property
     def area_m2(self) -> float:
-        """Sector area ``A = az_span/2 * (r_max^2 - r_min^2)`` in m^2 (104.46 m^2 for the paper)."""
-        # A = (2*az_max)/2 * (r_max^2 - r_min^2)
-        return self.max_azimuth_rad * (self.max_range_m**2 - self.min_range_m**2)
+        """Sector area in m² (:func:`core.config.sector_area_m2`; 104.46 m² for the paper)."""
+        return sector_area_m2(self.min_range_m, self.max_range_m, self.max_azimuth_deg)
 
     @property
     def centre_m(self) -> np.ndarray:

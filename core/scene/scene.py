@@ -13,12 +13,13 @@ from typing import Any
 
 import numpy as np
 
-from core.config import PAPER_RADAR, RadarConfig
+from core.config import PAPER_CLUTTER_DENSITY_PER_M2, PAPER_RADAR, RadarConfig
 from core.errors import InputError
 from core.files import check_text_field, parse_json, read_json, write_text_atomic
 from core.formats.ti_cfg import read_ti_cfg
 from core.limits import (
     MAX_FRAMES,
+    MAX_PERSON_DISTANCE_M,
     MAX_PERSON_FRAMES,
     MAX_PERSONS,
     MAX_SCATTERER_FRAMES,
@@ -48,7 +49,6 @@ from core.scene.walking import (
 )
 
 SCHEMA_VERSION = 1
-PAPER_CLUTTER_DENSITY_PER_M2 = 0.02
 SCENE_KEYS = (
     "schema_version",
     "radar",
@@ -347,10 +347,10 @@ def _integer(value: Any, where: str, lo: int = 0, hi: int | None = None) -> int:
     return value
 
 
-def _vector(value: Any, where: str) -> np.ndarray:
+def _vector(value: Any, where: str, lo: float | None = None, hi: float | None = None) -> np.ndarray:
     if not isinstance(value, list) or len(value) != 2:
         raise InputError(f"{where} must be a list [x, y], got {value!r}")
-    return np.array([_number(v, f"{where}[{i}]") for i, v in enumerate(value)])
+    return np.array([_number(v, f"{where}[{i}]", lo, hi) for i, v in enumerate(value)])
 
 
 def _parse_radar(spec: Any, base_dir: Path) -> RadarConfig:
@@ -447,8 +447,10 @@ def _parse_trajectory(
         for k in keys[:3]:
             if k not in spec:
                 raise InputError(f"{where}: missing key {k!r}")
-        p0 = _vector(spec["initial_position_m"], f"{where}.initial_position_m")
-        v0 = _vector(spec["initial_velocity_mps"], f"{where}.initial_velocity_mps")
+        # components bounded so that the integrated walk stays finite (checked whole below)
+        bound = (-MAX_PERSON_DISTANCE_M, MAX_PERSON_DISTANCE_M)
+        p0 = _vector(spec["initial_position_m"], f"{where}.initial_position_m", *bound)
+        v0 = _vector(spec["initial_velocity_mps"], f"{where}.initial_velocity_mps", *bound)
         acc = spec["acceleration_mps2"]
         if isinstance(acc, list) and len(acc) > MAX_PROFILE_FRAMES:
             raise InputError(
@@ -456,10 +458,13 @@ def _parse_trajectory(
             )
         if isinstance(acc, list) and acc and isinstance(acc[0], list):
             a = np.array(
-                [_vector(row, f"{where}.acceleration_mps2[{i}]") for i, row in enumerate(acc)]
+                [
+                    _vector(row, f"{where}.acceleration_mps2[{i}]", *bound)
+                    for i, row in enumerate(acc)
+                ]
             )
         else:
-            a = _vector(acc, f"{where}.acceleration_mps2")
+            a = _vector(acc, f"{where}.acceleration_mps2", *bound)
         frames = spec.get("frames")
         if frames is not None:
             frames = _integer(frames, f"{where}.frames", 1, MAX_PROFILE_FRAMES)
@@ -502,7 +507,13 @@ def _parse_scene(data: Any, base_dir: Path) -> Scene:
     radar_spec = data.get("radar", "paper")
     radar = _parse_radar(radar_spec, base_dir)
     seed = _integer(data.get("seed", 0), "seed")
-    density = _number(data.get("clutter_density_per_m2", 0.0), "clutter_density_per_m2", 0, 1)
+    # a file without a clutter density has the paper's, as Scene() and the editor do
+    density = _number(
+        data.get("clutter_density_per_m2", PAPER_CLUTTER_DENSITY_PER_M2),
+        "clutter_density_per_m2",
+        0,
+        1,
+    )
     aoi_d = _check_keys(
         data.get("aoi", {}), ("min_range_m", "max_range_m", "max_azimuth_deg"), "aoi"
     )
@@ -557,7 +568,14 @@ def _parse_scene(data: Any, base_dir: Path) -> Scene:
         traj = _parse_trajectory(
             p["trajectory"], f"{where}.trajectory", seed, i, aoi, radar.frame_period_s
         )
-        r_min = float(np.hypot(*traj.position_m.T).min())
+        r = np.hypot(*traj.position_m.T)
+        r_min = float(r.min())
+        if not r.max() <= MAX_PERSON_DISTANCE_M:
+            far = int(np.argmax(~(r <= MAX_PERSON_DISTANCE_M)))
+            raise InputError(
+                f"{where}.trajectory is {r[far]:.3g} m from the radar at frame {far} "
+                f"(at most {MAX_PERSON_DISTANCE_M:g} m)"
+            )
         if r_min < MIN_SCATTERER_RANGE_M:
             raise InputError(
                 f"{where}.trajectory passes within {r_min:.3g} m of the radar "

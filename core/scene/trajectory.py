@@ -8,7 +8,7 @@ velocity and an acceleration profile, integrated with eq. (6) (Δt = frame perio
 
 Generators build the *desired* velocity of every frame (constant speed on a turn, a stop, a
 circle) and turn it into the acceleration profile ``a(t-1) = (v(t) - v(t-1)) / Δt``, so that the
-stored positions are exactly eq. (6) of the stored accelerations.
+stored positions are exactly eq. (6) of the stored accelerations (:mod:`core.kinematics`).
 """
 
 from __future__ import annotations
@@ -21,6 +21,7 @@ from typing import Any
 import numpy as np
 
 from core.errors import InputError
+from core.kinematics import integrate_eq6
 from core.scene.aoi import AOI
 
 TRAJECTORY_CLASSES = ("a", "b", "c", "d", "e")
@@ -99,43 +100,6 @@ class Trajectory:
         p, v = self.position_m, self.velocity_mps
         r = np.maximum(np.hypot(p[:, 0], p[:, 1]), 1e-12)
         return (p[:, 0] * v[:, 0] + p[:, 1] * v[:, 1]) / r
-
-
-def integrate_eq6(
-    initial_position_m: np.ndarray,
-    initial_velocity_mps: np.ndarray,
-    acceleration_mps2: np.ndarray,
-    frame_period_s: float,
-) -> tuple[np.ndarray, np.ndarray]:
-    """Integrate eq. (6) over ``F = len(acceleration_mps2)`` frames.
-
-    Parameters
-    ----------
-    initial_position_m, initial_velocity_mps
-        ``p(0)``, ``v(0)``, shape ``(2,)``.
-    acceleration_mps2
-        ``a(t)``, shape ``(F, 2)``; ``a(F-1)`` is not used.
-    frame_period_s
-        Δt, s.
-
-    Returns
-    -------
-    position_m, velocity_mps
-        Shape ``(F, 2)`` each.
-    """
-    a = np.asarray(acceleration_mps2, dtype=np.float64)
-    dt = float(frame_period_s)
-    f = len(a)
-    v = np.empty((f, 2))
-    p = np.empty((f, 2))
-    v[0] = initial_velocity_mps
-    p[0] = initial_position_m
-    for t in range(1, f):
-        # v(t) = v(t-1) + a(t-1) Δt
-        v[t] = v[t - 1] + a[t - 1] * dt
-        # p(t) = p(t-1) + v(t) Δt
-        p[t] = p[t - 1] + v[t] * dt
-    return p, v
 
 
 def _from_velocities(

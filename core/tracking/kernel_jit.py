@@ -10,11 +10,11 @@ Its arguments are four groups of arrays, :class:`KernelFrames`, :class:`KernelCo
 :class:`KernelOutputs` and :class:`~core.tracking.results.TrackRecord`; the Python side that
 fills them and calls it is :mod:`core.tracking.kernel`.
 
-Why one module of about 630 lines (issue 12's exception for a compiled kernel): numba compiles
-:func:`track_kernel` together with the helpers it calls, and its on-disk cache
-(``cache=True``) checks only the source file of the function it caches for staleness: a helper
-moved to another file could change without the cached kernel being recompiled. The argument
-types stay with it because the kernel names its tuples with them.
+Why one module (over the house's ~600 lines): it was kept whole because numba's on-disk cache
+(``cache=True``) once checked only the source file of the function it caches, so a helper moved
+to another file could change without the cached kernel being recompiled; :mod:`core.jit_guard`
+now stamps every kernel with the hash of every numba module under ``core/``, so that reason is
+gone. The argument types stay with the kernel because it names its tuples with them.
 """
 
 from __future__ import annotations

@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 from core.errors import InputError
 
@@ -38,6 +39,8 @@ __all__ = [
     "search_space",
     "p0_names",
     "defaults",
+    "tracker_params_dict",
+    "flat_params",
 ]
 
 #: Motion models: constant velocity and constant acceleration.
@@ -223,3 +226,61 @@ def p0_names(model: str) -> tuple[str, ...]:
 def defaults(model: str) -> dict[str, float]:
     """Default value of every parameter ``model`` uses, by name (flat: ``p0_ii`` keys)."""
     return {p.name: p.default for p in search_space(model)}
+
+
+def tracker_params_dict(flat: dict[str, Any], model: str) -> dict[str, Any]:
+    """Flat parameters (by table name) → TrackerParams JSON (SPEC §6): ``p0_ii`` become ``p0``.
+
+    Keys not in the search space (``p_g``, thresholds, clutter density) are left out so that
+    they take the TrackerParams defaults.
+    """
+    names = [b.name for b in search_space(model)]
+    missing = [n for n in names if n not in flat]
+    if missing:
+        raise InputError(f"parameters missing for model {model}: {', '.join(missing)}")
+    if model == GTRACK:  # GtrackParams JSON: the rows by name, counters as integers
+        return {
+            b.name: int(round(float(flat[b.name]))) if b.integer else float(flat[b.name])
+            for b in search_space(model)
+        }
+    out: dict[str, Any] = {"model": model}
+    for n in names:
+        if n not in P0_NAMES:
+            out[n] = float(flat[n])
+    out["p0"] = [float(flat[p]) for p in p0_names(model)]
+    return out
+
+
+def flat_params(params: dict[str, Any]) -> dict[str, float]:
+    """TrackerParams JSON → flat parameters by table name (inverse of :func:`tracker_params_dict`).
+
+    Used to enqueue known parameters in a study and to put a parameter file on the app's
+    sliders; values outside the bounds are an error naming the field.
+    """
+    if "model" not in params and any(b.name in params for b in search_space(GTRACK)):
+        flat_g: dict[str, float] = {}
+        for b in search_space(GTRACK):
+            if b.name not in params:
+                raise InputError(f"parameter {b.name} missing")
+            value = float(params[b.name])
+            if not b.low <= value <= b.high:
+                raise InputError(f"{b.name} must be in [{b.low}, {b.high}], got {value}")
+            flat_g[b.name] = value
+        return flat_g
+    model = check_model(str(params.get("model", "cv")))
+    p0 = list(params.get("p0", []))
+    n_p0 = STATE_DIM[model]
+    if len(p0) != n_p0:
+        raise InputError(f"p0 must have {n_p0} entries for model {model}, got {len(p0)}")
+    flat: dict[str, float] = {}
+    for b in search_space(model):
+        if b.name in P0_NAMES:
+            value = float(p0[P0_NAMES.index(b.name)])
+        elif b.name in params:
+            value = float(params[b.name])
+        else:
+            raise InputError(f"parameter {b.name} missing")
+        if not b.low <= value <= b.high:
+            raise InputError(f"{b.name} must be in [{b.low}, {b.high}], got {value}")
+        flat[b.name] = value
+    return flat

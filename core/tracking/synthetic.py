@@ -1,11 +1,11 @@
 """Synthetic measurements for tests and the stability sweep (no radar simulation needed).
 
-Truth follows the paper's eq. (6) walk (``v(t) = v(t−1) + a(t−1)·Δt``, ``p(t) = p(t−1) +
-v(t)·Δt``); each frame the person is detected with probability P_D and measured as
-``[r, az, vr]`` plus Gaussian noise; clutter is Poisson with a given mean per frame, uniform in
-measurement space over the AOI (r ∈ [0.5, 10] m, |az| ≤ 60°, vr ∈ [−v_max, v_max]). With 2.1
-clutter points a frame (λ = 0.02 m⁻² over the 104.5 m² AOI) this is the paper-like scene, whose
-clutter density is 2.1 / (9.5 m · 2.094 rad · 14.48 m/s) ≈ 0.0073.
+Truth follows the paper's eq. (6) walk (:func:`core.kinematics.integrate_eq6`); each frame the
+person is detected with probability P_D and measured as ``[r, az, vr]`` plus Gaussian noise;
+clutter is Poisson with a given mean per frame, uniform in measurement space over the AOI
+(r ∈ [0.5, 10] m, |az| ≤ 60°, vr ∈ [−v_max, v_max]). With 2.1 clutter points a frame
+(λ = 0.02 m⁻² over the 104.5 m² AOI, :mod:`core.config`'s paper scene) this is the paper-like
+scene, whose clutter density is 2.1 / (9.5 m · 2.094 rad · 14.48 m/s) ≈ 0.0073.
 """
 
 from __future__ import annotations
@@ -16,12 +16,19 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from core.config import (
+    PAPER_AOI_AREA_M2,
+    PAPER_CLUTTER_DENSITY_PER_M2,
+    PAPER_MAX_AZIMUTH_DEG,
+    PAPER_MAX_RANGE_M,
+    PAPER_MIN_RANGE_M,
+)
 from core.dataset import Dataset
+from core.kinematics import integrate_eq6
 from core.pointcloud import SOURCE_CLUTTER, PointCloud
 
 __all__ = [
     "SyntheticScene",
-    "walk",
     "synthetic_trajectory",
     "synthetic_frames",
     "synthetic_dataset",
@@ -30,9 +37,6 @@ __all__ = [
     "people_dataset",
     "PAPER_LIKE",
 ]
-
-#: AOI area in m² (0.5 ≤ r ≤ 10 m, |az| ≤ 60°): (π/3)·(10² − 0.5²)/… = 104.46
-AOI_AREA_M2 = (math.radians(120.0) / 2.0) * (10.0**2 - 0.5**2)
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -55,10 +59,11 @@ class SyntheticScene:
 
     noise_std: tuple[float, float, float] = (0.05, 0.02, 0.15)
     p_d: float = 0.95
-    clutter_per_frame: float = 0.02 * AOI_AREA_M2
-    min_range_m: float = 0.5
-    max_range_m: float = 10.0
-    max_azimuth_rad: float = math.radians(60.0)
+    clutter_per_frame: float = PAPER_CLUTTER_DENSITY_PER_M2 * PAPER_AOI_AREA_M2
+    min_range_m: float = PAPER_MIN_RANGE_M
+    max_range_m: float = PAPER_MAX_RANGE_M
+    max_azimuth_rad: float = math.radians(PAPER_MAX_AZIMUTH_DEG)
+    # the paper radar's v_max (7.2414 m/s) to four figures, as the synthetic data sets were drawn
     max_velocity_mps: float = 7.241
     frame_period_s: float = 0.08
 
@@ -80,23 +85,6 @@ class SyntheticScene:
 
 
 PAPER_LIKE = SyntheticScene()
-
-
-def walk(
-    p0: np.ndarray, v0: np.ndarray, accel: np.ndarray, frame_period_s: float
-) -> tuple[np.ndarray, np.ndarray]:
-    """Eq. (6): positions and velocities (F, 2) from p(0), v(0) and accelerations a (F, 2).
-
-    v(t) = v(t−1) + a(t−1)·Δt, p(t) = p(t−1) + v(t)·Δt.
-    """
-    n = len(accel)
-    p = np.zeros((n, 2))
-    v = np.zeros((n, 2))
-    p[0], v[0] = p0, v0
-    for t in range(1, n):
-        v[t] = v[t - 1] + accel[t - 1] * frame_period_s
-        p[t] = p[t - 1] + v[t] * frame_period_s
-    return p, v
 
 
 def _inside(p: np.ndarray, scene: SyntheticScene) -> np.ndarray:
@@ -177,7 +165,7 @@ def synthetic_trajectory(
         else:
             raise ValueError(f"trajectory_class must be one of 'abcde', got {trajectory_class!r}")
         if trajectory_class != "e":
-            pos, vel = walk(p0, v0, accel, dt)
+            pos, vel = integrate_eq6(p0, v0, accel, dt)
         ok = _inside(pos, scene)
         n_ok = int(np.argmin(ok)) if not ok.all() else n_frames
         if n_ok >= 40:

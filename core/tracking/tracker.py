@@ -24,7 +24,7 @@ from core.tracking.inputs import Frames, TrackerConstants, frame_slices
 from core.tracking.params import TrackerParams
 from core.tracking.results import FrameTracks, TrackerResult
 
-__all__ = ["run_tracker", "gate_ellipses_xy", "StreamTracker"]
+__all__ = ["run_tracker", "StreamTracker"]
 
 
 @dataclass(slots=True)
@@ -335,25 +335,3 @@ class StreamTracker:
             np.array([t.confirmed for t in tracks], dtype=bool),
         )
         return _frame_tracks(tracks, self.params.state_dim, best)
-
-
-def gate_ellipses_xy(tracks: FrameTracks, n_points: int = 48) -> np.ndarray:
-    """All gate ellipses of a frame as one NaN-separated x–y curve (for one plot item).
-
-    Returns
-    -------
-    numpy.ndarray
-        Shape (n_tracks · (n_points + 2), 2) in m: each closed ellipse {c + d : dᵀG⁻¹d = 1}
-        (n_points + 1 vertices) followed by a NaN row.
-    """
-    n = len(tracks)
-    t = np.linspace(0.0, 2.0 * np.pi, n_points + 1)
-    circle = np.stack((np.cos(t), np.sin(t)))  # (2, n_points + 1)
-    out = np.full((n, n_points + 2, 2), np.nan)
-    for i in range(n):
-        # G = V Λ Vᵀ; boundary points c + V Λ^{1/2} u, |u| = 1
-        w, V = np.linalg.eigh(tracks.gate_shape_xy[i])
-        out[i, :-1] = (
-            tracks.gate_center_xy[i][:, None] + (V * np.sqrt(np.maximum(w, 0))) @ circle
-        ).T
-    return out.reshape(-1, 2)

@@ -1,4 +1,4 @@
-"""Defects of issue 17, each with the test that failed before its fix."""
+"""Defects of the app's windows and views, each with the test that failed before its fix."""
 
 from __future__ import annotations
 

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from app.data import ParamSpec
-from app.geometry import aoi_polyline, chi2_2dof_quantile, ellipse_polyline, trails_polyline
+from app.geometry import aoi_polyline, ellipse_polyline, trails_polyline
 from app.panels.tracker_panel import SLIDER_STEPS, from_slider, to_slider
 
 
@@ -41,10 +41,17 @@ def test_ellipse_points_lie_on_the_gate_boundary() -> None:
         np.testing.assert_allclose(m, 1.0, rtol=1e-9)
 
 
-def test_chi2_two_dof_quantile() -> None:
-    # P(χ²₂ ≤ γ) = 1 − exp(−γ/2)
-    assert 1 - math.exp(-chi2_2dof_quantile(0.99) / 2) == pytest.approx(0.99)
-    assert chi2_2dof_quantile(0.99) == pytest.approx(9.2103, abs=1e-4)
+def test_the_tracker_gates_are_drawn_on_their_boundary() -> None:
+    """The overlay's ellipse of a real tracker frame: every vertex satisfies dᵀ G⁻¹ d = 1 with
+    the gate shape G the tracker reports (already scaled by its threshold γ)."""
+    from core.tracking import TrackerParams, run_tracker
+
+    ft = run_tracker([np.array([[4.0, 0.2, 0.0]])], TrackerParams()).frames[0]
+    pts = ellipse_polyline(ft.gate_center_xy, ft.gate_shape_xy, 1.0).reshape(len(ft.ids), 34, 2)
+    for k in range(len(ft.ids)):
+        d = pts[k, :-1] - ft.gate_center_xy[k]
+        m = np.einsum("ni,ij,nj->n", d, np.linalg.inv(ft.gate_shape_xy[k]), d)
+        np.testing.assert_allclose(m, 1.0, rtol=1e-9)
 
 
 def test_aoi_outline_and_trails() -> None:

@@ -19,7 +19,7 @@ from app.errors import install_excepthooks
 
 ROOT = Path(__file__).resolve().parents[2]
 
-#: Files that are not scenes, as a new user might pass them (issue 18's kinds).
+#: Files that are not scenes, as a new user might pass them (the kinds the input fuzzing found).
 BAD_SCENES = {
     "binary.json": b"\x89PNG\r\n\x1a\n\x00\x00\xff\xfe\x00binary",
     "latin1.json": b'{"schema_version": 1, "name": "caf\xe9", "persons": []}',
@@ -179,6 +179,20 @@ def _gui(*args: str, tmp_path: Path) -> subprocess.CompletedProcess:
         [sys.executable, "-m", "core.cli", "gui", *args, "--settings", str(tmp_path / "s.ini")],
         cwd=ROOT, env=env, capture_output=True, text=True, timeout=120,
     )  # fmt: skip
+
+
+def test_gui_with_a_settings_value_nested_100000_deep_is_one_line_and_exit_2(tmp_path) -> None:
+    path = tmp_path / "s.ini"
+    text = "[tracker]\nmodel=cv\nvalues=" + "[" * 100_000 + "]" * 100_000 + "\n"
+    path.write_text(text)
+    out = _gui("--quit-after", "0", tmp_path=tmp_path)
+    assert out.returncode == 2, out.stderr
+    assert out.stderr.startswith("radartune gui: error: ")
+    line = out.stderr.rstrip("\n")
+    assert one_line_naming(line, str(path)), out.stderr
+    assert "tracker/values" in line and "nested deeper" in line
+    assert "Traceback" not in out.stderr and out.stdout == ""
+    assert path.read_text() == text  # no window: nothing written back
 
 
 @pytest.mark.parametrize("name", ["binary.json", "deep.json", "truncated.json"])

@@ -1,4 +1,4 @@
-"""The scene editor with several people (issue 14): add up to eight, select, remove; each person
+"""The scene editor with several people: add up to eight, select, remove; each person
 drawn in its own colour, the selected one wider; the list shows the same colours."""
 
 from __future__ import annotations
@@ -46,7 +46,7 @@ def test_editor_adds_selects_removes_and_colours_persons(window) -> None:
 
 def test_study_data_set_of_a_two_person_scene_gives_finite_losses(tmp_path) -> None:
     """The GUI writes the scene on screen as the study's data set; on the shipped two-person
-    scene every trial failed with a NaN loss (issue 14). Person 0 is absent in some frames
+    scene every trial failed with a NaN loss. Person 0 is absent in some frames
     (NaN truth); the data set keeps every person and the loss is finite."""
     import json
     import math
@@ -54,9 +54,8 @@ def test_study_data_set_of_a_two_person_scene_gives_finite_losses(tmp_path) -> N
     import numpy as np
 
     from core.dataset import Dataset
-    from core.optimization import tracker_params_dict
     from core.optimization.objective import TrackerLosses
-    from core.tracking.space import defaults
+    from core.tracking.space import defaults, tracker_params_dict
 
     path = engine.ROOT / "resources" / "scenes" / "two_persons.json"
     scene = engine.scene_from_document(json.loads(path.read_text()), path.parent)

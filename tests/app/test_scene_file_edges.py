@@ -1,5 +1,5 @@
 """``gui --scene FILE`` with a file that is not a scene: the scene loader refuses it with one line
-naming the file (the window shows it; a traceback is never the answer). Issue 18."""
+naming the file (the window shows it; a traceback is never the answer)."""
 
 from __future__ import annotations
 

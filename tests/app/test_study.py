@@ -143,7 +143,7 @@ def test_a_study_resumed_from_an_older_storage_keeps_its_objective(tmp_path, mon
         store.set_study_user_attr(old, key, value)
     asked = []
     monkeypatch.setattr(core.optimization, "start_study", lambda s, **kw: asked.append(s))
-    monkeypatch.setattr("app.engine.StudyProcesses", lambda handle: handle)
+    monkeypatch.setattr("app.engine.studies.StudyProcesses", lambda handle: handle)
     for name in ("old-paper", "new"):
         start_study(StudyForm(storage=db, study_name=name), dataset_path=data)
     assert [s.loss for s in asked] == ["paper", DEFAULT_OBJECTIVE]

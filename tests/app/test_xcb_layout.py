@@ -1,7 +1,7 @@
 """The real window under Xvfb (Qt's xcb platform): ``make test-xcb`` runs this on a 1366x768
 and a 1920x1080 screen, at 100 % and 150 % (``QT_SCALE_FACTOR``). Offscreen it is skipped.
 
-What a user saw clipped or lost (issue 17) is checked on the laid-out window: every panel fits
+What a user saw clipped or lost is checked on the laid-out window: every panel fits
 its dock without a horizontal scroll bar, the "Load TI .cfg" button is inside the dock, the top
 view shows the whole area of interest without wasting most of its height, the range-Doppler
 colour bar's labels are inside the view, and the first track is drawn.

@@ -41,7 +41,7 @@ def test_persons() -> None:
         InputError, match=f"persons lists 9, more than the limit {limits.MAX_PERSONS}"
     ):
         scene(persons=[profile(2)] * (limits.MAX_PERSONS + 1))
-    # and at least one: a scene of nobody is one line too (issue 14: 1–8 persons)
+    # and at least one: a scene of nobody is one line too (1–8 persons)
     with pytest.raises(
         InputError, match=f"persons lists none; a scene holds 1 to {limits.MAX_PERSONS}"
     ):
@@ -194,3 +194,21 @@ def test_person_height() -> None:
         walker = {"model": "walking", "height_m": h, "trajectory": slow}
         with pytest.raises(InputError, match=rf"persons\[0\]\.height_m must be in \[{lo}, {hi}\]"):
             scene(persons=[walker])
+
+
+def test_person_distance() -> None:
+    """A person 1e300 m away is refused at the field (it was simulated with overflow warnings);
+    at the limit it is accepted, and a walk that leaves the limit is refused at its frame."""
+    far = limits.MAX_PERSON_DISTANCE_M
+    p = profile(2)
+    p["trajectory"]["initial_position_m"] = [far, 0.0]
+    assert scene(persons=[p]).persons[0].trajectory.position_m[0, 0] == far
+    p["trajectory"]["initial_position_m"] = [1e300, 5.0]
+    with pytest.raises(InputError, match=r"persons\[0\]\.trajectory\.initial_position_m\[0\]"):
+        scene(persons=[p])
+    # 900 m/s from x = 1 m: 1 + 0.08·900·k passes 1000 m between frames 13 and 14
+    p["trajectory"].update(initial_position_m=[1.0, 0.0], initial_velocity_mps=[900.0, 0.0])
+    p["trajectory"]["frames"] = 20
+    with pytest.raises(InputError, match=r"persons\[0\]\.trajectory is 1\.01e\+03 m from the "
+                       r"radar at frame 14 \(at most 1000 m\)"):  # fmt: skip
+        scene(persons=[p])

@@ -1,7 +1,7 @@
 """Every bad input the CLI reads gets one line on stderr, exit code 2, and nothing written.
 
 One test per kind of input that ended in a traceback, a huge allocation, a run of minutes or a
-``nan`` before (issue 18). The CLI runs in-process (``core.cli.main``)."""
+``nan`` before. The CLI runs in-process (``core.cli.main``)."""
 
 from __future__ import annotations
 
@@ -249,6 +249,19 @@ def test_scene_work_bounded(capsys, tmp_path, change, needle) -> None:
         capsys, "simulate", "--scene", str(path), "--out", str(tmp_path / "o.npz")
     )
     assert_one_line(code, err, "s.json", needle)
+    assert not (tmp_path / "o.npz").exists()
+
+
+def test_scene_with_a_person_1e300_m_away(capsys, tmp_path) -> None:
+    """Before the fix: accepted and simulated with an overflow warning."""
+    far = {"trajectory": {"initial_position_m": [1e300, 5.0], "initial_velocity_mps": [0.0, 0.0],
+                          "acceleration_mps2": [0.0, 0.0], "frames": 5}}  # fmt: skip
+    path = tmp_path / "s.json"
+    path.write_text(json.dumps({**SCENE, "persons": [far]}))
+    code, _, err = run_cli(
+        capsys, "simulate", "--scene", str(path), "--out", str(tmp_path / "o.npz")
+    )
+    assert_one_line(code, err, "s.json", "persons[0].trajectory.initial_position_m[0]", "1e+300")
     assert not (tmp_path / "o.npz").exists()
 
 

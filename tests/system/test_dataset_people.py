@@ -1,5 +1,5 @@
 """``radartune dataset --persons N``: a multi-person data set for studies, reproducible by seed,
-and a short study on it with the multi-person loss (issue 14)."""
+and a short study on it with the multi-person loss."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Every shipped scene simulates and tracks end to end (issue 14): exit 0, no NaN in the text or
+"""Every shipped scene simulates and tracks end to end: exit 0, no NaN in the text or
 the JSON, one metrics entry per person, GOSPA within its bound."""
 
 from __future__ import annotations

@@ -1,6 +1,6 @@
 """Every metric is defined (or reported as undefined with its reason, never NaN) in the cases the
 paper's single-person scenes never reach: no track confirmed, no person, a person absent for some
-frames, several persons (issue 18). Each case is computed by hand."""
+frames, several persons. Each case is computed by hand."""
 
 from __future__ import annotations
 

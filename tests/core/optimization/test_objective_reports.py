@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 
 from core.optimization.objective import QuadraticLosses, evaluate, round_robin_order
-from core.optimization.space import search_space, tracker_params_dict
+from core.optimization.space import search_space
+from core.tracking.space import tracker_params_dict
 
 
 class Recorder:

@@ -10,14 +10,9 @@ import optuna
 import pytest
 
 from core.errors import InputError
-from core.optimization.space import (
-    SEARCH_SPACE,
-    flat_params,
-    search_space,
-    suggest_params,
-    tracker_params_dict,
-)
+from core.optimization.space import SEARCH_SPACE, search_space, suggest_params
 from core.optimization.study import make_sampler
+from core.tracking.space import flat_params, tracker_params_dict
 
 # eq. (15) of the paper, transcribed independently of the implementation
 PAPER = {

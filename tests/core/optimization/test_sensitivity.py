@@ -13,7 +13,8 @@ from core.optimization import StudySettings, prepare_study, run_worker, study_pr
 from core.optimization.objective import QuadraticLosses, make_losses
 from core.optimization.progress import TrialSummary
 from core.optimization.sensitivity import oat_sweep, parameter_importance, sweep_values
-from core.optimization.space import search_space, tracker_params_dict
+from core.optimization.space import search_space
+from core.tracking.space import tracker_params_dict
 from core.tracking.synthetic import synthetic_dataset
 
 

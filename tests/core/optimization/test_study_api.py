@@ -16,10 +16,10 @@ from core.optimization import (
     prepare_study,
     run_worker,
     study_progress,
-    tracker_params_dict,
 )
 from core.optimization.space import search_space
 from core.optimization.study import trial_seed
+from core.tracking.space import tracker_params_dict
 
 
 def settings(tmp_path: Path, **kw) -> StudySettings:
@@ -96,6 +96,41 @@ def test_dead_workers_running_trial_fails_on_resume(tmp_path: Path) -> None:
     states = {t.number: t.state.name for t in study.get_trials()}
     assert states[dead.number] == "FAIL" and states[alive.number] == "RUNNING"
     assert fail_stale_trials(study, stale_after_s=0.0) == [alive.number]
+
+
+def test_a_worker_ended_but_not_yet_reaped_is_dead(tmp_path: Path) -> None:
+    """A killed worker stays a zombie until ``tune`` reaps it (every 0.5 s); a worker finishing
+    the study in that window must free the zombie's RUNNING trial and reach the total."""
+    import socket
+    import subprocess
+    import sys
+    import time
+
+    from core.optimization.study import _start_ticks, worker_alive
+
+    child = subprocess.Popen([sys.executable, "-c", "import sys; sys.stdin.read()"],
+                             stdin=subprocess.PIPE)  # fmt: skip
+    try:
+        wid = f"{socket.gethostname()}:{child.pid}:{_start_ticks(child.pid)}"
+        assert worker_alive(wid) is True
+        child.stdin.close()  # it exits; not polled, so it stays a zombie
+        stat = Path(f"/proc/{child.pid}/stat")
+        deadline = time.monotonic() + 20
+        while stat.read_text().rsplit(")", 1)[1].split()[0] != "Z":
+            assert time.monotonic() < deadline, "the child did not exit"
+            time.sleep(0.02)
+        assert worker_alive(wid) is False
+        s = settings(tmp_path, n_trials=4, pruner="none")
+        prepare_study(s)
+        study = optuna.load_study(study_name=s.name, storage=open_storage(s.storage))
+        orphan = study.ask()
+        orphan.set_user_attr("worker", wid)
+        run_worker(s.storage, s.name, seed=0)
+        states = {t.number: t.state.name for t in study.get_trials()}
+        assert states[orphan.number] == "FAIL"
+        assert list(states.values()).count("COMPLETE") == 4 and "RUNNING" not in states.values()
+    finally:
+        child.wait(10)
 
 
 def test_enqueued_parameters_run_first(tmp_path: Path) -> None:

@@ -10,7 +10,6 @@ from core.scene import (
     AOI,
     TRAJECTORY_CLASSES,
     generate_trajectory,
-    integrate_eq6,
     paper_scenes,
     profile_trajectory,
     waypoint_trajectory,
@@ -26,14 +25,6 @@ def eq6_residual(tr) -> float:
     rv = v[1:] - (v[:-1] + a[:-1] * dt)
     rp = p[1:] - (p[:-1] + v[1:] * dt)
     return float(max(np.abs(rv).max(), np.abs(rp).max()))
-
-
-def test_integrate_eq6_hand_computed() -> None:
-    # p0 = 0, v0 = (1, 0), a = (0, 1): v(1) = (1, 0.08), p(1) = (0.08, 0.0064),
-    # v(2) = (1, 0.16), p(2) = (0.16, 0.0064 + 0.0128)
-    p, v = integrate_eq6(np.zeros(2), np.array([1.0, 0.0]), np.tile([0.0, 1.0], (3, 1)), DT)
-    np.testing.assert_allclose(v, [[1, 0], [1, 0.08], [1, 0.16]], atol=1e-15)
-    np.testing.assert_allclose(p, [[0, 0], [0.08, 0.0064], [0.16, 0.0192]], atol=1e-15)
 
 
 @pytest.mark.parametrize("cls", TRAJECTORY_CLASSES)

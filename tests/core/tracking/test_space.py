@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 from core.errors import InputError
-from core.optimization.space import flat_params, suggest_params, tracker_params_dict
+from core.optimization.space import suggest_params
 from core.tracking.models import process_noise
 from core.tracking.params import DEFAULT_P0, STATE_DIM, TrackerParams
 from core.tracking.space import (
@@ -23,9 +23,11 @@ from core.tracking.space import (
     SEARCH_SPACE,
     Parameter,
     defaults,
+    flat_params,
     p0_names,
     parameter,
     search_space,
+    tracker_params_dict,
 )
 from core.tracking.stability import corner_names, corner_params
 

@@ -1,4 +1,4 @@
-"""The readable tracker: per-frame output for the GUI, the gate ellipse, management rules."""
+"""The readable tracker: per-frame output for the GUI, management rules."""
 
 import numpy as np
 import pytest
@@ -6,7 +6,6 @@ from scipy.stats import chi2
 
 from core.tracking import TrackerParams, run_tracker
 from core.tracking import management as mg
-from core.tracking.tracker import gate_ellipses_xy
 
 
 def test_every_track_is_reported_and_births_follow_the_rules():
@@ -23,17 +22,6 @@ def test_every_track_is_reported_and_births_follow_the_rules():
     assert res.has_estimate.tolist() == [False, True]
     assert res.estimate_id[1] == f1.ids[np.argmax(f1.psi)]
     assert f1.state.shape == (2, 4) and f1.covariance.shape == (2, 4, 4)
-
-
-def test_gate_ellipse_matches_the_gate_shape():
-    res = run_tracker([np.array([[4.0, 0.2, 0.0]])], TrackerParams())
-    ft = res.frames[0]
-    curve = gate_ellipses_xy(ft, 32)
-    assert curve.shape == (34, 2) and np.isnan(curve[-1]).all()
-    d = curve[:-1] - ft.gate_center_xy[0]
-    G = ft.gate_shape_xy[0]
-    # every boundary point satisfies dᵀ G⁻¹ d = 1
-    np.testing.assert_allclose(np.einsum("ij,jk,ik->i", d, np.linalg.inv(G), d), 1.0, rtol=1e-9)
 
 
 def test_merge_keeps_the_higher_psi_and_older_on_ties():
