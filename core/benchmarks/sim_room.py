@@ -20,8 +20,9 @@ from pathlib import Path
 
 import numpy as np
 
+from core.config import PAPER_CLUTTER_DENSITY_PER_M2
+
 SCENE = Path(__file__).resolve().parents[2] / "resources" / "scenes" / "room_walker.json"
-CLUTTER_DENSITY_PER_M2 = 0.02
 BLOCK = 10
 
 
@@ -29,7 +30,7 @@ def _scenes():
     from core.scene import Scene
 
     room = Scene.from_json(SCENE)
-    room = dataclasses.replace(room, clutter_density_per_m2=CLUTTER_DENSITY_PER_M2)
+    room = dataclasses.replace(room, clutter_density_per_m2=PAPER_CLUTTER_DENSITY_PER_M2)
     return room, dataclasses.replace(room, room=None)
 
 
