@@ -28,6 +28,18 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         help="data association: joint IPDA over tracks sharing measurements, or independent "
         "IPDA per track (default: the parameters' 'association', jipda)",
     )
+    p.add_argument(
+        "--mode",
+        choices=("paper", "room"),
+        help="tracker: the paper's one-point IPDA, or the tracker for real rooms (groups of "
+        "points, static points, ghosts; default: the parameters' 'mode', paper)",
+    )
+    p.add_argument(
+        "--zones",
+        metavar="TI_CFG",
+        help="room mode: boundary, static and presence boxes from a TI .cfg's boundaryBox, "
+        "staticBoundaryBox and presenceBoundaryBox lines (default: none)",
+    )
     p.set_defaults(func=run)
 
 
@@ -56,6 +68,15 @@ def run(args: argparse.Namespace) -> int:
     )
     if args.association:
         params = replace(params, association=args.association)
+    if args.mode:
+        params = replace(params, mode=args.mode)
+    zones = None
+    if args.zones:
+        from core.tracking.zones import zones_from_cfg
+
+        if params.mode != "room":
+            raise InputError("--zones needs the room mode (--mode room)")
+        zones = zones_from_cfg(args.zones)
     ds = Dataset.load(args.data)
     traj = None
     if args.trajectories:
@@ -73,7 +94,9 @@ def run(args: argparse.Namespace) -> int:
     # loading the compiled kernels is start-up, not tracking: paid first, reported apart
     startup = load_compiled(params) if args.engine == "numba" else 0.0
     t0 = time.perf_counter()
-    est = track_dataset(ds, params, trajectories=traj, engine=args.engine, with_tracks=True)
+    est = track_dataset(
+        ds, params, trajectories=traj, engine=args.engine, with_tracks=True, zones=zones
+    )
     elapsed = time.perf_counter() - t0
     from core.formats.recording import has_truth
 

@@ -18,6 +18,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from numba.extending import register_jitable
 from scipy.linalg import cho_solve
 
 from core.tracking.ekf import joseph_update, symmetrize
@@ -38,6 +39,7 @@ __all__ = [
 LOG_2PI = math.log(2.0 * math.pi)
 
 
+@register_jitable
 def predict_existence(psi: float, p11: float, p21: float) -> float:
     """ψ⁻ = p11·ψ + p21·(1 − ψ) (eq. 9), clipped to [0, 1]."""
     # ψ⁻ = p11 ψ + p21 (1 − ψ)
