@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import json
 import os
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -21,6 +21,20 @@ from core.pointcloud import POINT_FIELDS, PointCloud
 PER_POINT = ("frame", *POINT_FIELDS, "source")
 PER_FRAME = ("trajectory", "truth_t_s", "truth_xy_m", "truth_v_mps")
 REQUIRED = (*PER_POINT, *PER_FRAME, "trajectory_class", "scene_json", "radar_json")
+#: The reference layer (optional): TI's own tracks of a recording, one entry per track row.
+REF_INT = ("ref_frame", "ref_track_id")
+REF_FLOAT = ("ref_x_m", "ref_y_m", "ref_z_m", "ref_vx_mps", "ref_vy_mps")
+REF_FIELDS = (*REF_INT, *REF_FLOAT)
+#: Optional per-frame head count (-1: unknown) and per-point reference track id (-1: none).
+OPTIONAL_ARRAYS = (*REF_FIELDS, "ref_point_track", "people_count")
+
+
+def _empty_int() -> np.ndarray:
+    return np.zeros(0, dtype=np.int64)
+
+
+def _empty_float() -> np.ndarray:
+    return np.zeros(0, dtype=np.float64)
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -34,6 +48,17 @@ class Dataset:
     Per trajectory (length K): ``trajectory_class`` (``"a"`` … ``"e"`` or ``"drawn"``).
     ``scene_json`` / ``radar_json``: the scene and radar configuration that produced it.
     ``fidelity`` and ``seed`` record how it was simulated.
+
+    Optional, empty (length 0) when absent:
+
+    * the reference layer, TI's own tracks of a recording, one entry per track row (length R,
+      sorted by ``ref_frame``): ``ref_frame`` (the data set's frame index), ``ref_track_id``,
+      ``ref_x_m``, ``ref_y_m``, ``ref_z_m``, ``ref_vx_mps``, ``ref_vy_mps`` (as the firmware
+      reports them);
+    * ``ref_point_track`` (length P): per point, the id of TI's track the firmware associated it
+      with, -1 for none;
+    * ``people_count`` (length F): the number of people present in each frame (a head count),
+      -1 where unknown.
     """
 
     frame: np.ndarray
@@ -55,6 +80,15 @@ class Dataset:
     radar_json: str
     fidelity: str = "exact"
     seed: int = 0
+    ref_frame: np.ndarray = field(default_factory=_empty_int)
+    ref_track_id: np.ndarray = field(default_factory=_empty_int)
+    ref_x_m: np.ndarray = field(default_factory=_empty_float)
+    ref_y_m: np.ndarray = field(default_factory=_empty_float)
+    ref_z_m: np.ndarray = field(default_factory=_empty_float)
+    ref_vx_mps: np.ndarray = field(default_factory=_empty_float)
+    ref_vy_mps: np.ndarray = field(default_factory=_empty_float)
+    ref_point_track: np.ndarray = field(default_factory=_empty_int)
+    people_count: np.ndarray = field(default_factory=_empty_int)
 
     def __post_init__(self) -> None:
         p = np.shape(self.frame)[0] if np.ndim(self.frame) == 1 else -1
@@ -118,6 +152,48 @@ class Dataset:
                 "Dataset.truth_xy_m and truth_v_mps must be NaN together (a person absent from "
                 "a frame has neither position nor velocity)"
             )
+        self._check_optional(p, f)
+
+    def _check_optional(self, p: int, f: int) -> None:
+        r = np.shape(self.ref_frame)[0] if np.ndim(self.ref_frame) == 1 else -1
+        for name in REF_FIELDS:
+            a = getattr(self, name)
+            if np.shape(a) != (r,):
+                raise ValueError(
+                    f"Dataset.{name} must have shape (R,) like ref_frame, got {np.shape(a)}"
+                )
+        for name in (*REF_INT, "ref_point_track", "people_count"):
+            if getattr(self, name).dtype.kind not in "iu":
+                raise ValueError(f"Dataset.{name} must hold integers")
+        if r:
+            if np.any(np.diff(self.ref_frame) < 0):
+                raise ValueError("Dataset.ref_frame must be sorted")
+            if not (0 <= self.ref_frame[0] and self.ref_frame[-1] < f):
+                raise ValueError(
+                    f"Dataset.ref_frame must index the {f} frames, got "
+                    f"{self.ref_frame[0]}..{self.ref_frame[-1]}"
+                )
+            if np.any(self.ref_track_id < 0):
+                raise ValueError("Dataset.ref_track_id must be >= 0")
+            for name in REF_FLOAT:
+                if not np.all(np.isfinite(getattr(self, name))):
+                    raise ValueError(f"Dataset.{name} must be finite")
+        if np.shape(self.ref_point_track) not in ((0,), (p,)):
+            raise ValueError(
+                f"Dataset.ref_point_track must have shape (0,) or ({p},), got "
+                f"{np.shape(self.ref_point_track)}"
+            )
+        if np.any(self.ref_point_track < -1):
+            raise ValueError("Dataset.ref_point_track must be a track id >= 0 or -1 (none)")
+        if np.shape(self.people_count) not in ((0,), (f,)):
+            raise ValueError(
+                f"Dataset.people_count must have shape (0,) or ({f},), got "
+                f"{np.shape(self.people_count)}"
+            )
+        if np.any(self.people_count < -1) or np.any(self.people_count > MAX_PERSONS):
+            raise ValueError(
+                f"Dataset.people_count must be a count in [0, {MAX_PERSONS}] or -1 (unknown)"
+            )
 
     # ---- derived -----------------------------------------------------------------------------
     @property
@@ -131,6 +207,11 @@ class Dataset:
     @property
     def n_persons(self) -> int:
         return self.truth_xy_m.shape[1]
+
+    @property
+    def has_reference(self) -> bool:
+        """True when the data set carries TI's own tracks (the reference layer)."""
+        return len(self.ref_frame) > 0
 
     @property
     def frame_offsets(self) -> np.ndarray:
@@ -238,6 +319,9 @@ class Dataset:
         arrays["radar_json"] = np.array(self.radar_json)
         arrays["fidelity"] = np.array(self.fidelity)
         arrays["seed"] = np.array(self.seed)
+        for name in OPTIONAL_ARRAYS:
+            if len(getattr(self, name)):
+                arrays[name] = getattr(self, name)
         write_npz_atomic(path, arrays)
         return path
 
@@ -252,11 +336,28 @@ class Dataset:
         kw: dict = {}
         for k in (*PER_POINT, *PER_FRAME, "trajectory_class"):
             kw[k] = _typed(data[k], k, src)
+        for k in OPTIONAL_ARRAYS:  # absent from files written before they existed
+            if k in data:
+                kw[k] = _typed(data[k], k, src)
+                if k in REF_FLOAT:
+                    kw[k] = kw[k].astype(np.float64)
+        present = [k for k in REF_FIELDS if k in kw]
+        if present and len(present) != len(REF_FIELDS):
+            missing_ref = [k for k in REF_FIELDS if k not in kw]
+            raise InputError(
+                f"the reference layer is incomplete: missing arrays {missing_ref}", src
+            )
         for k in ("scene_json", "radar_json", *(("fidelity",) if "fidelity" in data else ())):
             kw[k] = _text(data[k], k, src)
         if kw["scene_json"]:
             parse_json(kw["scene_json"], f"{src} (scene_json)")
         radar = parse_json(kw["radar_json"], f"{src} (radar_json)") if kw["radar_json"] else {}
+        if not isinstance(radar, dict):
+            raise InputError(
+                f"radar_json must be a JSON object (the radar configuration), got "
+                f"{kw['radar_json'][:40]!r}",
+                src,
+            )
         if isinstance(radar, dict) and "frame_period_s" in radar:
             t = radar["frame_period_s"]
             lo, hi = FRAME_PERIOD_RANGE_S
@@ -276,7 +377,7 @@ class Dataset:
 
 
 #: dtype kinds accepted per array: integers for indices, real numbers for values, text for class.
-_INTEGER_ARRAYS = ("frame", "source", "trajectory")
+_INTEGER_ARRAYS = ("frame", "source", "trajectory", *REF_INT, "ref_point_track", "people_count")
 
 
 def _typed(a: np.ndarray, name: str, src: str) -> np.ndarray:
@@ -290,9 +391,17 @@ def _typed(a: np.ndarray, name: str, src: str) -> np.ndarray:
     if name in _INTEGER_ARRAYS:
         if a.dtype.kind not in "iu":
             raise InputError(f"{name} must hold integers, got dtype {a.dtype}", src)
+        if name in OPTIONAL_ARRAYS:
+            if a.ndim != 1:
+                raise InputError(f"{name} must be 1-D, got shape {a.shape}", src)
+            if a.dtype.kind == "u" and a.size and int(a.max()) > np.iinfo(np.int64).max:
+                raise InputError(f"{name} holds values beyond int64", src)
+            return a.astype(np.int64)
         return a
     if a.dtype.kind not in "iuf":
         raise InputError(f"{name} must hold real numbers, got dtype {a.dtype}", src)
+    if name in OPTIONAL_ARRAYS and a.ndim != 1:
+        raise InputError(f"{name} must be 1-D, got shape {a.shape}", src)
     return a
 
 

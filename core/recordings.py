@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING
 
 from core.config import RadarConfig
 from core.errors import InputError
-from core.formats import ti_replay, ti_uart, ti_uart_import
+from core.formats import pointcloud_csv, ti_replay, ti_uart, ti_uart_import
 from core.formats.dca1000 import CAPTURE_FORMAT
 from core.formats.recording import Recording
 from core.formats.ti_cfg import read_ti_cfg
@@ -87,7 +87,8 @@ def _read_capture(path: Path, cfg: Path | None) -> Recording:
 
     from core.pipeline.capture import recording_from_capture  # the radar chain: heavy import
 
-    return recording_from_capture(path, cfg)
+    # the partial-frame note is among the recording's notes, which the caller prints: no warning
+    return recording_from_capture(path, cfg, note=lambda line: None)
 
 
 def _write_capture(
@@ -117,9 +118,38 @@ def _dca1000_row() -> FileFormat:
     )
 
 
+def _csv_rows() -> tuple[FileFormat, ...]:
+    return (
+        FileFormat(
+            name=pointcloud_csv.PEOPLE_CSV,
+            description="vendor CSV of TI's people-counting firmware (header time,fN,type; rows "
+            "v6 points, v7 TI's tracks, v8 point-to-track indices)",
+            suffixes=(".csv",),
+            sniff=pointcloud_csv.sniff_people,
+            read=lambda path, cfg: pointcloud_csv.read_people(path, _radar(cfg)),
+        ),
+        FileFormat(
+            name=pointcloud_csv.OOB_CSV,
+            description="out-of-box CSV (Frame #,# Obj,X,Y,Z,Doppler,Intensity[, date and time])",
+            suffixes=(".csv",),
+            sniff=pointcloud_csv.sniff_oob,
+            read=lambda path, cfg: pointcloud_csv.read_oob(path, _radar(cfg)),
+        ),
+        FileFormat(
+            name=pointcloud_csv.MAPPED_CSV,
+            description="any point-cloud CSV with a header, read through --columns "
+            "frame=...,x=...,y=...[,z=,doppler=,snr=,time=]",
+            suffixes=(".csv",),
+            # never detected: a plain CSV says nothing about which column is what
+            sniff=lambda head, path: False,
+            read=lambda path, cfg: pointcloud_csv.read_mapped(path, _radar(cfg), None),
+        ),
+    )
+
+
 #: name -> row, in the order auto-detection tries them.
 FORMATS: dict[str, FileFormat] = {
-    row.name: row for row in (_uart_row(), _replay_row(), _dca1000_row())
+    row.name: row for row in (_uart_row(), _replay_row(), _dca1000_row(), *_csv_rows())
 }
 
 #: Bytes read from the start of a file to recognise its format.
@@ -148,9 +178,22 @@ def detect_format(path: Path) -> FileFormat:
 
 
 def read_recording(
-    path: str | os.PathLike, *, fmt: str | None, cfg: str | os.PathLike | None
+    path: str | os.PathLike,
+    *,
+    fmt: str | None,
+    cfg: str | os.PathLike | None,
+    columns: str | None = None,
 ) -> Recording:
+    """Read ``path`` as format ``fmt`` (None: detected); ``columns``: the column map of a plain
+    CSV (``frame=...,x=...,y=...``; implies ``--format csv``)."""
     path = Path(path)
+    if columns is not None:
+        if fmt not in (None, pointcloud_csv.MAPPED_CSV):
+            raise InputError(f"--columns goes with --format csv, not --format {fmt}")
+        colmap = pointcloud_csv.parse_column_map(columns)
+        if not path.exists():
+            raise InputError("no such file", str(path))
+        return pointcloud_csv.read_mapped(path, _radar(None if cfg is None else Path(cfg)), colmap)
     if not path.exists():
         raise InputError("no such file", str(path))
     if fmt is None:

@@ -10,6 +10,12 @@ Figures, each against a reference measured in the same run (the machine is share
   costs). Target ≥ 50 MB/s (issue 16). Reference: a plain loop that only finds each packet and
   unpacks its points with :mod:`struct` (no checks, no resynchronisation, no arrays), on the
   first quarter of the same bytes; ``ratio`` = reference time / ours (> 1: ours faster).
+- ``csv``: MB/s of the point-cloud CSV readers (:mod:`core.formats.pointcloud_csv`, file →
+  :class:`Recording`) on generated files: an out-of-box CSV (24 points a frame, 13 columns with
+  the date and time, numbers written to 5 decimals like the public gait recordings) and a
+  people-counting vendor CSV (24 ``v6`` points, one ``v7`` track and one ``v8`` index per
+  frame); best of 3 by wall clock and CPU time; target ≥ 20 MB/s; ``ratio_to_uart``: CPU MB/s
+  over the UART reader's in the same run.
 - ``dca1000``: a DCA1000 capture through the exact chain's processing half in frames/s against
   the exact chain's own frames/s on the same frames (:mod:`core.benchmarks.import_adc`).
 """
@@ -74,6 +80,96 @@ def plain_read(data: bytes) -> int:
     return n_points
 
 
+def synthetic_oob_csv(path: Path, n_frames: int, rng: np.random.Generator) -> None:
+    """An out-of-box CSV of ``n_frames`` frames at 0.1 s, :data:`POINTS_PER_PACKET` points each."""
+    n = POINTS_PER_PACKET
+    fn = np.repeat(np.arange(1, n_frames + 1), n)
+    t = 11.0 + (fn - 1) * 0.1
+    rows = np.column_stack(
+        (
+            fn,
+            np.full(len(fn), n),
+            rng.uniform(-3, 3, len(fn)),
+            rng.uniform(0.5, 8, len(fn)),
+            rng.uniform(-1, 2, len(fn)),
+            rng.uniform(-2, 2, len(fn)),
+            rng.integers(150, 400, len(fn)),
+            np.full(len(fn), 2019),
+            np.full(len(fn), 7),
+            np.full(len(fn), 13),
+            np.full(len(fn), 11),
+            (t // 60) % 60,
+            t % 60,
+        )
+    )
+    with open(path, "w") as fh:
+        fh.write("Frame #,# Obj,X,Y,Z,Doppler,,y,m,d,h,m,s\n")
+        np.savetxt(fh, rows, fmt="%d,%d,%.5f,%.5f,%.5f,%.5f,%d,%d,%d,%d,%d,%d,%.3f")
+
+
+def synthetic_people_csv(path: Path, n_frames: int, rng: np.random.Generator) -> None:
+    """A people-counting vendor CSV: per frame 24 ``v6`` points, one ``v7`` track, one ``v8``."""
+    n = POINTS_PER_PACKET
+    header = (
+        "time,fN,type,posX,posY,posZ,velX,velY,velZ,accX,accY,accZ,"
+        + ",".join(f"ec{i}" for i in range(16))
+        + ",g,confi,tid\n"
+    )
+    lines = [header]
+    for k in range(n_frames):
+        stamp = f"2023-06-21 12:{27 + k // 600:02d}:{(k % 600) / 10:09.6f}"
+        r = rng.uniform(0.5, 8, n)
+        el, az = rng.uniform(-0.3, 0.3, n), rng.uniform(-1, 1, n)
+        x, y, z = r * np.cos(el) * np.sin(az), r * np.cos(el) * np.cos(az), r * np.sin(el)
+        pts = np.column_stack((el, az, r, rng.uniform(-2, 2, n), rng.uniform(4, 300, n), x, y, z))
+        prefix = f"{stamp},{k + 1},v6,"
+        lines.extend(prefix + ",".join(repr(float(v)) for v in row) + "\n" for row in pts)
+        track = [1.0, 3.0, 1.0, 0.1, -0.2, 0, 0, 0, 0, *([0.0] * 16), 3.0, 0.99, 0]
+        lines.append(f"{stamp},{k + 1},v7," + ",".join(map(str, track)) + "\n")
+        lines.append(f'{stamp},{k + 1},v8,"[' + ", ".join(["255"] * n) + ']"\n')
+    path.write_text("".join(lines))
+
+
+def _best_of_3(fn, path: Path) -> tuple[float, float]:
+    fn(path, None)  # warm up
+    best = best_cpu = float("inf")
+    for _ in range(3):
+        t0, c0 = time.perf_counter(), time.process_time()
+        fn(path, None)
+        best = min(best, time.perf_counter() - t0)
+        best_cpu = min(best_cpu, time.process_time() - c0)
+    return best, best_cpu
+
+
+def run_csv(quick: bool, uart_cpu_mb_per_s: float) -> dict:
+    from core.formats.pointcloud_csv import read_oob, read_people
+
+    rng = np.random.default_rng(27)
+    out: dict = {}
+    with tempfile.TemporaryDirectory(prefix="radartune-bench-csv-") as tmp:
+        for name, make, reader, frames in (
+            ("oob", synthetic_oob_csv, read_oob, 1_500 if quick else 12_000),
+            ("people", synthetic_people_csv, read_people, 200 if quick else 1_600),
+        ):
+            path = Path(tmp) / f"{name}.csv"
+            make(path, frames, rng)
+            size = path.stat().st_size
+            wall, cpu = _best_of_3(reader, path)
+            out[name] = {
+                "bytes": size,
+                "frames": frames,
+                "points": frames * POINTS_PER_PACKET,
+                "seconds": wall,
+                "cpu_seconds": cpu,
+                "mb_per_s": size / wall / 1e6,
+                "cpu_mb_per_s": size / cpu / 1e6,
+                "ratio_to_uart": size / cpu / 1e6 / uart_cpu_mb_per_s,
+            }
+    out["target_mb_per_s"] = 20.0
+    out["load_average_1min"] = os.getloadavg()[0]
+    return out
+
+
 def run(quick: bool = False) -> dict:
     rng = np.random.default_rng(16)
     n_unique = 256
@@ -119,6 +215,7 @@ def run(quick: bool = False) -> dict:
             "load_average_1min": os.getloadavg()[0],
             "target_mb_per_s": 50.0,
         },
+        "csv": run_csv(quick, size / best_cpu / 1e6),
         "dca1000": import_adc.run(quick),
     }
 
@@ -132,7 +229,15 @@ def summary(result: dict) -> str:
         f"{u['packets']} packets, {u['points']} points; target >= {u['target_mb_per_s']:.0f} "
         f"MB/s); a bare struct loop without checks: {u['reference_cpu_mb_per_s']:.0f} MB/s "
         f"(ratio {u['ratio']:.2f})\n"
-        f"DCA1000 capture through the processing half: {d['capture_fps']:.0f} frames/s, "
+        + "".join(
+            f"{name} CSV import: {c['cpu_mb_per_s']:.0f} MB/s of CPU time, {c['mb_per_s']:.0f} "
+            f"MB/s wall clock ({c['bytes'] / 1e6:.1f} MB, {c['points']} points; target >= "
+            f"{result['csv']['target_mb_per_s']:.0f} MB/s); {c['ratio_to_uart']:.2f}x the UART "
+            "reader's CPU MB/s\n"
+            for name, c in result["csv"].items()
+            if isinstance(c, dict)
+        )
+        + f"DCA1000 capture through the processing half: {d['capture_fps']:.0f} frames/s, "
         f"{d['capture_over_exact']:.2f}x the exact chain's {d['exact_fps']:.0f} frames/s in the "
         f"same run (CPU: {d['capture_over_exact_cpu']:.2f}x; goal >= 1x)"
     )

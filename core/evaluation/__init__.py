@@ -12,6 +12,8 @@
 - :mod:`~core.evaluation.spread` — spread of the person-labelled points around the truth
 - :mod:`~core.evaluation.consistency` — filter consistency: NEES and NIS of the track paired
   with each person against their χ² bands, per class (Bar-Shalom's ANEES test)
+- :mod:`~core.evaluation.reference` — agreement with a recording's reference layer (TI's own
+  tracks): GOSPA and count difference per frame
 - :mod:`~core.evaluation.intervals` — runs over noise seeds compared: ratio of mean losses with a
   paired bootstrap interval and its verdict, rates of runs without a track and of tail events
 """

@@ -33,6 +33,8 @@ from core.pointcloud import PointCloud
 
 #: File names the visualizer writes.
 REPLAY_NAME = re.compile(r"^replay_(\d+)\.json$")
+#: ``frameNum`` is the firmware's 32-bit frame counter.
+FRAME_NUMBER_END = 2**32
 #: Columns of a ``pointCloud`` row: x, y, z, Doppler required; SNR, noise, track index optional.
 POINT_COLUMNS = ("x", "y", "z", "doppler", "snr", "noise", "track")
 
@@ -77,8 +79,10 @@ def _frame_points(item: object, k: int, src: str) -> tuple[int, np.ndarray]:
         raise InputError(f"{where} must be an object with 'frameData'", src)
     fd = item["frameData"]
     fn = fd.get("frameNum")
-    if isinstance(fn, bool) or not isinstance(fn, int) or fn < 0:
-        raise InputError(f"{where}.frameData.frameNum must be an integer >= 0, got {fn!r}", src)
+    if isinstance(fn, bool) or not isinstance(fn, int) or not 0 <= fn < FRAME_NUMBER_END:
+        raise InputError(
+            f"{where}.frameData.frameNum must be an integer in [0, 2^32), got {str(fn)[:40]}", src
+        )
     pc = fd.get("pointCloud", [])
     if not isinstance(pc, list):
         raise InputError(f"{where}.frameData.pointCloud must be a list of rows", src)
@@ -103,7 +107,12 @@ def _frame_points(item: object, k: int, src: str) -> tuple[int, np.ndarray]:
     a = np.full((len(rows), 5), np.nan)
     for i, row in enumerate(rows):
         m = min(len(row), 5)
-        a[i, :m] = row[:m]
+        try:
+            a[i, :m] = [float(c) for c in row[:m]]  # float(): an int beyond int64 is fine
+        except OverflowError:
+            raise InputError(
+                f"{where}.frameData.pointCloud[{i}] holds a number beyond the float range", src
+            ) from None
     return fn, a
 
 

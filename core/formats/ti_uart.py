@@ -41,7 +41,7 @@ import math
 import os
 import struct
 from collections import Counter
-from collections.abc import Callable, Iterable, Iterator
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import NamedTuple, Protocol, TypeVar
@@ -592,6 +592,10 @@ class RawPacket(NamedTuple):
     side_info: bytes
     points: UartPoints | None
     extras: tuple[str, ...]
+    #: The firmware's own tracks (TLV 1010 / 308, :data:`TARGET_3D` records) and target index
+    #: (TLV 1011 / 309, one byte per point of the previous frame), when the packet has them.
+    targets: np.ndarray | None = None
+    target_index: np.ndarray | None = None
 
 
 #: TLV types whose payload the fast path checks by length only.
@@ -614,6 +618,7 @@ def parse_packet_raw(
             continue
         float_points = side = b""
         names: list[str] = []
+        targets = target_index = None
         simple = True
         for t, off, n in tlvs:
             if t == DETECTED_POINTS:
@@ -633,6 +638,10 @@ def parse_packet_raw(
                     simple = False
                     break
                 names.append(AUX_TLVS[t][0])
+                if t in (TARGET_LIST_3D, EXT_TARGET_LIST):
+                    targets = _records(packet, off, n, TARGET_3D).copy()
+                elif t in (TARGET_INDEX, EXT_TARGET_INDEX):
+                    target_index = _records(packet, off, n, np.dtype("u1")).copy()
             else:  # other point formats, unknown types: the full decoder
                 simple = False
                 break
@@ -645,6 +654,8 @@ def parse_packet_raw(
                 side,
                 None,
                 tuple(names),
+                targets,
+                target_index,
             )
         break
     frame = _parse_packet(packet, offset, radar, rep, src)
@@ -658,6 +669,8 @@ def parse_packet_raw(
         b"",
         frame.points,
         tuple(frame.extras),
+        frame.extras.get("targets"),
+        frame.extras.get("target_index"),
     )
 
 
@@ -761,7 +774,7 @@ def _detected_points(
                 y_m=p["y"] * scale,
                 z_m=p["z"] * scale,
                 velocity_mps=p["doppler_idx"] * dv,
-                snr_db=nan,
+                snr_db=peak_db(p["peak"]),
                 noise_db=nan,
             ),
             "q",
@@ -777,6 +790,29 @@ def _detected_points(
         ),
         "float",
     )
+
+
+def peak_db(peak: np.ndarray) -> np.ndarray:
+    """The level of SDK 1.x/2.x points in dB from their ``peakVal``: ``20·log10(peakVal)``.
+
+    TI's SDK 1.x/2.x demos set ``peakVal`` to the magnitude of the angle-FFT peak,
+    ``sqrt(max|X_az|² / (N_range·N_angle·N_Doppler))`` (xWR16xx DSP data path; the xWR14xx
+    hardware accelerator's ``|X_az|`` directly), a linear amplitude: 20·log10 puts it on a dB
+    scale. The packet carries no noise level, so this is the point's level above one FFT unit,
+    not a signal-to-noise ratio (for SDK 3, TI gives ``peak dB = snr + noise``, both in the side
+    info). ``peakVal`` 0 gives NaN (no level)."""
+    a = np.asarray(peak, dtype=np.float64)
+    with np.errstate(divide="ignore"):
+        return np.where(a > 0, 20.0 * np.log10(np.where(a > 0, a, 1.0)), np.nan)
+
+
+def linear_snr_db(snr: np.ndarray) -> np.ndarray:
+    """The people-tracking demo's point SNR, which TI's output structure documents as linear
+    (``Pcount3DDemo_output_message_point.snr``: "Range detection SNR, linear"), in dB:
+    ``10·log10(snr)``; 0 (or less) gives NaN."""
+    a = np.asarray(snr, dtype=np.float64)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(a > 0, 10.0 * np.log10(np.where(a > 0, a, 1.0)), np.nan)
 
 
 def _ext_points(packet: bytes, off: int, n: int) -> UartPoints:
@@ -819,7 +855,7 @@ def _compressed_points(packet: bytes, off: int, n: int) -> UartPoints:
         p["azimuth"] * az_u,
         p["elevation"] * el_u,
         p["doppler"] * dop_u,
-        p["snr"] * snr_u,
+        linear_snr_db(p["snr"] * snr_u),
     )
 
 
@@ -850,7 +886,8 @@ COMPRESSED_UNITS = {
     "azimuth_unit": math.pi / 127,
     "doppler_unit": 2.0**-8,
     "range_unit": 2.0**-8,
-    "snr_unit": 0.04,
+    # linear SNR steps of 0.25: up to 16 383 (42 dB), 0.17 dB steps at 5 dB
+    "snr_unit": 0.25,
 }
 #: Platform codes written in the header.
 PLATFORM = {"xwr68xx": 0xA6843, "xwr14xx": 0xA1443, "xwrl6432": 0x6432}
@@ -871,8 +908,11 @@ def encode_frame(
     fmt: str = "sdk3",
     radar: RadarConfig | None = None,
     time_cpu_cycles: int = 0,
+    extra_tlvs: Sequence[tuple[int, bytes]] = (),
 ) -> bytes:
-    """One packet holding ``cloud`` in point format ``fmt`` (:data:`WRITE_FORMATS`).
+    """One packet holding ``cloud`` in point format ``fmt`` (:data:`WRITE_FORMATS`), then the
+    TLVs ``extra_tlvs`` (type, payload) as given (e.g. TI's tracks, 1010, and target index,
+    1011).
 
     ``sdk3``: float points (type 1) and side info (type 7), 40-byte header, xWR68xx;
     ``sdk2``: Q9 points (type 1 with descriptor), 40-byte header (xWR16xx SDK 2.x);
@@ -904,7 +944,8 @@ def encode_frame(
         p["range_idx"] = _clip_round(
             np.asarray(cloud.range_m) / radar.range_resolution_m, np.uint16
         )
-        p["peak"] = _clip_round(np.maximum(snr, 0) * 100, np.uint16)
+        # peakVal: the amplitude whose 20·log10 is the level (the reader's peak_db)
+        p["peak"] = np.maximum(_clip_round(10.0 ** (snr / 20.0), np.uint16), 1)
         tlvs.append((DETECTED_POINTS, d.tobytes() + p.tobytes()))
         if fmt == "sdk1-xwr14":
             platform = PLATFORM["xwr14xx"]
@@ -935,10 +976,12 @@ def encode_frame(
         p["range"] = _clip_round(
             np.asarray(cloud.range_m) / COMPRESSED_UNITS["range_unit"], np.uint16
         )
-        p["snr"] = _clip_round(snr / COMPRESSED_UNITS["snr_unit"], np.uint16)
+        # the demo's SNR is linear (see linear_snr_db)
+        p["snr"] = _clip_round(10.0 ** (snr / 10.0) / COMPRESSED_UNITS["snr_unit"], np.uint16)
         tlvs.append((COMPRESSED_POINTS, u.tobytes() + p.tobytes()))
     else:
         raise InputError(f"UART point format must be one of {list(WRITE_FORMATS)}, got {fmt!r}")
+    tlvs += list(extra_tlvs)
     hdr_dtype = HEADER_36 if fmt == "sdk1-xwr14" else HEADER_40
     body = b"".join(np.array([(t, len(pl))], TLV_HEADER).tobytes() + pl for t, pl in tlvs)
     used = hdr_dtype.itemsize + len(body)

@@ -15,7 +15,12 @@ import numpy as np
 from core.config import PAPER_RADAR, RadarConfig
 from core.errors import InputError
 from core.formats import ti_uart
-from core.formats.recording import Recording, frames_from_numbers, points_to_cloud
+from core.formats.recording import (
+    Recording,
+    frames_from_numbers,
+    point_tracks_from_indices,
+    points_to_cloud,
+)
 from core.limits import MAX_DATASET_FRAMES
 from core.pointcloud import PointCloud
 
@@ -40,6 +45,9 @@ def read(
     numbers: list[int] = []
     counts: list[int] = []
     extras: set[str] = set()
+    # TI's own tracks: (packet index, targets), (packet index, target index bytes)
+    targets: list[tuple[int, np.ndarray]] = []
+    target_index: list[tuple[int, np.ndarray]] = []
     source = chunks if chunks is not None else path
     for k, pk in enumerate(
         ti_uart.iter_raw_packets(source, radar=radar, report=report, name=str(path))
@@ -63,8 +71,13 @@ def read(
         counts.append(n)
         if pk.extras:
             extras.update(pk.extras)
+        if pk.targets is not None and len(pk.targets):
+            targets.append((k, pk.targets))
+        if pk.target_index is not None:
+            target_index.append((k, pk.target_index))
     pkt_counts = np.asarray(counts, dtype=np.int64)
     x, y, z, v, snr = _assemble(raw, raw_side, decoded, pkt_counts)
+    point_track = point_tracks_from_indices(pkt_counts, target_index)[0] if target_index else None
     cloud, keep = points_to_cloud(x, y, z, v, snr)
     if not keep.all():
         # points with a non-finite coordinate or velocity are dropped (counted)
@@ -81,9 +94,16 @@ def read(
         notes.append(
             f"no --cfg: frame period {cfg.frame_period_s * 1e3:g} ms and radar of the paper assumed"
         )
-    if extras:
+    kept = {"targets", "target_index"}
+    if extras - kept:
         notes.append(
-            "auxiliary TLVs read and not kept in the data set: " + ", ".join(sorted(extras))
+            "auxiliary TLVs read and not kept in the data set: " + ", ".join(sorted(extras - kept))
+        )
+    ref_tracks = _ref_tracks(targets, slot)
+    if ref_tracks is not None:
+        notes.append(
+            f"TI's own tracks kept as the reference layer: {len(ref_tracks['frame'])} track rows "
+            f"of {len(np.unique(ref_tracks['track_id']))} track ids"
         )
     return Recording(
         format="uart",
@@ -99,7 +119,28 @@ def read(
             "damaged_packets": report.n_damaged,
             "unknown_tlvs": {str(k): v for k, v in report.unknown_tlvs.items()},
         },
+        ref_tracks=ref_tracks,
+        ref_point_track=point_track[keep] if point_track is not None else None,
     )
+
+
+def _ref_tracks(targets: list[tuple[int, np.ndarray]], slot: np.ndarray) -> dict | None:
+    """TLV 1010 / 308 records as reference-layer rows (frame = the packet's output frame)."""
+    if not targets:
+        return None
+    t = np.concatenate([a for _, a in targets])
+    frame = np.concatenate([np.full(len(a), slot[k], dtype=np.int64) for k, a in targets])
+    pos = t["pos"].astype(np.float64)
+    vel = t["vel"].astype(np.float64)
+    return {
+        "frame": frame,
+        "track_id": t["tid"].astype(np.int64),
+        "x_m": pos[:, 0],
+        "y_m": pos[:, 1],
+        "z_m": pos[:, 2],
+        "vx_mps": vel[:, 0],
+        "vy_mps": vel[:, 1],
+    }
 
 
 #: Side info of a packet without TLV 7: the most negative int16, read back as "no SNR".

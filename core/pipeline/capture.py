@@ -38,7 +38,7 @@ from core.formats.ti_cfg import adc_format, parse_ti_cfg, read_ti_capture_cfg, t
 from core.limits import MAX_DATASET_FRAMES
 from core.pipeline.frames import frame_inputs
 from core.pipeline.plan import plan
-from core.pointcloud import PointCloud
+from core.pointcloud import POINT_FIELDS, PointCloud
 from core.scene import Scene
 
 #: Receiver noise of written captures: standard deviation of I (and of Q) in ADC counts. The
@@ -160,6 +160,15 @@ def recording_from_capture(
         (note or _warn)(capture.dropped_note)
         notes.append(capture.dropped_note)
     clouds = list(iter_capture_clouds(radar, capture, settings=settings, elevation=elevation))
+    clouds, dropped = _finite_points(clouds)
+    if dropped:
+        line = (
+            f"{printable(str(bin_path))}: {dropped} points without a finite value dropped (a "
+            f"noise estimate of 0); {_saturated_fraction(bin_path):.1%} of the capture's words "
+            "are at full scale (-32768 or 32767): a saturated ADC, whose points are not to be "
+            "trusted"
+        )
+        notes.append(line)
     counts = np.array([len(c) for c in clouds], dtype=np.int64)
     return Recording(
         format=CAPTURE_FORMAT,
@@ -170,6 +179,34 @@ def recording_from_capture(
         radar=radar,
         notes=tuple(notes),
     )
+
+
+def _finite_points(clouds: list[PointCloud]) -> tuple[list[PointCloud], int]:
+    """The clouds without points holding a non-finite value (the SNR of a cell whose noise
+    estimate is 0, as in a saturated capture), and how many were dropped."""
+    out, dropped = [], 0
+    for c in clouds:
+        ok = np.ones(len(c), dtype=bool)
+        for name in POINT_FIELDS:
+            ok &= np.isfinite(getattr(c, name))
+        if not ok.all():
+            dropped += int((~ok).sum())
+            c = PointCloud(**{f: getattr(c, f)[ok] for f in POINT_FIELDS}, source=c.source[ok])
+        out.append(c)
+    return out, dropped
+
+
+def _saturated_fraction(bin_path: str | os.PathLike) -> float:
+    """The fraction of the capture's 16-bit words at full scale."""
+    words = np.memmap(bin_path, dtype="<i2", mode="r")
+    if not len(words):
+        return 0.0
+    full = 0
+    step = 1 << 22
+    for k in range(0, len(words), step):
+        w = np.asarray(words[k : k + step])
+        full += int(np.count_nonzero((w == 32767) | (w == -32768)))
+    return full / len(words)
 
 
 def dataset_from_capture(

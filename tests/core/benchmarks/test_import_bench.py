@@ -21,3 +21,17 @@ def test_synthetic_log_reads_the_same_in_both_readers() -> None:
     assert rec.counts.tolist() == [POINTS_PER_PACKET] * 20
     assert "0 dropped" in rec.notes[0] and "range_profile" in rec.notes[-1]
     assert np.all(rec.cloud.snr_db >= 5.0)  # side info (50..300 x 0.1 dB) attached to points
+
+
+def test_synthetic_csvs_read_to_their_points(tmp_path: Path) -> None:
+    """The CSV benchmark's files are valid: every frame, every point, a 0.1 s period."""
+    from core.benchmarks.import_ import synthetic_oob_csv, synthetic_people_csv
+    from core.formats.pointcloud_csv import read_oob, read_people
+
+    rng = np.random.default_rng(5)
+    synthetic_oob_csv(tmp_path / "o.csv", 30, rng)
+    synthetic_people_csv(tmp_path / "p.csv", 30, rng)
+    for rec in (read_oob(tmp_path / "o.csv", None), read_people(tmp_path / "p.csv", None)):
+        assert rec.counts.tolist() == [POINTS_PER_PACKET] * 30
+        assert abs(rec.radar.frame_period_s - 0.1) < 1e-6
+    assert read_people(tmp_path / "p.csv", None).ref_tracks is not None

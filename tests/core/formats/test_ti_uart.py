@@ -105,6 +105,8 @@ def test_sdk1_sdk2_q_format(platform, subframe, version, hlen) -> None:
     # v = Doppler index x velocity resolution
     dv = PAPER_RADAR.velocity_resolution_mps
     np.testing.assert_allclose(f.points.velocity_mps, [3 * dv, -2 * dv])
+    # level = 20·log10(peakVal), peakVal the angle-FFT peak's amplitude
+    np.testing.assert_allclose(f.points.snr_db, 20 * np.log10([500, 900]))
 
 
 def test_q_format_without_cfg_is_one_line() -> None:
@@ -166,6 +168,8 @@ def test_people_tracking_tlvs() -> None:
         [f.points.x_m[0], f.points.y_m[0]], [r * math.sin(az), r * math.cos(az)], rtol=1e-6
     )
     np.testing.assert_allclose(f.points.velocity_mps, [-0.5], rtol=1e-6)
+    # TI: "Range detection SNR, linear": 500 x 0.04 = 20, 13.01 dB
+    np.testing.assert_allclose(f.points.snr_db, [10 * math.log10(20.0)], rtol=1e-6)
     assert f.extras["targets"]["tid"][0] == 5
     np.testing.assert_allclose(f.extras["targets"]["pos"][0], [0.1, 2.9, 1.0], rtol=1e-6)
     assert f.extras["target_index"].tolist() == [5] and f.extras["presence"].tolist() == [1]
@@ -323,6 +327,12 @@ def test_round_trip_to_the_formats_precision(fmt) -> None:
             assert np.all(
                 np.abs(p.velocity_mps - c.radial_velocity_mps) <= lsb["velocity_mps"] / 2 + 1e-6
             )
+            # linear SNR in steps of snr_unit: within half a step, in dB
+            lin = 10 ** (c.snr_db / 10)
+            half = ti_uart.COMPRESSED_UNITS["snr_unit"] / 2
+            bound = 10 * np.log10(lin / (lin - half)) + 1e-6  # rounding down: the larger
+            in_range = lin < 65535 * ti_uart.COMPRESSED_UNITS["snr_unit"]
+            assert np.all(np.abs(p.snr_db - c.snr_db)[in_range] <= bound[in_range])
         else:  # integer formats: within half a step (round to nearest), float32 units aside
             for a, b in ((p.x_m, c.x_m), (p.y_m, c.y_m), (p.z_m, c.z_m)):
                 assert np.all(np.abs(a - b) <= lsb["xyz_m"] / 2 * (1 + 1e-6))
@@ -330,6 +340,10 @@ def test_round_trip_to_the_formats_precision(fmt) -> None:
                 np.abs(p.velocity_mps - c.radial_velocity_mps)
                 <= lsb["velocity_mps"] / 2 * (1 + 1e-6)
             )
+            if fmt != "sdk5":  # peakVal: an integer amplitude, 20·log10 of it the level
+                amp = 10 ** (c.snr_db / 20)
+                bound = 20 * np.log10(amp / (amp - 0.5)) + 1e-6  # rounding down: the larger
+                assert np.all(np.abs(p.snr_db - c.snr_db) <= bound)
 
 
 def test_import_inserts_empty_frames_for_gaps_and_splits_runs(tmp_path) -> None:
