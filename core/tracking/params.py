@@ -95,6 +95,7 @@ class TrackerParams:
     association: str = "jipda"
     mode: str = "paper"
     static_velocity: float = parameter("static_velocity").default
+    static_time: float = parameter("static_time").default
     body_sigma: float = parameter("body_sigma").default
     body_velocity_sigma: float = parameter("body_velocity_sigma").default
     alloc_points: float = parameter("alloc_points").default

@@ -66,6 +66,7 @@ class RoomConstants(NamedTuple):
     ghost_gap: float
     ghost_bearing: float
     ghost_velocity: float
+    static_frames: float
     boundary: np.ndarray
     static_boxes: np.ndarray
 
@@ -99,6 +100,8 @@ def room_constants(params: TrackerParams, frame_period_s: float, zones: Zones) -
         ghost_gap=float(params.ghost_gap),
         ghost_bearing=float(params.ghost_bearing),
         ghost_velocity=float(params.ghost_velocity),
+        # static_time in frames (T validated by TrackerConstants.build above)
+        static_frames=float(params.static_time) / float(frame_period_s),
         boundary=zones.boundary_array(),
         static_boxes=zones.static_array(),
     )
@@ -112,7 +115,7 @@ def _gate_xy(x, S, gamma, gc, gs):
     J = np.zeros((2, 2))
     J[0, 0], J[0, 1] = math.sin(az), r * math.cos(az)
     J[1, 0], J[1, 1] = math.cos(az), -r * math.sin(az)
-    G = gamma * (J @ S[:2, :2] @ J.T)
+    G = gamma * (J @ np.ascontiguousarray(S[:2, :2]) @ J.T)
     gc[0], gc[1] = px, py
     gs[:, :] = G
 
@@ -166,6 +169,7 @@ def room_frames(
     ghost = np.zeros(cap + 1, dtype=np.bool_)
     birth = np.zeros(cap + 1, dtype=np.int64)
     strength = np.zeros(cap + 1)
+    still = np.zeros(cap + 1, dtype=np.int64)  # frames since the track's last moving point
     height = np.zeros(cap + 1)
     npts = np.zeros(cap + 1, dtype=np.int64)
     nis = np.zeros(cap + 1)
@@ -217,15 +221,18 @@ def room_frames(
                 else:
                     rhos[k] = c.rho
                 _gate_xy(xp, S, c.gamma, gc[k], gs[k])
-                nu = np.zeros(3)
+                l00, l10, l11, l20, l21, l22 = L[0, 0], L[1, 0], L[1, 1], L[2, 0], L[2, 1], L[2, 2]
                 for j in range(m):
                     if not used[j]:
                         continue
-                    nu[0] = z[j, COL_R] - zp[0]
-                    nu[1] = ((z[j, COL_AZ] - zp[1] + math.pi) % (2.0 * math.pi)) - math.pi
-                    nu[2] = z[j, COL_VR] - zp[2]
-                    w = np.linalg.solve(L, nu)
-                    d2 = w[0] * w[0] + w[1] * w[1] + w[2] * w[2]
+                    n0 = z[j, COL_R] - zp[0]
+                    n1 = ((z[j, COL_AZ] - zp[1] + math.pi) % (2.0 * math.pi)) - math.pi
+                    n2 = z[j, COL_VR] - zp[2]
+                    # d² = ‖L⁻¹ν‖², forward substitution on the 3×3 factor
+                    w0 = n0 / l00
+                    w1 = (n1 - l10 * w0) / l11
+                    w2 = (n2 - l20 * w0 - l21 * w1) / l22
+                    d2 = w0 * w0 + w1 * w1 + w2 * w2
                     if d2 <= c.gamma:
                         score = d2 + log_det
                         if score < best[j]:
@@ -233,8 +240,17 @@ def room_frames(
                             owner[j] = k
             # 3.-4. each track's group updates it
             for k in range(nt):
-                # the track in a static box: its predicted x, y and its height
-                in_static = in_any_box(XP[k, 0], XP[k, 1], height[k], c.static_boxes)
+                # static points count while the track stands in a static box (its predicted
+                # x, y and its height) and has been still for at most static_frames frames
+                moving = 0
+                for j in range(m):
+                    if owner[j] == k and not static[j]:
+                        moving += 1
+                still[k] = 0 if moving > 0 else still[k] + 1
+                in_static = (
+                    in_any_box(XP[k, 0], XP[k, 1], height[k], c.static_boxes)
+                    and still[k] <= c.static_frames
+                )
                 n = 0
                 for j in range(m):
                     if owner[j] == k and (in_static or not static[j]):
@@ -290,6 +306,7 @@ def room_frames(
                 conf[nt] = False
                 birth[nt] = frame
                 strength[nt] = snr
+                still[nt] = 0
                 height[nt] = zsum / n
                 npts[nt] = 0
                 nis[nt] = math.nan
@@ -310,6 +327,7 @@ def room_frames(
                         X[keep], P[keep], psi[keep], ids[keep] = X[k], P[k], psi[k], ids[k]
                         conf[keep], ghost[keep], birth[keep] = conf[k], ghost[k], birth[k]
                         strength[keep], height[keep] = strength[k], height[k]
+                        still[keep] = still[k]
                         npts[keep], nis[keep] = npts[k], nis[k]
                         gc[keep], gs[keep] = gc[k], gs[k]
                     keep += 1

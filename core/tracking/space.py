@@ -144,6 +144,8 @@ SEARCH_SPACE: tuple[Parameter, ...] = (
     # recordings, docs/decisions/tracker-08-room-mode.md); appended: the paper's order is kept
     Parameter(name="static_velocity", symbol="v_static", meaning="zero-Doppler limit",
               unit="m/s", low=0.001, high=0.3, log=True, modes=("room",), default=0.02),
+    Parameter(name="static_time", symbol="t_static", meaning="time kept on static points",
+              unit="s", low=0.5, high=600.0, log=True, modes=("room",), default=60.0),
     Parameter(name="body_sigma", symbol="σ_body", meaning="body spread", unit="m",
               low=0.05, high=1.0, log=True, modes=("room",), default=0.3),
     Parameter(name="body_velocity_sigma", symbol="σ_vbody", meaning="body velocity spread",

@@ -20,7 +20,7 @@ T = 0.1
 ROOM_SET = dict(
     static_velocity=0.02, body_sigma=0.3, body_velocity_sigma=0.5, alloc_points=5.0,
     alloc_snr=60.0, alloc_distance=0.6, alloc_velocity=0.6, ghost_gap=0.5, ghost_bearing=0.25,
-    ghost_velocity=0.5,
+    ghost_velocity=0.5, static_time=60.0,
 )  # fmt: skip
 ROOM = TrackerParams(mode="room", **ROOM_SET)
 
@@ -115,6 +115,13 @@ def test_stopped_person_is_kept_in_the_static_zone_and_let_go_outside_it():
         frames_to_go += 1
     assert gone.n_tracks[15 + frames_to_go :].max() == 0
     assert gone.n_tracks[15 : 15 + frames_to_go - 1].min() == 1
+    # in the static box but for at most t_static = 2 s (20 frames) still: kept 20 frames, then
+    # let go as outside
+    brief = TrackerParams(mode="room", **(ROOM_SET | {"static_time": 2.0}))
+    res = run_room_tracker(frames, brief, T, inside)
+    assert res.n_confirmed[15 : 15 + 20].min() == 1
+    assert res.n_tracks[15 + 20 + frames_to_go :].max() == 0
+    assert res.n_tracks[15 + 20 + frames_to_go - 2] == 1
 
 
 def test_boundary_box_drops_points_outside_it():
@@ -249,7 +256,7 @@ def test_plain_python_and_compiled_agree(params):
 def test_room_parameters_join_the_search_space_and_stay_out_of_the_paper_mode():
     assert len(search_space("cv")) == 12 and len(search_space("ca")) == 14
     assert [p.name for p in search_space("cv", "room")][12:] == list(ROOM_NAMES)
-    assert len(ROOM_NAMES) == 10
+    assert len(ROOM_NAMES) == 11
     paper = TrackerParams.default()
     assert paper.mode == "paper" and not set(ROOM_NAMES) & set(paper.to_dict())
     d = ROOM.to_dict()
