@@ -417,8 +417,12 @@ def track_frame(ft) -> TrackFrame:
     names, per track); otherwise −1 and NaN.
     """
     n = len(ft.ids)
-    state = np.asarray(ft.state, dtype=float).reshape(n, -1)
-    cov = np.asarray(ft.covariance, dtype=float).reshape(n, state.shape[1], state.shape[1])
+    state = np.asarray(ft.state, dtype=float)
+    # the state dimension from the array itself: reshape(0, -1) cannot infer it for a frame
+    # without tracks (a recording that starts with empty frames)
+    d = state.shape[-1] if state.ndim == 2 else (state.size // n if n else 4)
+    state = state.reshape(n, d)
+    cov = np.asarray(ft.covariance, dtype=float).reshape(n, d, d)
     n_assoc = getattr(ft, "n_associated", None)
     nis = getattr(ft, "nis", None)
     return TrackFrame(

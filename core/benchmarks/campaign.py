@@ -3,8 +3,9 @@
 ``radartune bench campaign [--quick]`` writes ``bench/results/campaign.json`` and renders the
 tables and plots (``--render-only`` re-renders them from the JSON). Long: about 48 studies.
 
-A. **Objective comparison.** Every objective of :data:`core.evaluation.robust.OBJECTIVES` × CV,
-   CA × study indices ``0 … n−1``: a TPE + ASHA study (sampler seed *i*, training set
+A. **Objective comparison.** Every position objective
+   (:data:`core.evaluation.robust.POSITION_OBJECTIVES`) × CV, CA × study indices ``0 … n−1``:
+   a TPE + ASHA study (sampler seed *i*, training set
    ``paper:i:walking``, one worker, journal storage), its choice by validation on
    ``paper:1000:walking`` among its 10 best trials (:func:`validate_study`), that choice scored
    on the 20 test sets ``paper:2000 … 2019:walking`` (:func:`score_choice`) — also with the
@@ -41,7 +42,7 @@ from typing import Any
 import numpy as np
 
 from core.evaluation.intervals import two_level_bootstrap
-from core.evaluation.robust import FAR_FRAMES, OBJECTIVES
+from core.evaluation.robust import FAR_FRAMES, POSITION_OBJECTIVES
 from core.files import save_figure
 
 MODELS = ("cv", "ca")
@@ -66,7 +67,7 @@ PERSON = "walking"
 class Settings:
     """One campaign (decision evaluation-07)."""
 
-    objectives: tuple[str, ...] = tuple(OBJECTIVES)
+    objectives: tuple[str, ...] = POSITION_OBJECTIVES
     compare_seeds: tuple[int, ...] = (0, 1, 2, 3)
     compare_trials: int = 300
     final_seeds: tuple[int, ...] = tuple(range(8))

@@ -21,6 +21,12 @@ one command share one session's slice) are recorded beside it, and CPU time per 
 figure that load disturbs least. The point-person data set's SQLite
 2-job study and references are measured too, for comparison with earlier figures.
 Goal (issue 15): at least 20 trials/s with 2 jobs on SQLite.
+
+``radartune bench tune --recording REC.npz [--people N]`` measures instead a study on a
+recording (an imported data set without truth), cut to its first :data:`RECORDING_FRAMES`
+frames, minimising the objective without positions a recording study minimises (fragmentation
+with a head count, else nis): the same references (bare objective, in-memory study, one worker
+in process) and the SQLite studies with 1 and 2 jobs; same goal.
 """
 
 from __future__ import annotations
@@ -35,16 +41,21 @@ from typing import Any
 import numpy as np
 
 GOAL_TRIALS_PER_S_2_JOBS = 20.0
+#: Frames of the recording a recording study is measured on.
+RECORDING_FRAMES = 2000
 
 
-def _reference(dataset_path: str, n: int) -> dict[str, float]:
+def _reference(
+    dataset_path: str, n: int, *, loss: str = "paper", people: int | None = None
+) -> dict[str, float]:
     """The bare objective in this process: a full (unpruned) trial's work, no Optuna."""
     from core.dataset import Dataset
-    from core.optimization.objective import TrackerLosses, evaluate
+    from core.optimization.objective import evaluate, tracker_losses
     from core.optimization.space import search_space, tracker_params_dict
 
     ds = Dataset.load(dataset_path)
-    losses = TrackerLosses(ds, capped=False)  # the work of a default (paper-loss) trial
+    # the work of a default (paper-loss) trial, or of the recording study's objective
+    losses = tracker_losses(ds, loss, people=people)
     rng = np.random.default_rng(0)
 
     def draw() -> dict[str, Any]:
@@ -56,15 +67,16 @@ def _reference(dataset_path: str, n: int) -> dict[str, float]:
                 flat[b.name] = float(rng.uniform(b.low, b.high))
         return tracker_params_dict(flat, "cv")
 
-    evaluate(losses, draw())  # compile / warm caches
+    evaluate(losses, draw(), loss=loss)  # compile / warm caches
     t0, c0 = time.perf_counter(), time.process_time()
     for _ in range(n):
-        evaluate(losses, draw())
+        evaluate(losses, draw(), loss=loss)
     dt, dc = time.perf_counter() - t0, time.process_time() - c0
     return {"trials": n, "seconds": dt, "trials_per_s": n / dt, "cpu_s_per_trial": dc / n}
 
 
-def _settings(dataset_path: str, storage: str, n_jobs: int, n_trials: int) -> Any:
+def _settings(dataset_path: str, storage: str, n_jobs: int, n_trials: int, **study: Any) -> Any:
+    """The bench study's settings; ``study``: ``loss`` and ``people`` of a recording study."""
     from core.optimization.study import StudySettings
 
     return StudySettings(
@@ -74,6 +86,7 @@ def _settings(dataset_path: str, storage: str, n_jobs: int, n_trials: int) -> An
         storage=storage,
         dataset=dataset_path,
         study_name=f"bench-cv-{n_jobs}-{time.time_ns()}",  # one storage may hold several
+        **study,
     )
 
 
@@ -104,12 +117,12 @@ def cpu_share(seconds: float = 0.5) -> float:
     return (time.process_time() - c0) / (time.perf_counter() - t0)
 
 
-def _in_process(dataset_path: str, storage: str, n_trials: int) -> dict[str, Any]:
+def _in_process(dataset_path: str, storage: str, n_trials: int, **study: Any) -> dict[str, Any]:
     """The study with one worker in this process (no process start-up): Optuna's in-memory
     storage (``memory://``) for the reference, or a file or server storage."""
     from core.optimization.study import prepare_study, run_worker
 
-    s = _settings(dataset_path, storage, 1, n_trials)
+    s = _settings(dataset_path, storage, 1, n_trials, **study)
     prepare_study(s, dataset_path=dataset_path)
     share = cpu_share()
     t0, c0 = time.perf_counter(), time.process_time()
@@ -126,10 +139,12 @@ def _in_process(dataset_path: str, storage: str, n_trials: int) -> dict[str, Any
     return r
 
 
-def _study(dataset_path: str, storage: str, n_jobs: int, n_trials: int) -> dict[str, Any]:
+def _study(
+    dataset_path: str, storage: str, n_jobs: int, n_trials: int, **study: Any
+) -> dict[str, Any]:
     from core.optimization.study import start_study
 
-    s = _settings(dataset_path, storage, n_jobs, n_trials)
+    s = _settings(dataset_path, storage, n_jobs, n_trials, **study)
     share = cpu_share()
     load0 = os.getloadavg()[0]
     cpu0 = resource.getrusage(resource.RUSAGE_CHILDREN)
@@ -162,19 +177,20 @@ def _dataset_runs(
     jobs: tuple[int, ...],
     *,
     in_process: bool = True,
+    **study: Any,
 ) -> dict[str, Any]:
-    ref = _reference(dataset_path, n_ref)
-    memory = _in_process(dataset_path, f"memory://bench-{time.time_ns()}", n_trials)
+    ref = _reference(dataset_path, n_ref, **study)
+    memory = _in_process(dataset_path, f"memory://bench-{time.time_ns()}", n_trials, **study)
     memory["storage"] = "memory"
     one_process, runs = [], []
     for kind, url in storages:
         if in_process:
-            r = _in_process(dataset_path, url.format(jobs="in-process"), n_trials)
+            r = _in_process(dataset_path, url.format(jobs="in-process"), n_trials, **study)
             r["storage"] = kind
             r["cpu_ratio_to_in_memory"] = r["cpu_s_per_trial"] / memory["cpu_s_per_trial"]
             one_process.append(r)
         for n_jobs in jobs:
-            r = _study(dataset_path, url.format(jobs=n_jobs), n_jobs, n_trials)
+            r = _study(dataset_path, url.format(jobs=n_jobs), n_jobs, n_trials, **study)
             r["storage"] = kind
             r["ratio_to_objective"] = r["trials_per_s_steady"] / ref["trials_per_s"]
             r["ratio_to_in_memory"] = r["trials_per_s_steady"] / memory["trials_per_s_steady"]
@@ -188,10 +204,67 @@ def _dataset_runs(
     }
 
 
-def run(quick: bool = False) -> dict:
+def first_frames(dataset: Any, n: int) -> Any:
+    """The data set cut to its first ``n`` frames (its points, truth and trajectories there)."""
+    from dataclasses import replace
+
+    n = min(int(n), dataset.n_frames)
+    p = int(np.searchsorted(dataset.frame, n))
+    per_point = ("frame", "range_m", "azimuth_rad", "elevation_rad", "radial_velocity_mps",
+                 "snr_db", "x_m", "y_m", "z_m", "source")  # fmt: skip
+    k = int(dataset.trajectory[n - 1]) + 1 if n else 0
+    return replace(
+        dataset,
+        **{f: getattr(dataset, f)[:p] for f in per_point},
+        trajectory=dataset.trajectory[:n],
+        truth_t_s=dataset.truth_t_s[:n],
+        truth_xy_m=dataset.truth_xy_m[:n],
+        truth_v_mps=dataset.truth_v_mps[:n],
+        trajectory_class=dataset.trajectory_class[:k],
+    )
+
+
+def run_recording(path: str, people: int | None, quick: bool = False) -> dict:
+    """A study on a recording's first :data:`RECORDING_FRAMES` frames (see the module)."""
+    from core.dataset import Dataset
+
+    n_trials = 20 if quick else 200
+    n_ref = 5 if quick else 30
+    loss = "fragmentation" if people is not None else "nis"
+    full = Dataset.load(path)
+    ds = first_frames(full, RECORDING_FRAMES)
+    with tempfile.TemporaryDirectory(prefix="radartune-bench-") as tmp:
+        cut = str(ds.save(Path(tmp) / "recording.npz"))
+        part = _dataset_runs(
+            cut,
+            n_trials,
+            n_ref,
+            [("sqlite", f"sqlite:///{tmp}/r{{jobs}}.db")],
+            (1, 2),
+            loss=loss,
+            people=people,
+        )
+    part["dataset"] = Path(path).name
+    return {
+        "n_trials": n_trials,
+        "goal_trials_per_s_2_jobs": GOAL_TRIALS_PER_S_2_JOBS,
+        "recording": {
+            **part,
+            "frames": ds.n_frames,
+            "points": int(len(ds.frame)),
+            "runs": ds.n_trajectories,
+            "loss": loss,
+            "people": people,
+        },
+    }
+
+
+def run(quick: bool = False, recording: str | None = None, people: int | None = None) -> dict:
     from core.benchmarks.postgres import postgres_server
     from core.optimization.data import resolve_dataset
 
+    if recording:
+        return run_recording(recording, people, quick)
     n_trials = 20 if quick else 200
     n_ref = 5 if quick else 30
     walking = resolve_dataset("paper:0:walking")
@@ -226,12 +299,20 @@ def summary(result: dict) -> str:
         f"bench tune: CV study, TPE + ASHA, {result['n_trials']} trials; goal "
         f"{result['goal_trials_per_s_2_jobs']:.0f} trials/s with 2 jobs on SQLite",
     ]
-    for person in ("walking", "point"):
+    for person in ("walking", "point", "recording"):
+        if person not in result:
+            continue
         part = result[person]
+        if person == "recording":
+            lines.append(
+                f"  recording {part['dataset']}: first {part['frames']} frames "
+                f"({part['points']} points, {part['runs']} runs), --loss {part['loss']}"
+                + (f", --people {part['people']}" if part["people"] is not None else "")
+            )
         ref, mem = part["objective_in_process"], part["in_memory_study"]
         lines += [
             f"  {person} person ({part['dataset']}):",
-            f"    objective in process (35 trajectories, no Optuna): "
+            f"    objective in process (every trajectory, no Optuna): "
             f"{ref['trials_per_s']:.1f} trials/s, {1e3 * ref['cpu_s_per_trial']:.1f} ms CPU",
             f"    in process, 1 worker: memory {mem['trials_per_s_steady']:.1f} trials/s, "
             f"{1e3 * mem['cpu_s_per_trial']:.1f} ms CPU a trial ({mem['pruned']} pruned; "

@@ -22,7 +22,8 @@ MODULES = {"import": "import_"}
 #: not part of ``all``: hours of studies (16 x 1000 trials); person clouds (a calibration, not
 #: a speed figure); the desktop app (needs Qt); held-out loss against run time per sampler
 #: (60 studies); the objective comparison and the CV-against-CA design (hours of studies)
-LONG = ("cvca_seeds", "clouds", "gui", "samplers", "campaign")
+#: transfer: tuned parameters judged on held-out public recordings (needs them: $RADARTUNE_REAL)
+LONG = ("cvca_seeds", "clouds", "gui", "samplers", "campaign", "transfer")
 #: benchmarks whose tables and plots ``--render-only`` re-writes from their stored JSON
 RENDERABLE = ("fidelity", "clouds", "samplers", "campaign")
 
@@ -64,6 +65,15 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         help="fidelity: the paper scenes' person, point (the paper's, default), blob or walking "
         "(writes fidelity-walking.json and docs/fidelity/results-walking.md)",
     )
+    p.add_argument(
+        "--recording",
+        metavar="NPZ",
+        help="tune: measure a study on this recording's first 2 000 frames instead (written to "
+        "tune-recording.json)",
+    )
+    p.add_argument(
+        "--people", type=int, help="tune --recording: people in every frame (the head count)"
+    )
     p.set_defaults(func=run)
 
 
@@ -72,6 +82,10 @@ def run(args: argparse.Namespace) -> int:
         from core.errors import InputError
 
         raise InputError(f"--person-model is for fidelity only, not {args.name!r}")
+    if (getattr(args, "recording", None) or args.people is not None) and args.name != "tune":
+        from core.errors import InputError
+
+        raise InputError(f"--recording and --people are for tune only, not {args.name!r}")
     if args.render_only:
         return _render_only(args)
     if getattr(args, "lambda_only", False):
@@ -82,6 +96,11 @@ def run(args: argparse.Namespace) -> int:
     for name in names:
         module = importlib.import_module(f"core.benchmarks.{MODULES.get(name, name)}")
         extra, flags, stem = {}, "", _result_stem(name, args)
+        if name == "tune" and getattr(args, "recording", None):
+            extra = {"recording": args.recording, "people": args.people}
+            flags = f" --recording {args.recording}" + (
+                f" --people {args.people}" if args.people is not None else ""
+            )
         if name == "fidelity":
             model = args.person_model  # checked by _result_stem
             extra = {"params_cv": args.params_cv, "params_ca": args.params_ca}
@@ -111,6 +130,8 @@ def _result_stem(name: str, args: argparse.Namespace) -> str:
     """A benchmark result's file stem in ``--out-dir``: ``<name>[-quick]``; for fidelity
     :func:`~core.benchmarks.fidelity_report.result_name` of ``--person-model``, checked against
     the scene's person models (one-line InputError)."""
+    if name == "tune" and getattr(args, "recording", None):
+        return f"tune-recording{'-quick' if args.quick else ''}"
     if name != "fidelity":
         return f"{name}{'-quick' if args.quick else ''}"
     from core.benchmarks.fidelity_report import result_name

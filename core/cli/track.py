@@ -1,9 +1,17 @@
 """``radartune track``: run the (J)IPDA tracker on a data set and print the paper's loss table,
-GOSPA, the people-count error, identity switches and the metrics of every person."""
+GOSPA, the people-count error, identity switches and the metrics of every person; for every data
+set (with or without truth) the scores that need no positions (head count, fragmentation, NIS)
+and, with ``--tracks``, every track of every frame as a CSV."""
 
 from __future__ import annotations
 
 import argparse
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from core.dataset import Dataset
+    from core.evaluation.counting import RecordingScores
+    from core.tracking import DatasetEstimates
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
@@ -16,6 +24,17 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         "--model", choices=("cv", "ca"), help="motion model when --params is not given (cv)"
     )
     p.add_argument("--out", help="write parameters, table and metrics to this JSON file")
+    p.add_argument(
+        "--tracks",
+        help="write every track of every frame to this CSV (frame,time_s,track_id,status,x_m,"
+        "y_m,z_m,vx_mps,vy_mps,existence,n_points)",
+    )
+    p.add_argument(
+        "--people",
+        type=int,
+        help="people in the room in every frame: scores the confirmed-track count and the "
+        "fragmentation without positions (default: the count in the truth, if any)",
+    )
     p.add_argument(
         "--trajectories", help="comma-separated trajectory indices to track (default: all)"
     )
@@ -59,8 +78,11 @@ def run(args: argparse.Namespace) -> int:
 
     if args.params and args.model:
         raise InputError("give either --params or --model, not both")
-    if args.out:
-        check_output_path(args.out)
+    for out_path, what in ((args.out, "--out"), (args.tracks, "--tracks")):
+        if out_path:
+            check_output_path(out_path, what=f"{what} file")
+    if args.people is not None and args.people < 0:
+        raise InputError(f"--people must be >= 0, got {args.people}")
     params = (
         TrackerParams.load(args.params)
         if args.params
@@ -100,6 +122,7 @@ def run(args: argparse.Namespace) -> int:
     elapsed = time.perf_counter() - t0
     from core.formats.recording import has_truth
 
+    scores = _scores_without_positions(ds, est, args.people)
     if not has_truth(ds):
         n_conf = int(np.sum(np.isfinite(est.confirmed_xy[..., 0]).any(axis=1)))
         print(
@@ -107,6 +130,8 @@ def run(args: argparse.Namespace) -> int:
             f"model {params.model}, tracked in {elapsed * 1e3:.1f} ms; {n_conf} frames with a "
             "confirmed track; no ground truth, so no loss table (import with --truth to score)"
         )
+        print("\n".join(scores.format_lines()))
+        _write_tracks(args.tracks, ds, est)
         if args.out:
             doc = {
                 "data": str(args.data),
@@ -115,6 +140,8 @@ def run(args: argparse.Namespace) -> int:
                 "elapsed_s": elapsed,
                 "frames_with_confirmed_track": n_conf,
                 "truth": False,
+                **_per_frame(est),
+                "without_positions": scores.to_dict(),
             }
             write_json_atomic(Path(args.out), doc)
             print(f"written: {args.out}")
@@ -128,6 +155,8 @@ def run(args: argparse.Namespace) -> int:
         f"tracker took {startup * 1e3:.0f} ms before)"
     )
     print(ev.format_table())
+    print("\n".join(scores.format_lines()))
+    _write_tracks(args.tracks, ds, est)
     if args.out:
         out = Path(args.out)
         doc = {
@@ -137,7 +166,41 @@ def run(args: argparse.Namespace) -> int:
             "elapsed_s": elapsed,
             "startup_s": startup,
             **ev.to_dict(),
+            **_per_frame(est),
+            "without_positions": scores.to_dict(),
         }
         write_json_atomic(out, doc)
         print(f"written: {out}")
     return 0
+
+
+def _scores_without_positions(
+    ds: Dataset, est: DatasetEstimates, people: int | None
+) -> RecordingScores:
+    """Count, fragmentation and NIS of the run (:mod:`core.evaluation.counting`)."""
+    from core.evaluation.counting import recording_scores
+    from core.tracking.batch import dataset_frame_period_s
+
+    return recording_scores(ds, est, dataset_frame_period_s(ds), people=people)
+
+
+def _per_frame(est: DatasetEstimates) -> dict:
+    """The JSON's per-frame counts: global frame index, confirmed and tentative tracks."""
+    return {
+        "per_frame": {
+            "frame": est.frame_index.tolist(),
+            "confirmed": est.n_confirmed.tolist(),
+            "tentative": (est.n_tracks - est.n_confirmed).tolist(),
+        }
+    }
+
+
+def _write_tracks(path: str | None, ds: Dataset, est: DatasetEstimates) -> None:
+    """The tracks CSV (:mod:`core.formats.tracks_csv`), when asked for."""
+    if not path:
+        return
+    from core.formats.tracks_csv import track_rows, write_tracks_csv
+
+    rows = track_rows(ds, est)
+    write_tracks_csv(path, rows)
+    print(f"written: {path} ({len(rows)} rows)")

@@ -75,8 +75,33 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         "--loss",
         default=None,
         help="what trials minimise: trimmed (default for a new study: L_t without the largest "
-        "10 %% of the trajectory losses), paper (L_t, eq. 14), capped or median (docs/tuning.md; "
-        "the paper's L_t is always recorded; a resumed study keeps its own)",
+        "10 %% of the trajectory losses), paper (L_t, eq. 14), capped or median; without "
+        "positions (recordings): count, fragmentation (default with a head count), nis "
+        "(default without) or reference (agreement with the recording's own tracks) "
+        "(docs/tuning.md; the paper's L_t is recorded where there is truth; a "
+        "resumed study keeps its own)",
+    )
+    p.add_argument(
+        "--people",
+        type=int,
+        default=None,
+        help="people in every frame of the data sets (a recording without truth): the head "
+        "count of the count and fragmentation objectives",
+    )
+    p.add_argument(
+        "--mix",
+        action="append",
+        default=[],
+        metavar="DATASET[=WEIGHT]",
+        help="another training data set (a .npz or paper:SEED[:MODEL]), weight 1 unless given; "
+        "repeatable. Each set is scored with --loss where it has what --loss needs, else with "
+        "--recording-loss, divided by the default parameters' score on it (docs/tuning.md)",
+    )
+    p.add_argument(
+        "--recording-loss",
+        default=None,
+        help="objective of a mixed or validation data set without truth: fragmentation "
+        "(default with --people), nis (default without), count or reference",
     )
     p.add_argument(
         "--validation",
@@ -148,6 +173,8 @@ def _paper_model(args: argparse.Namespace) -> str:
 
 
 def run(args: argparse.Namespace) -> int:
+    from dataclasses import replace
+
     from core.evaluation.robust import check_objective
     from core.optimization.data import like_training, resolve_dataset
     from core.optimization.study import StudySettings
@@ -155,9 +182,13 @@ def run(args: argparse.Namespace) -> int:
 
     if args.repeats < 1:
         raise InputError(f"--repeats must be >= 1, got {args.repeats}")
+    if args.recording_loss is not None:
+        check_objective(args.recording_loss)
     top_k = TOP_K if args.top_k is None else args.top_k
     if top_k < 1:
         raise InputError(f"--top-k must be >= 1, got {top_k}")
+    if args.people is not None and args.people < 0:
+        raise InputError(f"--people must be >= 0, got {args.people}")
     if args.loss is None:
         args.loss = _default_loss(args)
     check_objective(args.loss)
@@ -174,6 +205,8 @@ def run(args: argparse.Namespace) -> int:
         objective=args.objective,
         objective_options=_options(args.objective_option),
         loss=args.loss,
+        people=args.people,
+        recording_loss=args.recording_loss or "",
     )
     # every data set is resolved and checked before any study is touched
     plans: list[tuple[StudySettings, str | None]] = []
@@ -186,8 +219,12 @@ def run(args: argparse.Namespace) -> int:
             )
         sets = _training_sets(args)
         paths = [resolve_dataset(d, person_model=args.person_model) for d in sets]
-        for train_path in dict.fromkeys(paths):
-            require_truth(train_path)
+        mix = _mix(args)
+        if mix:
+            base = replace(base, mix=tuple(mix))
+        for train_path in dict.fromkeys([*paths, *(p for p, _ in mix)]):
+            require_truth(train_path, _loss_for(train_path, args) if mix else args.loss,
+                          args.people)  # fmt: skip
         val_arg = args.validation
         if val_arg is None and _paper_seed(args.dataset) is not None:
             val_arg = f"paper:{VALIDATION_SEED}:{_paper_model(args)}"
@@ -201,10 +238,10 @@ def run(args: argparse.Namespace) -> int:
             if args.person_model is None:
                 val_arg = like_training(val_arg, paths[0])
             validation = resolve_dataset(val_arg, person_model=args.person_model)
-            require_truth(validation)
-            if validation in paths:
+            require_truth(validation, _loss_for(validation, args), args.people)
+            if validation in paths or validation in (p for p, _ in mix):
                 raise InputError(f"--validation {val_arg!r} is a training set of this run")
-            check_same_radar(paths[0], validation, "validation")
+            _check_validation_radar([paths[0], *(p for p, _ in mix)], validation)
         for i, train_path in enumerate(paths):
             check_same_radar(paths[0], train_path, "training")
             plans.append((_repeat(base, i, args.repeats, dataset=sets[i]), train_path))
@@ -229,7 +266,8 @@ def run(args: argparse.Namespace) -> int:
             record.update(top.to_dict())
             print(
                 f"study {settings.name}: chosen trial {top.number} by validation: "
-                f"{args.loss} {top.validation_value:.4g} (training {top.train_value:.4g})",
+                f"{_loss_for(validation, args)} {top.validation_value:.4g} on the validation set "
+                f"(training {top.train_value:.4g})",
                 file=sys.stderr,
             )
         chosen.append(record)
@@ -249,12 +287,65 @@ def run(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+def _mix(args: argparse.Namespace) -> list[tuple[str, float]]:
+    """The ``--mix`` data sets, resolved to paths, with their weights."""
+    from core.optimization.data import resolve_dataset
+    from core.optimization.mix import parse_mix
+
+    out = []
+    for item in args.mix:
+        part = parse_mix(item)
+        out.append((resolve_dataset(part.dataset, person_model=args.person_model), part.weight))
+    return out
+
+
+def _loss_for(path: str, args: argparse.Namespace) -> str:
+    """The objective a data set is scored with: ``--loss`` where it has what that needs, else
+    the recording objective (:func:`core.optimization.mix.objective_for`)."""
+    from core.dataset import Dataset
+    from core.optimization.mix import objective_for, recording_objective
+
+    rec = args.recording_loss or recording_objective(args.people)
+    return objective_for(Dataset.load(path), args.loss, rec, args.people)
+
+
+def _check_validation_radar(training: list[str], validation: str) -> None:
+    """The validation set must share the radar of one of the training sets."""
+    from core.optimization.validation import check_same_radar
+
+    first: InputError | None = None
+    for path in training:
+        try:
+            check_same_radar(path, validation, "validation")
+            return
+        except InputError as exc:
+            first = first or exc
+    if first is not None:
+        raise first
+
+
 def _default_loss(args: argparse.Namespace) -> str:
-    """The objective when ``--loss`` is not given (:func:`core.optimization.loss_of_study`)."""
+    """The objective when ``--loss`` is not given (:func:`core.optimization.loss_of_study`); for
+    a new study on a data-set file without truth: ``fragmentation`` with ``--people``, else
+    ``nis`` (said on stderr)."""
+    from core.evaluation.robust import DEFAULT_OBJECTIVE
     from core.optimization.study import loss_of_study
 
     name = args.study or f"radartune-{args.model}"
-    return loss_of_study(args.storage, f"{name}-r0" if args.repeats > 1 else name)
+    loss = loss_of_study(args.storage, f"{name}-r0" if args.repeats > 1 else name)
+    if loss != DEFAULT_OBJECTIVE or _paper_seed(args.dataset) is not None:
+        return loss
+    if args.objective == "tracker" and not args.mix and not _file_has_truth(args.dataset):
+        loss = "fragmentation" if args.people is not None else "nis"
+        print(f"the data set has no truth: the study minimises --loss {loss}", file=sys.stderr)
+    return loss
+
+
+def _file_has_truth(path: str) -> bool:
+    from core.dataset import Dataset
+    from core.formats.recording import has_truth
+
+    return has_truth(Dataset.load(path))
 
 
 def _repeat(base: StudySettings, i: int, n: int, *, dataset: str | None) -> StudySettings:
@@ -375,16 +466,34 @@ def exit_code(
     return EXIT_WORKER_LOST
 
 
-def require_truth(path: str) -> None:
-    """A study scores tracks against ground truth: refuse a data set without any (an imported
-    recording without ``--truth``) with one line."""
+def require_truth(path: str, loss: str = "paper", people: int | None = None) -> None:
+    """What the objective ``loss`` needs of a data set (:data:`core.evaluation.robust.
+    OBJECTIVE_NEEDS`): refuse, with one line, a data set without truth for an objective on
+    positions, or without a head count (``--people`` or the truth) for count and fragmentation."""
     from core.dataset import Dataset
     from core.errors import InputError
+    from core.evaluation.robust import OBJECTIVE_NEEDS
     from core.formats.recording import has_truth
 
-    if not has_truth(Dataset.load(path)):
+    need = OBJECTIVE_NEEDS[loss]
+    if not need or (need == "head count" and people is not None):
+        return
+    ds = Dataset.load(path)
+    if need == "reference layer":
+        if not ds.has_reference:
+            raise InputError(
+                "the data set has no reference layer (no tracks of the sensor's own): --loss "
+                "reference needs one",
+                str(path),
+            )
+        return
+    if need == "head count" and len(ds.people_count) and bool((ds.people_count >= 0).any()):
+        return
+    if not has_truth(ds):
         raise InputError(
-            "the data set has no ground truth (imported without --truth?): a study needs "
-            "truth to score; import it again with --truth CSV",
+            f"the data set has no ground truth (imported without --truth?): --loss {loss} needs "
+            f"{'positions' if need == 'truth' else 'a head count'}; import it again with --truth "
+            "CSV, or tune without positions: --loss count|fragmentation with --people N, or "
+            "--loss nis",
             str(path),
         )

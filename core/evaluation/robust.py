@@ -42,12 +42,32 @@ TRIM_FRACTION = 0.1
 #: The objective a study minimises unless told otherwise: held-out on 20 test sets it gave the
 #: lowest median paper loss of the four (docs/decisions/tuning-08-default-objective.md).
 DEFAULT_OBJECTIVE = "trimmed"
-#: Study objectives: name → (per-trajectory loss, aggregation over trajectories).
+#: Study objectives: name → (per-trajectory loss, aggregation over trajectories). The first
+#: four score positions against the truth; ``count``, ``fragmentation``, ``nis`` and
+#: ``reference`` need no positions (:mod:`core.evaluation.counting`: a head count, nothing for
+#: ``nis``, a recording's own tracks for ``reference``) and are
+#: aggregated over trajectories weighted by what each trajectory scored (frames, person-frames,
+#: NIS samples), so that a short run of a recording weighs as little as it holds.
 OBJECTIVES: dict[str, tuple[str, str]] = {
     "paper": ("paper", "mean"),
     "capped": ("capped", "mean"),
     "median": ("paper", "median"),
     "trimmed": ("paper", "trimmed"),
+    "count": ("count", "weighted"),
+    "fragmentation": ("fragmentation", "weighted"),
+    "nis": ("nis", "weighted"),
+    "reference": ("reference", "weighted"),
+}
+#: The objectives that score positions against the truth.
+POSITION_OBJECTIVES = ("paper", "capped", "median", "trimmed")
+#: What each objective needs of a data set: the truth's positions, a head count (``--people N``
+#: or the truth), or nothing.
+OBJECTIVE_NEEDS: dict[str, str] = {
+    **dict.fromkeys(POSITION_OBJECTIVES, "truth"),
+    "count": "head count",
+    "fragmentation": "head count",
+    "nis": "",
+    "reference": "reference layer",
 }
 
 
@@ -170,15 +190,21 @@ def trimmed_mean(values: Sequence[float], fraction: float = TRIM_FRACTION) -> fl
     return float(np.mean(v[:keep]))
 
 
-def aggregate(values: Sequence[float], how: str) -> float:
-    """Trajectory losses → one objective value: ``"mean"``, ``"median"`` or ``"trimmed"``."""
+def aggregate(values: Sequence[float], how: str, weights: Sequence[float] | None = None) -> float:
+    """Trajectory losses → one objective value: ``"mean"``, ``"median"``, ``"trimmed"`` or
+    ``"weighted"`` (Σ wₖ vₖ / Σ wₖ with the trajectories' ``weights``)."""
+    if how == "weighted":
+        if weights is None or len(weights) != len(values):
+            raise ValueError("the weighted aggregation needs one weight per value")
+        w = np.asarray(weights, dtype=np.float64)
+        return float(np.sum(w * np.asarray(values, dtype=np.float64)) / np.sum(w))
     if how == "mean":
         return float(np.mean(values))
     if how == "median":
         return float(np.median(values))
     if how == "trimmed":
         return trimmed_mean(values)
-    raise InputError(f"aggregation must be mean, median or trimmed, got {how!r}")
+    raise InputError(f"aggregation must be mean, median, trimmed or weighted, got {how!r}")
 
 
 __all__ = [
@@ -187,6 +213,8 @@ __all__ = [
     "FAR_DISTANCE_M",
     "FAR_FRAMES",
     "OBJECTIVES",
+    "OBJECTIVE_NEEDS",
+    "POSITION_OBJECTIVES",
     "TRIM_FRACTION",
     "aggregate",
     "capped_loss",

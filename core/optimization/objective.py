@@ -33,13 +33,17 @@ from core.optimization.space import P0_NAMES, check_model, search_space, tracker
 
 
 class TrajectoryScore(NamedTuple):
-    """One trajectory's scores: the paper's ``L(k)`` (m², eq. 13), ``MSE(k)`` (m², NaN when
-    ``N_c = 0``), ``N_c(k)`` and the capped loss ``C(k)`` (m², :mod:`core.evaluation.robust`)."""
+    """One trajectory's scores: the paper's ``L(k)`` (m², eq. 13; NaN on a data set without
+    truth), ``MSE(k)`` (m², NaN when ``N_c = 0``), ``N_c(k)``, the capped loss ``C(k)`` (m²,
+    :mod:`core.evaluation.robust`) and, for an objective without positions
+    (:func:`core.evaluation.counting.trajectory_terms`), its ``value`` and ``weight``."""
 
     loss: float
     mse: float
     n_c: int
     capped: float
+    value: float = math.nan
+    weight: float = 1.0
 
 
 class TrajectoryLosses(Protocol):
@@ -131,14 +135,41 @@ class TrackerLosses:
         Also score the capped loss ``C(k)`` (:mod:`core.evaluation.robust`); without it the
         scores' ``capped`` is NaN. It costs about a tenth of a trial, so a study computes it
         only when its objective uses it (:func:`uses_capped`).
+    without_positions
+        ``"count"``, ``"fragmentation"``, ``"nis"`` or ``"reference"``: also score that
+        objective per trajectory (the scores' ``value`` and ``weight``); ``""``: none.
+    people
+        Head count in every frame (``--people N``); None: the truth's, if any.
     """
 
     def __init__(
-        self, dataset: Any, base_params: dict[str, Any] | None = None, *, capped: bool = True
+        self,
+        dataset: Any,
+        base_params: dict[str, Any] | None = None,
+        *,
+        capped: bool = True,
+        without_positions: str = "",
+        people: int | None = None,
     ) -> None:
+        from core.evaluation.counting import head_counts
+        from core.formats.recording import has_truth
+
         self.dataset = dataset
         self.base_params = dict(base_params or {})
         self.capped = capped
+        self.without_positions = without_positions
+        self.truth = has_truth(dataset)
+        self.counts = head_counts(dataset, people)
+        if without_positions in ("count", "fragmentation") and self.counts is None:
+            raise InputError(
+                f"the {without_positions} objective needs a head count: give --people N (the "
+                "data set has no truth)"
+            )
+        if without_positions == "reference" and not dataset.has_reference:
+            raise InputError(
+                "the reference objective needs a recording with its own tracks (a reference "
+                "layer: TI's tracks of a people-counting recording)"
+            )
 
     @property
     def trajectory_classes(self) -> tuple[str, ...]:
@@ -163,16 +194,28 @@ class TrackerLosses:
             return []
         tp = TrackerParams.from_dict({**self.base_params, **params})
         # several persons are scored from every confirmed track (the multi-person loss); one
-        # person from the single-person estimate, as ever (the same numbers bit for bit)
+        # person from the single-person estimate, as ever (the same numbers bit for bit); the
+        # track ids and NIS of fragmentation and nis come from the kernel's record of every track
         several = self.dataset.n_persons > 1
-        est = track_dataset(self.dataset, tp, trajectories=list(ks), with_tracks=several)
-        terms = trajectory_loss_terms(self.dataset, est)
-        capped = (
-            trajectory_capped_losses(self.dataset, est) if self.capped else [math.nan] * len(terms)
+        record = self.without_positions in ("fragmentation", "nis", "reference")
+        est = track_dataset(self.dataset, tp, trajectories=list(ks), with_tracks=several or record)
+        n = len(est.trajectories)
+        nan = [math.nan] * n
+        terms = (
+            trajectory_loss_terms(self.dataset, est)
+            if self.truth
+            else [(math.nan, math.nan, 0)] * n
         )
+        capped = trajectory_capped_losses(self.dataset, est) if self.capped and self.truth else nan
+        extra = [(math.nan, 1.0)] * n
+        if self.without_positions:
+            from core.evaluation.counting import trajectory_terms
+
+            counts = None if self.counts is None else self.counts[est.frame_index]
+            extra = trajectory_terms(self.without_positions, est, counts, self.dataset)
         return [
-            TrajectoryScore(float(value), float(mse), int(n_c), c)
-            for (value, mse, n_c), c in zip(terms, capped, strict=True)
+            TrajectoryScore(float(value), float(mse), int(n_c), c, v, w)
+            for (value, mse, n_c), c, (v, w) in zip(terms, capped, extra, strict=True)
         ]
 
 
@@ -241,6 +284,9 @@ def evaluate(
         one).
     """
     per_trajectory, how = OBJECTIVES[check_objective(loss)]
+    # the per-trajectory loss the objective uses: the paper's L(k), the capped C(k) or the
+    # value of an objective without positions (weighted by what each trajectory scored)
+    field = {"paper": "loss", "capped": "capped"}.get(per_trajectory, "value")
     order = round_robin_order(losses.trajectory_classes)
     if not order:
         raise InputError("the data set has no trajectories")
@@ -258,11 +304,12 @@ def evaluate(
     cs: list[float] = []
     ms: list[float] = []
     ns: list[int] = []
-    used = cs if per_trajectory == "capped" else ls  # the per-trajectory loss the objective uses
+    used: list[float] = []
+    ws: list[float] = []
 
     def result(pruned: bool) -> TrialResult:
         return TrialResult(
-            value=aggregate(used, how),
+            value=aggregate(used, how, ws),
             paper_value=float(np.mean(ls)),
             losses=tuple(ls),
             capped=tuple(cs),
@@ -276,11 +323,15 @@ def evaluate(
     for end in ends:
         for score in losses.losses(params, order[start:end]):
             k = order[len(ls)]
-            for name, value in (("loss", score.loss), ("capped loss", score.capped)):
-                if (name == "loss" or per_trajectory == "capped") and not math.isfinite(value):
-                    raise FloatingPointError(f"trajectory {k}: {name} is {value}")
+            value = float(getattr(score, field))
+            if field != "value" and not math.isfinite(score.loss):
+                raise FloatingPointError(f"trajectory {k}: loss is {score.loss}")
+            if not math.isfinite(value):
+                raise FloatingPointError(f"trajectory {k}: {loss} loss is {value}")
             ls.append(score.loss)
             cs.append(score.capped)
+            used.append(value)
+            ws.append(score.weight)
             ms.append(score.mse)
             ns.append(score.n_c)
             if trial is not None and pruner != "none":
@@ -290,7 +341,7 @@ def evaluate(
                     # the objective of the first i trajectories (for L_t: L̄_i = (1/i) Σ_j L(k_j)),
                     # reported where the pruner decides (and at the end): every report is a
                     # storage write, and successive halving reads only the values at its rungs
-                    trial.report(aggregate(used, how), len(ls))
+                    trial.report(aggregate(used, how, ws), len(ls))
         start = end
         if trial is not None and pruner != "none" and end < n and trial.should_prune():
             return result(pruned=True)
@@ -302,6 +353,27 @@ def uses_capped(loss: str) -> bool:
     return OBJECTIVES[check_objective(loss)][0] == "capped"
 
 
+def without_positions(loss: str) -> str:
+    """The objective's per-trajectory score when it needs no positions (``count``,
+    ``fragmentation``, ``nis``, ``reference``), else ``""``."""
+    kind = OBJECTIVES[check_objective(loss)][0]
+    return "" if kind in ("paper", "capped") else kind
+
+
+def tracker_losses(
+    dataset: Any, loss: str, *, people: int | None = None, base_params: dict | None = None
+) -> TrackerLosses:
+    """The tracker's loss source for the study objective ``loss`` on ``dataset`` (the capped
+    loss and the scores without positions computed only when ``loss`` uses them)."""
+    return TrackerLosses(
+        dataset,
+        base_params,
+        capped=uses_capped(loss),
+        without_positions=without_positions(loss),
+        people=people,
+    )
+
+
 def make_losses(objective: str, model: str, dataset: Any = None, **kwargs: Any) -> TrajectoryLosses:
     """Loss source by name: ``"tracker"`` (needs ``dataset``; ``capped=False`` skips the capped
     loss) or ``"quadratic"`` (tests)."""
@@ -310,7 +382,11 @@ def make_losses(objective: str, model: str, dataset: Any = None, **kwargs: Any) 
         if dataset is None:
             raise InputError("objective 'tracker' needs a data set")
         return TrackerLosses(
-            dataset, kwargs.get("base_params"), capped=bool(kwargs.get("capped", True))
+            dataset,
+            kwargs.get("base_params"),
+            capped=bool(kwargs.get("capped", True)),
+            without_positions=str(kwargs.get("without_positions", "")),
+            people=kwargs.get("people"),
         )
     if objective == "quadratic":
         return QuadraticLosses(
@@ -333,4 +409,6 @@ __all__ = [
     "round_robin_order",
     "uses_capped",
     "tracker_params_dict",
+    "tracker_losses",
+    "without_positions",
 ]

@@ -43,7 +43,7 @@ import numpy as np
 
 from core.errors import InputError
 from core.evaluation.robust import DEFAULT_OBJECTIVE, check_objective
-from core.optimization.objective import evaluate, make_losses, uses_capped
+from core.optimization.objective import evaluate, make_losses, uses_capped, without_positions
 from core.optimization.space import check_model, suggest_params, tracker_params_dict
 from core.optimization.storage import (
     DEFAULT_STORAGE,
@@ -100,6 +100,15 @@ class StudySettings:
         recorded beside it on every trial (user attribute ``paper_loss``).
     objective_options
         Options of the quadratic objective (``n_trajectories``, ``delay_s``).
+    people
+        Head count in every frame of the data set (``--people N``) for the objectives without
+        positions (``count``, ``fragmentation``); None: the truth's.
+    mix
+        Further training data sets, ``(path, weight)`` each (:mod:`core.optimization.mix`); the
+        study's own data set weighs 1.
+    recording_loss
+        The objective of a data set without what ``loss`` needs (a recording without truth, in
+        a mixed study or at validation); ``""``: fragmentation with ``people``, else nis.
     """
 
     model: str = "cv"
@@ -114,9 +123,19 @@ class StudySettings:
     objective: str = "tracker"
     objective_options: dict[str, float] = field(default_factory=dict)
     loss: str = DEFAULT_OBJECTIVE
+    people: int | None = None
+    mix: tuple[tuple[str, float], ...] = ()
+    recording_loss: str = ""
 
     def __post_init__(self) -> None:
         check_model(self.model)
+        if self.recording_loss:
+            check_objective(self.recording_loss)
+        for path, weight in self.mix:
+            if not (math.isfinite(weight) and weight > 0):
+                raise InputError(f"mix {path}: weight must be > 0, got {weight}")
+        if self.people is not None and (isinstance(self.people, bool) or int(self.people) < 0):
+            raise InputError(f"people must be a whole number >= 0, got {self.people!r}")
         if int(self.n_trials) < 1:
             raise InputError(f"n_trials must be >= 1, got {self.n_trials}")
         if int(self.n_jobs) < 1:
@@ -380,9 +399,26 @@ def prepare_study(settings: StudySettings, *, dataset_path: str | None = None) -
         "loss": settings.loss,
         "space": "paper-eq15",
     }
+    if settings.people is not None:
+        attrs["people"] = int(settings.people)
+    if settings.mix:
+        attrs["mix"] = [[str(p), float(w)] for p, w in settings.mix]
+    if settings.recording_loss:
+        attrs["recording_loss"] = settings.recording_loss
     study = load_existing_study(storage, settings.name)
     if study is not None:
         old = study.user_attrs
+        for key in ("mix", "recording_loss"):
+            if old.get(key) != attrs.get(key):
+                raise InputError(
+                    f"study {settings.name!r} in {redact(settings.storage)} has {key}="
+                    f"{old.get(key)!r}, asked {attrs.get(key)!r}; use another --study name"
+                )
+        if old.get("people") != attrs.get("people"):
+            raise InputError(
+                f"study {settings.name!r} in {redact(settings.storage)} has people="
+                f"{old.get('people')!r}, asked {attrs.get('people')!r}; use another --study name"
+            )
         for key in ("model", "objective", "sampler", "pruner", "loss"):
             # a study made before robust objectives existed minimised the paper's loss
             if old.get(key, "paper" if key == "loss" else None) != attrs[key]:
@@ -467,6 +503,29 @@ def load_dataset_for(attrs: dict[str, Any], dataset_path: str | None) -> Any:
     return Dataset.load(path)
 
 
+def _mixed_objective(attrs: dict[str, Any], main_set: Any, model: str) -> Any:
+    """The study's :class:`~core.optimization.mix.MixedObjective`, or None for a study on one
+    data set."""
+    if not attrs.get("mix"):
+        return None
+    from core.dataset import Dataset
+    from core.optimization.mix import MixedObjective, recording_objective
+
+    people = attrs.get("people")
+    parts = [(main_set, 1.0)]
+    for path, weight in attrs["mix"]:
+        if not Path(path).is_file():
+            raise InputError(f"mixed data set {path!r} (recorded in the study) does not exist here")
+        parts.append((Dataset.load(path), float(weight)))
+    return MixedObjective(
+        parts,
+        model,
+        loss=str(attrs.get("loss", "paper")),
+        recording_loss=str(attrs.get("recording_loss") or recording_objective(people)),
+        people=people,
+    )
+
+
 def run_worker(
     storage: str,
     study_name: str,
@@ -520,13 +579,18 @@ def run_worker(
         sampler=sampler_for(0),
         pruner=make_pruner(attrs["pruner"]),
     )
+    loss = str(attrs.get("loss", "paper"))
+    main_set = load_dataset_for(attrs, dataset_path)
     losses = make_losses(
         attrs["objective"],
         model,
-        load_dataset_for(attrs, dataset_path),
-        capped=uses_capped(str(attrs.get("loss", "paper"))),
+        main_set,
+        capped=uses_capped(loss),
+        without_positions=without_positions(loss) if not attrs.get("mix") else "",
+        people=attrs.get("people"),
         **dict(attrs.get("objective_options") or {}),
     )
+    mixed = _mixed_objective(attrs, main_set, model)
     if hasattr(losses, "warm_up"):
         losses.warm_up(model)
     fail_stale_trials(study)
@@ -562,14 +626,17 @@ def run_worker(
                 study.tell(trial, state=TrialState.FAIL)
                 break
             reports = _RungReports(trial, store)
-            result = evaluate(
-                losses,
-                params,
-                trial=reports,
-                pruner=attrs["pruner"],
-                prune_steps=prune_steps,
-                loss=str(attrs.get("loss", "paper")),
-            )
+            if mixed is not None:
+                result = mixed.evaluate(params)  # scored whole: no pruning
+            else:
+                result = evaluate(
+                    losses,
+                    params,
+                    trial=reports,
+                    pruner=attrs["pruner"],
+                    prune_steps=prune_steps,
+                    loss=str(attrs.get("loss", "paper")),
+                )
             with batched(store, read=False):
                 reports.flush()
         except KeyboardInterrupt:
@@ -590,7 +657,8 @@ def run_worker(
                 ) from None
             continue
         failures = 0
-        if attrs.get("loss", "paper") != "paper":  # else the trial's value is L_t itself
+        if attrs.get("loss", "paper") != "paper" and math.isfinite(result.paper_value):
+            # else the trial's value is L_t itself, or the data set has no truth for it
             trial.set_user_attr("paper_loss", result.paper_value)
         if result.pruned:
             study.tell(trial, state=TrialState.PRUNED)

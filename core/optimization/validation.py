@@ -21,7 +21,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from core.errors import InputError
-from core.optimization.objective import evaluate, make_losses, uses_capped
+from core.optimization.objective import evaluate, tracker_losses
 from core.optimization.storage import load_existing_study, open_storage, redact
 
 #: Seed of the paper validation data set (training seeds must lie below it).
@@ -54,7 +54,10 @@ class ValidatedTrial:
             "trial": self.number,
             "train_value": self.train_value,
             "validation_value": self.validation_value,
-            "validation_paper_loss": self.validation_paper_loss,
+            # None on a validation set without truth (JSON has no NaN)
+            "validation_paper_loss": (
+                self.validation_paper_loss if math.isfinite(self.validation_paper_loss) else None
+            ),
             "params": self.params,
         }
 
@@ -89,12 +92,25 @@ def check_same_radar(training: str, other: str, role: str) -> None:
         ``"validation"`` or ``"test"``: named in the message.
     """
     a, b = radar_of(training), radar_of(other)
-    if a != b:
-        keys = sorted(k for k in a.keys() | b.keys() if a.get(k) != b.get(k))
+    keys = sorted(k for k in a.keys() | b.keys() if not _same_setting(a.get(k), b.get(k)))
+    if keys:
         raise InputError(
             f"{role} data set {other!r} was made with another radar configuration than the "
             f"training set {training!r} (differs in {', '.join(keys[:4])})"
         )
+
+
+#: Relative difference up to which two numeric radar settings are the same: a recording's frame
+#: period is measured from its time stamps (0.0993-0.1000 s over three files of one sensor).
+RADAR_TOLERANCE = 0.02
+
+
+def _same_setting(a: Any, b: Any) -> bool:
+    """Equal, or two numbers within :data:`RADAR_TOLERANCE` of each other."""
+    numbers = (int, float)
+    if isinstance(a, numbers) and isinstance(b, numbers) and not isinstance(a, bool):
+        return math.isclose(float(a), float(b), rel_tol=RADAR_TOLERANCE)
+    return bool(a == b)
 
 
 def validate_study(
@@ -126,8 +142,19 @@ def validate_study(
     loss = str(attrs.get("loss", "paper"))
     if attrs.get("objective", "tracker") != "tracker":
         raise InputError(f"study {name!r} does not track a data set; nothing to validate")
-    if attrs.get("dataset"):
-        check_same_radar(str(attrs["dataset"]), validation_path, "validation")
+    training = [str(attrs["dataset"])] if attrs.get("dataset") else []
+    training += [str(p) for p, _ in attrs.get("mix") or []]
+    if training:
+        # a mixed study's validation set is made with the radar of one of its training sets
+        errors = []
+        for path in training:
+            try:
+                check_same_radar(path, validation_path, "validation")
+                break
+            except InputError as exc:
+                errors.append(exc)
+        else:
+            raise errors[0]
     record = attrs.get("validation") or {}
     if record.get("dataset") != validation_path or record.get("loss") != loss:
         record = {"dataset": validation_path, "loss": loss, "trials": {}}
@@ -138,7 +165,15 @@ def validate_study(
         if t.state.name == "COMPLETE" and t.value is not None and math.isfinite(t.value)
     ]
     best = sorted(done, key=lambda t: (t.value, t.number))[:top_k]
-    losses = make_losses("tracker", model, Dataset.load(validation_path), capped=uses_capped(loss))
+    from core.optimization.mix import objective_for, recording_objective
+
+    people = attrs.get("people")
+    val_set = Dataset.load(validation_path)
+    # the study's objective where the validation set has what it needs, else the recording one
+    loss = objective_for(
+        val_set, loss, str(attrs.get("recording_loss") or recording_objective(people)), people
+    )
+    losses = tracker_losses(val_set, loss, people=people)
     out = []
     for t in best:
         params = tracker_params_dict({k: float(v) for k, v in t.params.items()}, model)

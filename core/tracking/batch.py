@@ -18,7 +18,7 @@ import numpy as np
 from core.dataset import Dataset
 from core.errors import InputError
 from core.tracking.params import TrackerParams
-from core.tracking.results import FrameTracks
+from core.tracking.results import FrameTracks, TrackRecord
 from core.tracking.zones import Zones
 
 __all__ = [
@@ -126,6 +126,11 @@ class DatasetEstimates:
     tracks
         Every confirmed track with its id (:class:`ConfirmedTracks`), or None unless asked for
         (``track_dataset(..., with_tracks=True)``): the identities several-person metrics need.
+    record
+        Every live track (tentative and confirmed) of every output frame with its state, ψ,
+        status, gated measurements and NIS (:class:`~core.tracking.results.TrackRecord`, rows
+        in output-frame order), or None unless ``with_tracks=True``: the tracks file and the
+        scores without positions read it.
     """
 
     trajectories: np.ndarray
@@ -139,6 +144,7 @@ class DatasetEstimates:
     n_tracks: np.ndarray
     model: str = "cv"
     tracks: ConfirmedTracks | None = None
+    record: TrackRecord | None = None
 
 
 def dataset_frame_period_s(dataset: Dataset) -> float:
@@ -240,6 +246,7 @@ def track_dataset(
     sel = _selection(dataset, trajectories)
     z, f_off, t_off, period = _prepare(dataset)
     tracks: ConfirmedTracks | None = None
+    record: TrackRecord | None = None
     lengths = t_off[sel + 1] - t_off[sel]
     offsets = np.concatenate(([0], np.cumsum(lengths))).astype(np.int64)
     frame_index = (
@@ -256,7 +263,7 @@ def track_dataset(
         )  # fmt: skip
         est_xy, has, psi, conf_xy, n_conf, n_tr = out[:6]
         if with_tracks:
-            rec = out[8]
+            rec = record = out[8]
             tracks = ConfirmedTracks.from_slots(
                 rec.ids, rec.state[..., :2], rec.psi, _live(rec.n_tracks, rec.confirmed)
             )
@@ -266,7 +273,7 @@ def track_dataset(
         out = track_frames(z, f_off, t_off, sel, params, period, record=with_tracks)
         est_xy, has, psi, conf_xy, n_conf, n_tr = out[:6]
         if with_tracks:
-            rec = out[-1]
+            rec = record = out[-1]
             tracks = ConfirmedTracks.from_slots(
                 rec.ids, rec.state[..., :2], rec.psi, _live(rec.n_tracks, rec.confirmed)
             )
@@ -281,10 +288,7 @@ def track_dataset(
         n_conf = np.zeros(n_sel, dtype=np.int64)
         n_tr = np.zeros(n_sel, dtype=np.int64)
         cap = params.max_tracks
-        t_ids = np.full((n_sel, cap), -1, np.int64)
-        t_xy = np.full((n_sel, cap, 2), np.nan)
-        t_psi = np.full((n_sel, cap), np.nan)
-        t_conf = np.zeros((n_sel, cap), dtype=bool)
+        rec = TrackRecord.allocate(n_sel if with_tracks else 0, cap, params.state_dim)
         for i, k in enumerate(sel):
             a, b = t_off[k], t_off[k + 1]
             res = run_tracker(
@@ -297,11 +301,12 @@ def track_dataset(
             est_xy[s], has[s], psi[s] = res.estimate_xy, res.has_estimate, res.estimate_psi
             conf_xy[s], n_conf[s], n_tr[s] = res.confirmed_xy, res.n_confirmed, res.n_tracks
             for j, ft in enumerate(res.frames or ()):
-                row, n = offsets[i] + j, len(ft)
-                t_ids[row, :n], t_xy[row, :n], t_psi[row, :n] = ft.ids, ft.state[:, :2], ft.psi
-                t_conf[row, :n] = ft.confirmed
+                _record_frame(rec, offsets[i] + j, ft)
         if with_tracks:
-            tracks = ConfirmedTracks.from_slots(t_ids, t_xy, t_psi, t_conf)
+            record = rec._replace(n_tracks=n_tr.copy())
+            tracks = ConfirmedTracks.from_slots(
+                rec.ids, rec.state[..., :2], rec.psi, _live(record.n_tracks, rec.confirmed)
+            )
     else:
         raise InputError(f"engine must be 'numba' or 'numpy', got engine={engine!r}")
     return DatasetEstimates(
@@ -316,7 +321,23 @@ def track_dataset(
         n_tracks=n_tr,
         model=params.model,
         tracks=tracks,
+        record=record,
     )
+
+
+def _record_frame(rec: TrackRecord, row: int, ft: FrameTracks) -> None:
+    """Write one frame of the readable tracker (:class:`FrameTracks`) into row ``row`` of a
+    :class:`TrackRecord`, as the compiled kernel records it."""
+    n = len(ft)
+    rec.ids[row, :n], rec.state[row, :n], rec.covariance[row, :n] = (
+        ft.ids, ft.state, ft.covariance
+    )  # fmt: skip
+    rec.psi[row, :n], rec.confirmed[row, :n], rec.birth_frame[row, :n] = (
+        ft.psi, ft.confirmed, ft.birth_frame
+    )  # fmt: skip
+    rec.gate_center_xy[row, :n], rec.gate_shape_xy[row, :n] = ft.gate_center_xy, ft.gate_shape_xy
+    rec.n_associated[row, :n], rec.nis[row, :n] = ft.n_associated, ft.nis
+    rec.estimate[row] = ft.estimate
 
 
 def _live(n_tracks: np.ndarray, confirmed: np.ndarray) -> np.ndarray:

@@ -3,6 +3,8 @@ cache in order with the recorded points, playback advances, and the tracker runs
 
 from __future__ import annotations
 
+import json
+
 import numpy as np
 import pytest
 
@@ -84,3 +86,51 @@ def test_bad_recording_is_one_line(tmp_path) -> None:
     bad.write_bytes(b"\x00" * 100)
     with pytest.raises(InputError, match="format not recognised"):
         load_recording(bad)
+
+
+def test_replay_of_a_recording_that_starts_with_empty_frames(tmp_path) -> None:
+    """The first frames of a recording often hold no point (the sensor starts before anyone
+    walks in): the frames without a track are drawn empty and the walker is tracked after."""
+    from app import engine as eng
+    from app.replay import ReplayEngine
+    from core.dataset import Dataset
+    from core.tracking import TrackerParams
+
+    n_empty, n_walk = 12, 30
+    period = PAPER_RADAR.frame_period_s
+    clouds = [PointCloud.empty() for _ in range(n_empty)]
+    for k in range(n_walk):
+        x, y = 0.5, 3.0 + 1.0 * k * period
+        r = float(np.hypot(x, y))
+        clouds.append(
+            PointCloud(
+                range_m=np.array([r]),
+                azimuth_rad=np.array([np.arctan2(x, y)]),
+                elevation_rad=np.zeros(1),
+                radial_velocity_mps=np.array([y / r]),
+                snr_db=np.array([20.0]),
+                x_m=np.array([x]),
+                y_m=np.array([y]),
+                z_m=np.zeros(1),
+                source=np.zeros(1, dtype=np.int32),
+            )  # fmt: skip
+        )
+    f = n_empty + n_walk
+    nan = np.full((f, 0, 2), np.nan)
+    ds = Dataset.from_frames(
+        clouds=clouds, trajectory=np.zeros(f, np.int64), truth_t_s=np.arange(f) * period,
+        truth_xy_m=nan, truth_v_mps=nan, trajectory_class=["real"], scene_json="{}",
+        radar_json=json.dumps(PAPER_RADAR.to_dict()),
+    )  # fmt: skip
+    frames = list(ReplayEngine(ds).simulate(None))
+    for engine in ("numpy", "numba"):
+        res = eng.track(frames, TrackerParams.default("cv"), period, engine=engine)
+        assert len(res.frames) == f
+        assert all(len(t.track_id) == 0 and t.xy_m.shape == (0, 2) for t in res.frames[:n_empty])
+        assert all(t.velocity_xy_mps.shape == (0, 2) for t in res.frames[:n_empty])
+        # the walker is confirmed and followed once points arrive
+        last = res.frames[-1]
+        y_end = 3.0 + (n_walk - 1) * period
+        assert last.confirmed.any()
+        xy = last.xy_m[last.confirmed][0]
+        assert np.hypot(xy[0] - 0.5, xy[1] - y_end) < 0.5

@@ -18,7 +18,7 @@ from tests.scenes import small_scene
 
 #: Fuzz tests in tests/fuzz/test_fuzz_inputs.py and test_fuzz_recordings.py (the long profile
 #: shares its budget among them).
-N_FUZZ_TESTS = 11
+N_FUZZ_TESTS = 13
 #: Examples per test in the short profile.
 SHORT_EXAMPLES = 40
 #: Address-space limit of the long profile's process: a limit that failed to reject an input

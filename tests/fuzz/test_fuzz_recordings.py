@@ -126,3 +126,60 @@ def test_mutated_replays_import(data, bytes_level: bool) -> None:
         ]
 
     check(run_input(write, label="replay"))
+
+
+OOB_CSV = (
+    b"Frame #,# Obj,X,Y,Z,Doppler,,y,m,d,h,m,s\n"
+    b"5,2,1.0,2.0,0.5,-0.25,100,2019,7,13,11,18,0.000\n"
+    b"5,2,1.5,2.0,0.5,-0.25,163,2019,7,13,11,18,0.000\n"
+    b"6,1,0,0,0,0,163,2019,7,13,11,18,0.100\n"
+    b"8,1,0.2,3.0,0.1,0.5,200,2019,7,13,11,18,0.300\n"
+    b"1,1,0.2,3.1,0.1,0.5,210,2019,7,13,11,18,9.000\n"
+)
+PEOPLE_CSV = (
+    "time,fN,type,posX,posY,posZ,velX,velY,velZ,accX,accY,accZ,"
+    + ",".join(f"ec{i}" for i in range(16))
+    + ",g,confi,tid\n"
+    "2023-06-21 12:27:01.100000,10,v6,0.1,-0.5,2.0,0.3,-991.32,-0.95,1.73,0.2\n"
+    "2023-06-21 12:27:01.100000,10,v7,1,2,0.1,0.1,-0.2,0,0,0,0,"
+    + ",".join(["0"] * 16)
+    + ",2,0.9,4\n"
+    "2023-06-21 12:27:01.200000,11,v6,0.0,0.0,1.0,-0.4,10.0,0.0,1.0,0.0\n"
+    '2023-06-21 12:27:01.200000,11,v8,"[4]"\n'
+).encode()
+TRUTH_CSV = b"time_s,person,x_m,y_m\n0,0,1,2\n0.1,0,1,2.1\n0.2,1,-1,3\n"
+COUNT_CSV = b"t_start_s,t_end_s,people\n0,0.15,1\n0.2,10,0\n"
+
+
+@FUZZ_SETTINGS
+@given(data=st.data(), which=st.sampled_from(["oob", "people", "mapped"]))
+def test_mutated_point_cloud_csvs_import(data, which: str) -> None:
+    """The CSV readers on mutated files (detected, or forced by --format / --columns): exit 0,
+    or exit 2 with one line."""
+    raw = data.draw(byte_mutations(PEOPLE_CSV if which == "people" else OOB_CSV))
+
+    def write(folder: Path) -> list[str]:
+        (folder / "pc.csv").write_bytes(raw)
+        argv = ["import", str(folder / "pc.csv"), "--out", str(folder / "out" / "d.npz")]
+        if which == "mapped":
+            argv += ["--columns", "frame=Frame #,x=X,y=Y,doppler=Doppler,time=s"]
+        elif data.draw(st.booleans()):
+            argv += ["--format", "people-csv" if which == "people" else "oob-csv"]
+        return argv
+
+    check(run_input(write, label=f"{which} csv"))
+
+
+@FUZZ_SETTINGS
+@given(data=st.data(), which=st.sampled_from(["truth", "count"]))
+def test_mutated_truth_and_count_csvs_import(data, which: str) -> None:
+    raw = data.draw(byte_mutations(TRUTH_CSV if which == "truth" else COUNT_CSV))
+
+    def write(folder: Path) -> list[str]:
+        (folder / "pc.csv").write_bytes(OOB_CSV)
+        (folder / "t.csv").write_bytes(raw)
+        flag = "--truth" if which == "truth" else "--people-csv"
+        return ["import", str(folder / "pc.csv"), flag, str(folder / "t.csv"),
+                "--out", str(folder / "out" / "d.npz")]  # fmt: skip
+
+    check(run_input(write, label=f"{which} csv"))
