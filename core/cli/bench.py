@@ -16,7 +16,17 @@ from pathlib import Path
 
 from core.files import write_json_atomic
 
-BENCHMARKS = ("sim", "track", "tune", "fidelity", "dataset", "false_alarms", "cvca", "import")
+BENCHMARKS = (
+    "sim",
+    "track",
+    "tune",
+    "fidelity",
+    "dataset",
+    "false_alarms",
+    "cvca",
+    "import",
+    "room",
+)
 #: benchmark name -> module in core.benchmarks, where the name is a Python keyword
 MODULES = {"import": "import_"}
 #: not part of ``all``: hours of studies (16 x 1000 trials); person clouds (a calibration, not

@@ -6,10 +6,11 @@ Per frame:
    *static* when ``|vr| ≤ v_static`` (zero Doppler);
 2. every track is predicted (state, covariance, existence eq. 9) and every point goes to the
    track whose body gate explains it best (:mod:`core.tracking.groups`);
-3. a track's group is its moving points, plus its static points when the track stands in a
-   static box and has had no moving point for at most ``t_static``: so a person who stops or
-   sits stays tracked there for that long, and a track that only static points would support
-   outside the static boxes (or longer) gets no update and is let go by its existence;
+3. a track's group is its moving points; a track with none takes its static points instead
+   while it stands in a static box and has had no moving point for at most ``t_static``: so a
+   person who stops or sits stays tracked there for that long (and furniture never drags a
+   walking person's group), and a track that only static points would support outside the
+   static boxes (or longer) gets no update and is let go by its existence;
 4. each track is updated by its group as one measurement (:func:`groups.group_update`), its
    strength (smoothed SNR sum) and height (mean z of its points) follow;
 5. the moving points no track explained form groups (:mod:`core.tracking.allocation`); each

@@ -240,16 +240,18 @@ def room_frames(
                             owner[j] = k
             # 3.-4. each track's group updates it
             for k in range(nt):
-                # static points count while the track stands in a static box (its predicted
-                # x, y and its height) and has been still for at most static_frames frames
+                # the group is the track's moving points; with none, its static points while
+                # it stands in a static box (its predicted x, y and its height) and has been
+                # still for at most static_frames frames
                 moving = 0
                 for j in range(m):
                     if owner[j] == k and not static[j]:
                         moving += 1
                 still[k] = 0 if moving > 0 else still[k] + 1
                 in_static = (
-                    in_any_box(XP[k, 0], XP[k, 1], height[k], c.static_boxes)
+                    moving == 0
                     and still[k] <= c.static_frames
+                    and in_any_box(XP[k, 0], XP[k, 1], height[k], c.static_boxes)
                 )
                 n = 0
                 for j in range(m):

@@ -140,30 +140,31 @@ SEARCH_SPACE: tuple[Parameter, ...] = (
               low=0.7, high=1.0, log=False, default=0.98),
     Parameter(name="p21", symbol="p21", meaning="existence appearance", unit="",
               low=0.0, high=0.4, log=False, default=0.0),
-    # the room tracker's own rows (docs/tracker.md "Tracking in rooms"; defaults chosen on
-    # recordings, docs/decisions/tracker-08-room-mode.md); appended: the paper's order is kept
+    # the room tracker's own rows (docs/tracker.md "Tracking in rooms"; defaults chosen on TI's
+    # people-counting recording and two walking recordings, a third held out); appended: the
+    # paper's order is kept
     Parameter(name="static_velocity", symbol="v_static", meaning="zero-Doppler limit",
               unit="m/s", low=0.001, high=0.3, log=True, modes=("room",), default=0.02),
     Parameter(name="static_time", symbol="t_static", meaning="time kept on static points",
               unit="s", low=0.5, high=600.0, log=True, modes=("room",), default=60.0),
     Parameter(name="body_sigma", symbol="σ_body", meaning="body spread", unit="m",
-              low=0.05, high=1.0, log=True, modes=("room",), default=0.3),
+              low=0.05, high=1.0, log=True, modes=("room",), default=0.5),
     Parameter(name="body_velocity_sigma", symbol="σ_vbody", meaning="body velocity spread",
-              unit="m/s", low=0.05, high=2.0, log=True, modes=("room",), default=0.5),
+              unit="m/s", low=0.05, high=2.0, log=True, modes=("room",), default=1.0),
     Parameter(name="alloc_points", symbol="n_alloc", meaning="points to start a track",
-              unit="", low=1.0, high=30.0, log=True, modes=("room",), default=5.0),
+              unit="", low=1.0, high=30.0, log=True, modes=("room",), default=18.0),
     Parameter(name="alloc_snr", symbol="SNR_alloc", meaning="SNR sum to start a track",
               unit="dB", low=1.0, high=1000.0, log=True, modes=("room",), default=60.0),
     Parameter(name="alloc_distance", symbol="d_alloc", meaning="group radius", unit="m",
-              low=0.1, high=2.0, log=True, modes=("room",), default=0.6),
+              low=0.1, high=2.0, log=True, modes=("room",), default=0.9),
     Parameter(name="alloc_velocity", symbol="v_alloc", meaning="group velocity spread",
-              unit="m/s", low=0.05, high=3.0, log=True, modes=("room",), default=0.6),
+              unit="m/s", low=0.05, high=3.0, log=True, modes=("room",), default=1.0),
     Parameter(name="ghost_gap", symbol="Δr_ghost", meaning="ghost range gap", unit="m",
               low=0.1, high=3.0, log=True, modes=("room",), default=0.5),
     Parameter(name="ghost_bearing", symbol="Δaz_ghost", meaning="ghost bearing", unit="rad",
-              low=0.02, high=0.8, log=True, modes=("room",), default=0.25),
+              low=0.02, high=0.8, log=True, modes=("room",), default=0.5),
     Parameter(name="ghost_velocity", symbol="Δv_ghost", meaning="ghost velocity match",
-              unit="m/s", low=0.05, high=2.0, log=True, modes=("room",), default=0.5),
+              unit="m/s", low=0.05, high=2.0, log=True, modes=("room",), default=1.5),
 )
 # fmt: on
 

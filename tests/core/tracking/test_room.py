@@ -2,6 +2,7 @@
 ghost rule and heights, on constructed frames whose outcome follows from the thresholds; the
 plain-Python loop and its compiled form agree; the paper mode is untouched."""
 
+import json
 import math
 
 import numpy as np
@@ -269,3 +270,30 @@ def test_room_parameters_join_the_search_space_and_stay_out_of_the_paper_mode():
             TrackerParams(mode="room", **{p.name: p.high * 2})
     with pytest.raises(InputError, match="mode"):
         TrackerParams(mode="office")
+
+
+# ---- the command line ---------------------------------------------------------------------------
+def test_track_command_room_mode_and_zones(tmp_path, capsys):
+    from core.cli import main
+    from core.tracking.synthetic import circling_paths, room_dataset
+
+    data = tmp_path / "room.npz"
+    room_dataset(*circling_paths(1, 40), seed=2).save(data)
+    cfg = tmp_path / "zones.cfg"
+    cfg.write_text("boundaryBox -4 4 0 9 -1 3\nstaticBoundaryBox -3 3 1 8 0 3\n")
+    out = tmp_path / "t.json"
+    code = main(["track", "--data", str(data), "--mode", "room", "--zones", str(cfg),
+                 "--out", str(out)])  # fmt: skip
+    assert code == 0 and out.exists()
+    doc = json.loads(out.read_text())
+    assert doc["params"]["mode"] == "room" and "alloc_points" in doc["params"]
+    capsys.readouterr()
+    # zones need the room mode; a bad zone line is one line naming it, exit 2, nothing written
+    bad_out = tmp_path / "bad.json"
+    assert main(["track", "--data", str(data), "--zones", str(cfg), "--out", str(bad_out)]) == 2
+    assert "--zones needs the room mode" in capsys.readouterr().err
+    cfg.write_text("boundaryBox -4 4 0 9 -1\n")
+    code = main(["track", "--data", str(data), "--mode", "room", "--zones", str(cfg),
+                 "--out", str(bad_out)])  # fmt: skip
+    err = capsys.readouterr().err
+    assert code == 2 and "zones.cfg:1" in err and "6 fields" in err and not bad_out.exists()
