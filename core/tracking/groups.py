@@ -46,6 +46,8 @@ __all__ = [
     "COL_Z",
     "COL_SNR",
     "body_covariance",
+    "chol3",
+    "inv_from_chol3",
     "group_update",
 ]
 
@@ -62,6 +64,33 @@ def body_covariance(r: float, sigma: float, sigma_v: float) -> np.ndarray:
     D[1, 1] = (sigma / r) ** 2
     D[2, 2] = sigma_v * sigma_v
     return D
+
+
+@register_jitable
+def chol3(S: np.ndarray) -> np.ndarray:
+    """Lower Cholesky factor L (3, 3) of a symmetric positive-definite S (S = L Lᵀ), written out
+    (a LAPACK call per track costs more than the arithmetic at this size)."""
+    L = np.zeros((3, 3))
+    L[0, 0] = math.sqrt(S[0, 0])
+    L[1, 0] = S[1, 0] / L[0, 0]
+    L[2, 0] = S[2, 0] / L[0, 0]
+    L[1, 1] = math.sqrt(S[1, 1] - L[1, 0] * L[1, 0])
+    L[2, 1] = (S[2, 1] - L[2, 0] * L[1, 0]) / L[1, 1]
+    L[2, 2] = math.sqrt(S[2, 2] - L[2, 0] * L[2, 0] - L[2, 1] * L[2, 1])
+    return L
+
+
+@register_jitable
+def inv_from_chol3(L: np.ndarray) -> np.ndarray:
+    """S⁻¹ = L⁻ᵀ L⁻¹ (3, 3) from the lower Cholesky factor."""
+    M = np.zeros((3, 3))  # M = L⁻¹, lower triangular
+    M[0, 0] = 1.0 / L[0, 0]
+    M[1, 1] = 1.0 / L[1, 1]
+    M[2, 2] = 1.0 / L[2, 2]
+    M[1, 0] = -L[1, 0] * M[0, 0] / L[1, 1]
+    M[2, 1] = -L[2, 1] * M[1, 1] / L[2, 2]
+    M[2, 0] = -(L[2, 0] * M[0, 0] + L[2, 1] * M[1, 0]) / L[2, 2]
+    return M.T @ M
 
 
 @register_jitable
@@ -129,9 +158,12 @@ def group_update(
     Rc = (R + D) / n
     S = H @ P_pred @ H.T + Rc
     S = 0.5 * (S + S.T)
-    L = np.linalg.cholesky(S)
-    w = np.linalg.solve(L, nu)
-    d2 = float(w @ w)
+    L = chol3(S)
+    # d² = ‖L⁻¹ν̄‖², forward substitution
+    w0 = nu[0] / L[0, 0]
+    w1 = (nu[1] - L[1, 0] * w0) / L[1, 1]
+    w2 = (nu[2] - L[2, 0] * w0 - L[2, 1] * w1) / L[2, 2]
+    d2 = w0 * w0 + w1 * w1 + w2 * w2
     log_det = 2.0 * (math.log(L[0, 0]) + math.log(L[1, 1]) + math.log(L[2, 2]))
     # log Λ = log N(ν̄; 0, S_c) − log(P_G ρ)
     log_lr = -0.5 * d2 - 0.5 * log_det - 1.5 * LOG_2PI - math.log(p_g * rho)
@@ -150,7 +182,7 @@ def group_update(
         psi = one_minus_delta * psi_pred / ((1.0 - psi_pred) + one_minus_delta * psi_pred)
         psi = min(1.0, max(0.0, psi))
     # K = P⁻ Hᵀ S_c⁻¹
-    K = np.linalg.solve(S, H @ P_pred).T
+    K = (P_pred @ H.T) @ inv_from_chol3(L)
     x = x_pred + beta1 * (K @ nu)
     Pc = ekf.joseph_update(P_pred, K, H, Rc)
     Knu = K @ nu

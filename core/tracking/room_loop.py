@@ -26,6 +26,7 @@ from core.tracking.groups import (
     COL_Y,
     COL_Z,
     body_covariance,
+    chol3,
     group_update,
 )
 from core.tracking.inputs import TrackerConstants
@@ -213,7 +214,7 @@ def room_frames(
                 DD[k] = D
                 S = H @ Pp @ H.T + c.R + D
                 S = 0.5 * (S + S.T)
-                L = np.linalg.cholesky(S)
+                L = chol3(S)
                 log_det = 2.0 * (math.log(L[0, 0]) + math.log(L[1, 1]) + math.log(L[2, 2]))
                 if c.nonparametric:
                     # one group in the point gate: ρ̂ = 1/V, V = (4π/3) γ^{3/2} √det S
