@@ -23,6 +23,7 @@ from __future__ import annotations
 import numpy as np
 from numba.extending import register_jitable
 
+from core import jit_guard  # noqa: F401  (before any kernel compiles: see core/jit_guard.py)
 from core.tracking.groups import COL_SNR, COL_VR, COL_X, COL_Y
 
 __all__ = ["allocate"]

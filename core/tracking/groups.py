@@ -33,6 +33,7 @@ import math
 import numpy as np
 from numba.extending import register_jitable
 
+from core import jit_guard  # noqa: F401  (before any kernel compiles: see core/jit_guard.py)
 from core.tracking import ekf
 from core.tracking.ipda import LOG_2PI
 

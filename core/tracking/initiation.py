@@ -8,6 +8,8 @@ from __future__ import annotations
 import numpy as np
 from numba.extending import register_jitable
 
+from core import jit_guard  # noqa: F401  (before any kernel compiles: see core/jit_guard.py)
+
 __all__ = ["unassociated", "initial_state", "initial_covariance"]
 
 

@@ -21,6 +21,7 @@ import numpy as np
 from numba.extending import register_jitable
 from scipy.linalg import cho_solve
 
+from core import jit_guard  # noqa: F401  (before any kernel compiles: see core/jit_guard.py)
 from core.tracking.ekf import joseph_update, symmetrize
 from core.tracking.gating import mahalanobis_squared
 

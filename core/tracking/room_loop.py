@@ -14,6 +14,7 @@ from typing import NamedTuple
 import numpy as np
 from numba.extending import register_jitable
 
+from core import jit_guard  # noqa: F401  (before any kernel compiles: see core/jit_guard.py)
 from core.tracking import ekf, initiation, ipda
 from core.tracking.allocation import allocate
 from core.tracking.ghosts import ghost_candidates

@@ -25,6 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 from numba.extending import register_jitable
 
+from core import jit_guard  # noqa: F401  (before any kernel compiles: see core/jit_guard.py)
 from core.errors import InputError
 from core.files import read_text
 
