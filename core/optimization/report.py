@@ -39,6 +39,7 @@ from typing import Any
 import numpy as np
 
 from core.errors import InputError
+from core.evaluation.robust import OBJECTIVE_NEEDS
 from core.files import save_figure, write_json_atomic, write_text_atomic
 from core.optimization.progress import TrialSummary, study_progress
 from core.optimization.report_sensitivity import sensitivity_markdown
@@ -111,6 +112,14 @@ def load_studies(storage: str) -> list[StudyRecord]:
         attrs = s.user_attrs
         if "model" not in attrs:
             continue
+        if attrs.get("mix") or OBJECTIVE_NEEDS.get(str(attrs.get("loss", "paper"))) != "truth":
+            # the report is the paper's loss on simulated sets: refused before any simulation
+            raise InputError(
+                f"study {s.study_name!r} minimised --loss {attrs.get('loss')}"
+                f"{' on mixed data sets' if attrs.get('mix') else ''}: the report scores "
+                "positions on simulated sets; judge it with radartune track --params (scores "
+                "without positions) or radartune bench transfer"
+            )
         trials, _ = study_progress(storage, s.study_name)
         out.append(
             StudyRecord(

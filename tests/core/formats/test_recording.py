@@ -150,7 +150,7 @@ def test_export_import_round_trip(simulated, fmt, variant, capsys) -> None:
     assert res["imp"]["rmse_m"] == pytest.approx(res["sim"]["rmse_m"], rel=rel)
 
 
-def test_import_without_truth_tracks_and_refuses_a_study(simulated, capsys) -> None:
+def test_import_without_truth_tracks_and_refuses_a_position_study(simulated, capsys) -> None:
     folder, scene, _, _ = simulated
     log = folder / "plain.dat"
     assert (
@@ -162,11 +162,15 @@ def test_import_without_truth_tracks_and_refuses_a_study(simulated, capsys) -> N
     assert "no --cfg" in capsys.readouterr().out
     assert run_cli("track", "--data", data) == 0
     assert "no ground truth" in capsys.readouterr().out
+    # an objective on positions needs truth (a recording is tuned without positions: --loss
+    # count, fragmentation, nis; tests/core/optimization/test_objectives_without_positions.py)
     code = run_cli(
-        "tune", "--model", "cv", "--dataset", data, "--trials", "1", "--storage", folder / "s.db"
-    )
+        "tune", "--model", "cv", "--dataset", data, "--trials", "1", "--storage",
+        folder / "s.db", "--loss", "paper",
+    )  # fmt: skip
     err = capsys.readouterr().err
     assert code == 2 and len(err.strip().splitlines()) == 1 and "no ground truth" in err
+    assert "--loss nis" in err
     assert not (folder / "s.db").exists()
 
 

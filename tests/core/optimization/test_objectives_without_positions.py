@@ -119,6 +119,10 @@ def test_tune_on_a_recording_without_truth(tmp_path, capsys) -> None:
     p.write_text(json.dumps(out["params"]))
     assert main(["track", "--data", str(val), "--params", str(p), "--people", "1"]) == 0
     assert "head count from --people 1" in capsys.readouterr().out
+    # the report (the paper's loss on simulated sets) refuses such a study before any work
+    assert main(["report", "--storage", storage, "--out", str(tmp_path / "rep")]) == 2
+    assert "--loss fragmentation" in capsys.readouterr().err
+    assert not (tmp_path / "rep").exists()
 
 
 def test_bench_cuts_a_recording_to_its_first_frames() -> None:
