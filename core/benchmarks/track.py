@@ -284,6 +284,7 @@ def run(quick: bool = False) -> dict:
         }
     out["jipda"] = jipda_bench(ds, quick)
     out["gtrack"] = gtrack_bench(quick)
+    out["room"] = room_bench(ds, quick)
     return out
 
 
@@ -342,6 +343,52 @@ def gtrack_bench(quick: bool = False) -> dict:
         "compiled_over_readable": (n_read / c_r and (n_frames / c_g) / (n_read / c_r)),
         "mean_active_tracks": float(np.mean(res.n_active)),
     }
+
+
+#: Frames of the room scene of the room-mode measurement (four people, 150 points a frame).
+ROOM_FRAMES = 1000
+
+
+def room_bench(ds, quick: bool = False) -> dict:
+    """The room mode's speed, in the same run as the paper mode: CPU time of a pass over the
+    paper data set (room defaults against paper defaults, CV), and frames/s on a room scene of
+    four people circling with 150 points a frame (:func:`core.tracking.stability.room_scenes`);
+    plus whether the compiled room loop equals its plain-Python run on that scene."""
+    from core.tracking import TrackerParams, track_dataset
+    from core.tracking.stability import room_scenes
+
+    repeats = 3 if quick else 15
+    paper, room = TrackerParams.default("cv"), TrackerParams.default("cv", mode="room")
+    # the room defaults need 18 points to start a track: none on a one-point-a-person set; with
+    # n_alloc = 1 and SNR_alloc = 1 dB the room mode tracks it (the cost that matters)
+    room1 = replace(room, alloc_points=1.0, alloc_snr=1.0)
+    row: dict = {}
+    for name, p in (("paper", paper), ("room", room), ("room_alloc1", room1)):
+        est = track_dataset(ds, p)  # loads (or compiles) the kernel
+        _, cpu = _best_of(lambda p=p: track_dataset(ds, p), repeats)
+        row[f"{name}_cpu_ms_per_pass"] = 1e3 * cpu
+        row[f"{name}_frames_per_s"] = ds.n_frames / cpu
+        row[f"{name}_mean_confirmed"] = float(est.n_confirmed.mean())
+    row["cpu_ratio_room_to_paper"] = row["room_cpu_ms_per_pass"] / row["paper_cpu_ms_per_pass"]
+    row["cpu_ratio_room_alloc1_to_paper"] = (
+        row["room_alloc1_cpu_ms_per_pass"] / row["paper_cpu_ms_per_pass"]
+    )
+    n_frames = 200 if quick else ROOM_FRAMES
+    scene = room_scenes(n_frames, seed=0)["room, 4 people circling"]
+    scene_row: dict = {"frames": n_frames, "points_per_frame": len(scene.frame) / n_frames}
+    for name, p in (("paper", paper), ("room", room)):
+        est = track_dataset(scene, p)
+        _, cpu = _best_of(lambda p=p: track_dataset(scene, p), repeats)
+        scene_row[f"{name}_frames_per_s"] = n_frames / cpu
+        scene_row[f"{name}_mean_confirmed"] = float(est.n_confirmed.mean())
+    short = room_scenes(100 if quick else 300, seed=0)["room, 4 people circling"]
+    a = track_dataset(short, room, engine="numpy")
+    b = track_dataset(short, room)
+    scene_row["compiled_equals_plain"] = bool(
+        np.array_equal(a.n_confirmed, b.n_confirmed)
+        and np.allclose(a.estimate_xy, b.estimate_xy, rtol=0, atol=1e-10, equal_nan=True)
+    )
+    return {"paper_data_set": row, "room_scene": scene_row}
 
 
 #: People in the cost-against-people measurement.
@@ -483,5 +530,24 @@ def summary(result: dict) -> str:
             f"the same points {g['paper_jipda_frames_per_s']:.0f} frames/s (gtrack takes "
             f"{g['ratio_gtrack_to_paper_time']:.2f}x its time); readable gtrack "
             f"{g['readable_gtrack_frames_per_s']:.0f} frames/s ({g['compiled_over_readable']:.0f}x)"
+        )
+    r = result.get("room")
+    if r:
+        pr, sc = r["paper_data_set"], r["room_scene"]
+        lines.append(
+            f"room mode, same run (CV defaults, CPU best of repeats): paper data set "
+            f"{pr['paper_cpu_ms_per_pass']:.2f} ms paper mode, {pr['room_cpu_ms_per_pass']:.2f} "
+            f"ms room mode a pass, ratio {pr['cpu_ratio_room_to_paper']:.2f} (confirmed "
+            f"{pr['room_mean_confirmed']:.2f}); n_alloc = 1: "
+            f"{pr['room_alloc1_cpu_ms_per_pass']:.2f} ms, ratio "
+            f"{pr['cpu_ratio_room_alloc1_to_paper']:.2f} (confirmed "
+            f"{pr['room_alloc1_mean_confirmed']:.2f}, paper {pr['paper_mean_confirmed']:.2f})"
+        )
+        lines.append(
+            f"  room scene, 4 people, {sc['points_per_frame']:.0f} points/frame, "
+            f"{sc['frames']} frames: room {sc['room_frames_per_s']:.0f} frames/s "
+            f"(confirmed {sc['room_mean_confirmed']:.2f}), paper {sc['paper_frames_per_s']:.0f} "
+            f"frames/s (confirmed {sc['paper_mean_confirmed']:.2f}); compiled = plain: "
+            f"{sc['compiled_equals_plain']}"
         )
     return "\n".join(lines)

@@ -27,6 +27,7 @@ BENCHMARKS = (
     "import",
     "gtrack_ti",
     "chain_calibration",
+    "room",
 )
 #: benchmark name -> module in core.benchmarks, where the name is a Python keyword
 MODULES = {"import": "import_"}

@@ -2,8 +2,9 @@
 and the filter consistency of the tuned trackers on the chain's own data.
 
 Sweep: all 2¹² CV corners and a seeded sample of CA corners (2048 by default) each track the
-synthetic paper-like scene and three multi-person scenes with crossings for 300 frames; any
-NaN/Inf or non-SPD covariance makes the command exit 1.
+synthetic paper-like scene and three multi-person scenes with crossings for 300 frames, and a
+seeded sample of the room mode's corners (512 by default) the two room scenes; any NaN/Inf or
+non-SPD covariance makes the command exit 1.
 
 Consistency: NEES and NIS (:mod:`core.evaluation.consistency`) per trajectory class of the tuned
 parameters (``docs/report/best_*.json`` on the point person, ``docs/report/walking-campaign/
@@ -44,6 +45,12 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--ca-corners", type=int, default=2048, help="CA corners sampled (default: %(default)s)"
     )
+    p.add_argument(
+        "--room-corners",
+        type=int,
+        default=512,
+        help="room-mode CV corners sampled, on the room scenes (default: %(default)s)",
+    )
     p.add_argument("--frames", type=int, default=300, help="frames per run (default: %(default)s)")
     p.add_argument("--seed", type=int, default=0, help="scene and sample seed")
     p.add_argument(
@@ -68,8 +75,10 @@ def run(args: argparse.Namespace) -> int:
     from core.files import check_output_path, write_json_atomic
     from core.limits import MAX_FRAMES
 
-    if not 2 <= args.frames <= MAX_FRAMES or args.ca_corners < 1:
-        raise InputError(f"--frames must be in [2, {MAX_FRAMES}] and --ca-corners >= 1")
+    if not 2 <= args.frames <= MAX_FRAMES or args.ca_corners < 1 or args.room_corners < 1:
+        raise InputError(
+            f"--frames must be in [2, {MAX_FRAMES}], --ca-corners and --room-corners >= 1"
+        )
     if args.paper_seed < 0:
         raise InputError(f"--paper-seed must be >= 0, got {args.paper_seed}")
     for path in (args.json, args.plot):
@@ -102,6 +111,7 @@ def _sweep(args: argparse.Namespace) -> tuple[bool, list[dict[str, Any]]]:
     from core.tracking.stability import (
         all_corners,
         multi_person_scenes,
+        room_scenes,
         stability_scene,
         sweep,
     )
@@ -109,39 +119,43 @@ def _sweep(args: argparse.Namespace) -> tuple[bool, list[dict[str, Any]]]:
     scenes = {"1 person circling": stability_scene(args.frames, args.seed)}
     scenes.update(multi_person_scenes(args.frames, args.seed))
     plans = [
-        ("cv", all_corners("cv", 256 if args.quick else None, args.seed)),
-        ("ca", all_corners("ca", 128 if args.quick else args.ca_corners, args.seed)),
+        ("cv", "paper", all_corners("cv", 256 if args.quick else None, args.seed)),
+        ("ca", "paper", all_corners("ca", 128 if args.quick else args.ca_corners, args.seed)),
     ]
+    room = all_corners("cv", 32 if args.quick else args.room_corners, args.seed, "room")
+    runs = [(scene, ds, plan) for scene, ds in scenes.items() for plan in plans]
+    runs += [(scene, ds, ("cv", "room", room)) for scene, ds in room_scenes(args.frames).items()]
     ok = True
     rows = []
-    for scene, ds in scenes.items():
-        for model, corners in plans:
-            t0 = time.perf_counter()
-            rep = sweep(model, corners, ds)
-            dt = time.perf_counter() - t0
-            print(
-                f"{scene}, {model}: {rep.n_corners} corners x {rep.n_frames} frames in "
-                f"{dt:.1f} s: {rep.bad_corners} bad corners, {rep.bad_track_frames} unhealthy "
-                f"track-frames (NaN/Inf, psi outside [0,1] or P not SPD), "
-                f"{rep.nonfinite_outputs} non-finite outputs; at most {rep.max_tracks_seen} "
-                "live tracks"
-            )
-            for bits in rep.failures:
-                print(f"  failing corner ({model}): {''.join(map(str, bits))}")
-            ok &= rep.ok
-            rows.append(
-                {
-                    "scene": scene,
-                    "model": model,
-                    "corners": rep.n_corners,
-                    "frames": rep.n_frames,
-                    "bad_corners": rep.bad_corners,
-                    "unhealthy_track_frames": rep.bad_track_frames,
-                    "nonfinite_outputs": rep.nonfinite_outputs,
-                    "max_tracks": rep.max_tracks_seen,
-                    "seconds": round(dt, 2),
-                }
-            )
+    for scene, ds, (model, mode, corners) in runs:
+        t0 = time.perf_counter()
+        rep = sweep(model, corners, ds, mode)
+        dt = time.perf_counter() - t0
+        print(
+            f"{scene}, {model}{' room' if mode == 'room' else ''}: {rep.n_corners} corners x "
+            f"{rep.n_frames} frames in "
+            f"{dt:.1f} s: {rep.bad_corners} bad corners, {rep.bad_track_frames} unhealthy "
+            f"track-frames (NaN/Inf, psi outside [0,1] or P not SPD), "
+            f"{rep.nonfinite_outputs} non-finite outputs; at most {rep.max_tracks_seen} "
+            "live tracks"
+        )
+        for bits in rep.failures:
+            print(f"  failing corner ({model}): {''.join(map(str, bits))}")
+        ok &= rep.ok
+        rows.append(
+            {
+                "scene": scene,
+                "model": model,
+                "mode": mode,
+                "corners": rep.n_corners,
+                "frames": rep.n_frames,
+                "bad_corners": rep.bad_corners,
+                "unhealthy_track_frames": rep.bad_track_frames,
+                "nonfinite_outputs": rep.nonfinite_outputs,
+                "max_tracks": rep.max_tracks_seen,
+                "seconds": round(dt, 2),
+            }
+        )
     return ok, rows
 
 

@@ -54,6 +54,18 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         help="the paper's (J)IPDA, or TI's people tracker rebuilt (gtrack); default: paper",
     )
     p.add_argument("--cfg", help="gtrack: take the tracker lines of this TI .cfg")
+    p.add_argument(
+        "--mode",
+        choices=("paper", "room"),
+        help="tracker: the paper's one-point IPDA, or the tracker for real rooms (groups of "
+        "points, static points, ghosts; default: the parameters' 'mode', paper)",
+    )
+    p.add_argument(
+        "--zones",
+        metavar="TI_CFG",
+        help="room mode: boundary, static and presence boxes from a TI .cfg's boundaryBox, "
+        "staticBoundaryBox and presenceBoundaryBox lines (default: none)",
+    )
     p.set_defaults(func=run)
 
 
@@ -74,6 +86,16 @@ def run(args: argparse.Namespace) -> int:
     if args.tracker == "gtrack":
         from core.cli.gtrack import run_track
 
+        if args.mode or args.zones:
+            raise InputError(
+                "--mode and --zones set RadarTune's tracker; gtrack takes its boxes from --cfg"
+            )
+        if args.tracks or args.people is not None:
+            raise InputError(
+                "--tracks and --people are not yet available with --tracker gtrack "
+                "(radartune bench gtrack_ti compares gtrack with a recording's own tracks)"
+            )
+
         return run_track(args)
     if args.cfg:
         raise InputError("--cfg sets gtrack's tracker lines: use it with --tracker gtrack")
@@ -91,6 +113,15 @@ def run(args: argparse.Namespace) -> int:
     )
     if args.association:
         params = replace(params, association=args.association)
+    if args.mode:
+        params = replace(params, mode=args.mode)
+    zones = None
+    if args.zones:
+        from core.tracking.zones import zones_from_cfg
+
+        if params.mode != "room":
+            raise InputError("--zones needs the room mode (--mode room)")
+        zones = zones_from_cfg(args.zones)
     ds = Dataset.load(args.data)
     traj = None
     if args.trajectories:
@@ -108,7 +139,9 @@ def run(args: argparse.Namespace) -> int:
     # loading the compiled kernels is start-up, not tracking: paid first, reported apart
     startup = load_compiled(params) if args.engine == "numba" else 0.0
     t0 = time.perf_counter()
-    est = track_dataset(ds, params, trajectories=traj, engine=args.engine, with_tracks=True)
+    est = track_dataset(
+        ds, params, trajectories=traj, engine=args.engine, with_tracks=True, zones=zones
+    )
     elapsed = time.perf_counter() - t0
     from core.formats.recording import has_truth
 

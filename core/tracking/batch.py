@@ -19,6 +19,7 @@ from core.dataset import Dataset
 from core.errors import InputError
 from core.tracking.params import TrackerParams
 from core.tracking.results import FrameTracks, TrackRecord
+from core.tracking.zones import Zones
 
 __all__ = [
     "ConfirmedTracks",
@@ -163,6 +164,7 @@ def dataset_frame_period_s(dataset: Dataset) -> float:
 
 
 _PREPARED: list = []  # single entry: (dataset, z, frame_offsets, trajectory_offsets, period)
+_ROOM_PREPARED: list = []  # single entry: (dataset, room points)
 
 
 def _prepare(dataset: Dataset) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
@@ -185,6 +187,22 @@ def _prepare(dataset: Dataset) -> tuple[np.ndarray, np.ndarray, np.ndarray, floa
     return z, f_off, t_off, period
 
 
+def room_points_of(dataset: Dataset) -> np.ndarray:
+    """The room tracker's points (P, 7) of a data set (:data:`core.tracking.groups.COLUMNS`),
+    kept for the last data set used."""
+    entry = _ROOM_PREPARED[0] if _ROOM_PREPARED else None
+    if entry is not None and entry[0] is dataset:
+        return entry[1]
+    from core.tracking.room import room_points
+
+    pts = room_points(
+        dataset.range_m, dataset.azimuth_rad, dataset.radial_velocity_mps,
+        dataset.x_m, dataset.y_m, dataset.z_m, dataset.snr_db,
+    )  # fmt: skip
+    _ROOM_PREPARED[:] = [(dataset, pts)]
+    return pts
+
+
 def _selection(dataset: Dataset, trajectories: Sequence[int] | None) -> np.ndarray:
     k = dataset.n_trajectories
     if trajectories is None:
@@ -202,6 +220,7 @@ def track_dataset(
     trajectories: Sequence[int] | None = None,
     engine: str = "numba",
     with_tracks: bool = False,
+    zones: Zones | None = None,
 ) -> DatasetEstimates:
     """Track every selected trajectory of a data set from scratch.
 
@@ -217,6 +236,8 @@ def track_dataset(
         ``"numba"`` (compiled kernel, default) or ``"numpy"`` (readable reference).
     with_tracks
         Also return every confirmed track with its id (``tracks``); off on the optimiser's path.
+    zones
+        The room's zones (room mode only; default: none, every point used).
 
     Returns
     -------
@@ -233,7 +254,20 @@ def track_dataset(
         if len(sel)
         else np.zeros(0, dtype=np.int64)
     )
-    if engine == "numba":
+    if params.mode == "room":
+        from core.tracking.room import track_room_arrays
+
+        out = track_room_arrays(
+            room_points_of(dataset), f_off, t_off, sel, params, period, zones,
+            record=with_tracks, engine=engine,
+        )  # fmt: skip
+        est_xy, has, psi, conf_xy, n_conf, n_tr = out[:6]
+        if with_tracks:
+            rec = record = out[8]
+            tracks = ConfirmedTracks.from_slots(
+                rec.ids, rec.state[..., :2], rec.psi, _live(rec.n_tracks, rec.confirmed)
+            )
+    elif engine == "numba":
         from core.tracking.kernel import track_frames
 
         out = track_frames(z, f_off, t_off, sel, params, period, record=with_tracks)

@@ -4,11 +4,17 @@
 Jacobian is singular at r = 0, so position is evaluated at a range of at least
 :data:`MIN_RANGE_M` along the same bearing (along boresight when x = y = 0): no NaN can arise.
 Azimuth innovations are wrapped to (−π, π].
+
+The functions marked ``register_jitable`` are plain Python here and compile inside the room
+tracker's kernel (:mod:`core.tracking.room_kernel`): one definition for both.
 """
 
 from __future__ import annotations
 
 import numpy as np
+from numba.extending import register_jitable
+
+from core import jit_guard  # noqa: F401  (before any kernel compiles: see core/jit_guard.py)
 
 __all__ = [
     "MIN_RANGE_M",
@@ -33,6 +39,7 @@ def wrap_angle(a: np.ndarray | float) -> np.ndarray:
     return np.where(w == -np.pi, np.pi, w)
 
 
+@register_jitable
 def safe_position(x: float, y: float) -> tuple[float, float, float]:
     """Position moved out to at least MIN_RANGE_M along its bearing; returns (x, y, r)."""
     r = float(np.hypot(x, y))
@@ -44,6 +51,7 @@ def safe_position(x: float, y: float) -> tuple[float, float, float]:
     return float(x) * s, float(y) * s, MIN_RANGE_M
 
 
+@register_jitable
 def measure(state: np.ndarray) -> np.ndarray:
     """Predicted measurement h(x) = [r (m), az (rad), vr (m/s)], shape (3,)."""
     x, y, r = safe_position(state[0], state[1])
@@ -52,6 +60,7 @@ def measure(state: np.ndarray) -> np.ndarray:
     return np.array([r, np.arctan2(x, y), (x * vx + y * vy) / r])
 
 
+@register_jitable
 def jacobian(state: np.ndarray) -> np.ndarray:
     """Jacobian H = ∂h/∂x at the state, shape (3, n) with n = len(state)."""
     x, y, r = safe_position(state[0], state[1])
@@ -77,11 +86,13 @@ def innovation(z: np.ndarray, z_pred: np.ndarray) -> np.ndarray:
     return nu
 
 
+@register_jitable
 def symmetrize(P: np.ndarray) -> np.ndarray:
     """(P + Pᵀ)/2."""
     return 0.5 * (P + P.T)
 
 
+@register_jitable
 def predict(x: np.ndarray, P: np.ndarray, F: np.ndarray, Q: np.ndarray):
     """Kalman prediction; returns (x⁻, P⁻)."""
     # x⁻ = F x
@@ -91,6 +102,7 @@ def predict(x: np.ndarray, P: np.ndarray, F: np.ndarray, Q: np.ndarray):
     return x_pred, P_pred
 
 
+@register_jitable
 def joseph_update(P_pred: np.ndarray, K: np.ndarray, H: np.ndarray, R: np.ndarray) -> np.ndarray:
     """Updated covariance in the Joseph form (positive semi-definite for any gain K)."""
     I_KH = np.eye(P_pred.shape[0]) - K @ H

@@ -6,6 +6,9 @@ a tentative track with position from (r, az), velocity vr along the line of sigh
 from __future__ import annotations
 
 import numpy as np
+from numba.extending import register_jitable
+
+from core import jit_guard  # noqa: F401  (before any kernel compiles: see core/jit_guard.py)
 
 __all__ = ["unassociated", "initial_state", "initial_covariance"]
 
@@ -17,6 +20,7 @@ def unassociated(gated: np.ndarray) -> np.ndarray:
     return ~np.any(gated, axis=0)
 
 
+@register_jitable
 def initial_state(z: np.ndarray, state_dim: int) -> np.ndarray:
     """State (state_dim,) of a new track from one measurement z = [r, az, vr]."""
     r, az, vr = float(z[0]), float(z[1]), float(z[2])

@@ -18,8 +18,10 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from numba.extending import register_jitable
 from scipy.linalg import cho_solve
 
+from core import jit_guard  # noqa: F401  (before any kernel compiles: see core/jit_guard.py)
 from core.tracking.ekf import joseph_update, symmetrize
 from core.tracking.gating import mahalanobis_squared
 
@@ -38,6 +40,7 @@ __all__ = [
 LOG_2PI = math.log(2.0 * math.pi)
 
 
+@register_jitable
 def predict_existence(psi: float, p11: float, p21: float) -> float:
     """ψ⁻ = p11·ψ + p21·(1 − ψ) (eq. 9), clipped to [0, 1]."""
     # ψ⁻ = p11 ψ + p21 (1 − ψ)

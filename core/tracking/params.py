@@ -15,7 +15,16 @@ from core.errors import InputError
 from core.files import read_json, write_json_atomic
 from core.limits import CLUTTER_DENSITY_RANGE, MAX_TRACKS, VARIANCE_RANGE
 from core.tracking.jipda import ASSOCIATIONS
-from core.tracking.space import MODELS, P0_NAMES, STATE_DIM, defaults, p0_names, parameter
+from core.tracking.space import (
+    MODELS,
+    MODES,
+    P0_NAMES,
+    ROOM_NAMES,
+    STATE_DIM,
+    defaults,
+    p0_names,
+    parameter,
+)
 
 NONPARAMETRIC = "nonparametric"
 
@@ -59,6 +68,12 @@ class TrackerParams:
     association
         ``"jipda"`` (joint IPDA over tracks whose gates share measurements, the default) or
         ``"ipda"`` (independent IPDA per track); not optimised (docs/decisions/tracker-06).
+    mode
+        ``"paper"`` (the paper's one-point IPDA, :mod:`core.tracking.tracker`) or ``"room"``
+        (people as groups of points, static points, ghosts: :mod:`core.tracking.room`).
+    static_velocity … ghost_velocity
+        The room tracker's own parameters (rows of :mod:`core.tracking.space`, units there);
+        ignored by the paper mode and left out of its JSON.
     """
 
     model: str = "cv"
@@ -78,6 +93,18 @@ class TrackerParams:
     clutter_density: float | str = 0.0073
     max_tracks: int = 20
     association: str = "jipda"
+    mode: str = "paper"
+    static_velocity: float = parameter("static_velocity").default
+    static_time: float = parameter("static_time").default
+    body_sigma: float = parameter("body_sigma").default
+    body_velocity_sigma: float = parameter("body_velocity_sigma").default
+    alloc_points: float = parameter("alloc_points").default
+    alloc_snr: float = parameter("alloc_snr").default
+    alloc_distance: float = parameter("alloc_distance").default
+    alloc_velocity: float = parameter("alloc_velocity").default
+    ghost_gap: float = parameter("ghost_gap").default
+    ghost_bearing: float = parameter("ghost_bearing").default
+    ghost_velocity: float = parameter("ghost_velocity").default
 
     def __post_init__(self) -> None:
         if self.model not in MODELS:
@@ -143,6 +170,14 @@ class TrackerParams:
             raise InputError(
                 f"association must be one of {ASSOCIATIONS}, got association={self.association!r}"
             )
+        if self.mode not in MODES:
+            raise InputError(f"mode must be one of {MODES}, got mode={self.mode!r}")
+        for name in ROOM_NAMES:
+            v, row = getattr(self, name), parameter(name)
+            if not _is_number(v) or not (math.isfinite(v) and row.low <= v <= row.high):
+                raise InputError(
+                    f"{name} must be a number in [{row.low:g}, {row.high:g}], got {name}={v!r}"
+                )
         if isinstance(self.max_tracks, bool) or not isinstance(self.max_tracks, int):
             raise InputError(f"max_tracks must be an integer, got max_tracks={self.max_tracks!r}")
         if not 1 <= self.max_tracks <= MAX_TRACKS:
@@ -163,16 +198,20 @@ class TrackerParams:
 
     # ---- construction ------------------------------------------------------------------------
     @classmethod
-    def default(cls, model: str = "cv") -> TrackerParams:
-        """The default parameters of a motion model (see docs/tracker.md)."""
+    def default(cls, model: str = "cv", mode: str = "paper") -> TrackerParams:
+        """The default parameters of a motion model and mode (see docs/tracker.md)."""
         if model not in MODELS:
             raise InputError(f"model must be one of {MODELS}, got model={model!r}")
-        return cls(model=model, p0=DEFAULT_P0[model])
+        return cls(model=model, p0=DEFAULT_P0[model], mode=mode)
 
     def to_dict(self) -> dict:
-        """JSON-ready dict with the SPEC §6 keys (``p0`` as a list)."""
+        """JSON-ready dict with the SPEC §6 keys (``p0`` as a list); the mode and the room
+        tracker's keys only in the room mode (a paper-mode file is as it was)."""
         d = {f.name: getattr(self, f.name) for f in fields(self)}
         d["p0"] = list(self.p0)
+        if self.mode == "paper":
+            for name in ("mode", *ROOM_NAMES):
+                del d[name]
         return d
 
     @classmethod

@@ -54,6 +54,12 @@ class FrameTracks:
         was gated and for a track born in this frame.
     estimate
         Index into these arrays of the single-person estimate, or −1.
+    height_m
+        (n,) height of each track (m, the mean z of its latest group of points), room mode
+        only (None in the paper mode).
+    ghost
+        (n,) bool, the track is a ghost candidate (neither confirmed nor counted), room mode
+        only (None in the paper mode).
     """
 
     ids: np.ndarray
@@ -67,6 +73,8 @@ class FrameTracks:
     n_associated: np.ndarray
     nis: np.ndarray
     estimate: int = -1
+    height_m: np.ndarray | None = None
+    ghost: np.ndarray | None = None
 
     def __len__(self) -> int:
         return len(self.ids)

@@ -29,12 +29,15 @@ __all__ = [
     "MODELS",
     "GTRACK",
     "GTRACK_SPACE",
+    "MODES",
     "STATE_DIM",
     "Parameter",
     "SEARCH_SPACE",
     "P0_NAMES",
+    "ROOM_NAMES",
     "check_model",
     "check_tuned",
+    "check_mode",
     "parameter",
     "search_space",
     "p0_names",
@@ -47,6 +50,9 @@ __all__ = [
 MODELS = ("cv", "ca")
 #: The key of TI's tracker's table (:data:`GTRACK_SPACE`), beside the motion models.
 GTRACK = "gtrack"
+#: Tracker modes: the paper's one-point IPDA, and the tracker for real rooms (groups of points,
+#: zones, static points, ghosts; :mod:`core.tracking.room`).
+MODES = ("paper", "room")
 #: State dimension per motion model: CV [x, y, vx, vy], CA [x, y, vx, vy, ax, ay].
 STATE_DIM = {"cv": 4, "ca": 6}
 
@@ -72,6 +78,8 @@ class Parameter:
         Sampled on a log scale (the interval spans a decade or more).
     models
         The motion models that use it (``("gtrack",)``: a row of gtrack's table).
+    modes
+        The tracker modes that use it (the paper's rows: both; the room tracker's own: room).
     default
         The default value (docs/decisions/tracker-03), inside ``[low, high]``.
     integer
@@ -86,6 +94,7 @@ class Parameter:
     high: float
     log: bool
     models: tuple[str, ...] = MODELS
+    modes: tuple[str, ...] = MODES
     default: float
     integer: bool = False
 
@@ -98,6 +107,8 @@ class Parameter:
             raise InputError(
                 f"{self.name}: models must be some of {(*MODELS, GTRACK)}, got {self.models}"
             )
+        if not self.modes or not set(self.modes) <= set(MODES):
+            raise InputError(f"{self.name}: modes must be some of {MODES}, got {self.modes}")
         if not (math.isfinite(self.default) and self.low <= self.default <= self.high):
             raise InputError(
                 f"{self.name}: default must lie in [{self.low}, {self.high}], got {self.default}"
@@ -142,6 +153,31 @@ SEARCH_SPACE: tuple[Parameter, ...] = (
               low=0.7, high=1.0, log=False, default=0.98),
     Parameter(name="p21", symbol="p21", meaning="existence appearance", unit="",
               low=0.0, high=0.4, log=False, default=0.0),
+    # the room tracker's own rows (docs/tracker.md "Tracking in rooms"; defaults chosen on TI's
+    # people-counting recording and two walking recordings, a third held out); appended: the
+    # paper's order is kept
+    Parameter(name="static_velocity", symbol="v_static", meaning="zero-Doppler limit",
+              unit="m/s", low=0.001, high=0.3, log=True, modes=("room",), default=0.02),
+    Parameter(name="static_time", symbol="t_static", meaning="time kept on static points",
+              unit="s", low=0.5, high=600.0, log=True, modes=("room",), default=60.0),
+    Parameter(name="body_sigma", symbol="σ_body", meaning="body spread", unit="m",
+              low=0.05, high=1.0, log=True, modes=("room",), default=0.5),
+    Parameter(name="body_velocity_sigma", symbol="σ_vbody", meaning="body velocity spread",
+              unit="m/s", low=0.05, high=2.0, log=True, modes=("room",), default=1.0),
+    Parameter(name="alloc_points", symbol="n_alloc", meaning="points to start a track",
+              unit="", low=1.0, high=30.0, log=True, modes=("room",), default=18.0),
+    Parameter(name="alloc_snr", symbol="SNR_alloc", meaning="SNR sum to start a track",
+              unit="dB", low=1.0, high=1000.0, log=True, modes=("room",), default=60.0),
+    Parameter(name="alloc_distance", symbol="d_alloc", meaning="group radius", unit="m",
+              low=0.1, high=2.0, log=True, modes=("room",), default=0.9),
+    Parameter(name="alloc_velocity", symbol="v_alloc", meaning="group velocity spread",
+              unit="m/s", low=0.05, high=3.0, log=True, modes=("room",), default=1.0),
+    Parameter(name="ghost_gap", symbol="Δr_ghost", meaning="ghost range gap", unit="m",
+              low=0.1, high=3.0, log=True, modes=("room",), default=0.5),
+    Parameter(name="ghost_bearing", symbol="Δaz_ghost", meaning="ghost bearing", unit="rad",
+              low=0.02, high=0.8, log=True, modes=("room",), default=0.5),
+    Parameter(name="ghost_velocity", symbol="Δv_ghost", meaning="ghost velocity match",
+              unit="m/s", low=0.05, high=2.0, log=True, modes=("room",), default=1.5),
 )
 # fmt: on
 
@@ -210,12 +246,25 @@ def parameter(name: str) -> Parameter:
         raise InputError(f"{name!r} is not an optimised tracker parameter") from None
 
 
-def search_space(model: str) -> tuple[Parameter, ...]:
-    """The rows ``model`` uses, in table order (CV: 12, CA: 14; ``"gtrack"``: gtrack's 20)."""
+def check_mode(mode: str) -> str:
+    """Return ``mode`` if it is a known tracker mode, else raise :class:`InputError`."""
+    if mode not in MODES:
+        raise InputError(f"mode must be one of {', '.join(MODES)}, got {mode!r}")
+    return mode
+
+
+def search_space(model: str, mode: str = "paper") -> tuple[Parameter, ...]:
+    """The rows ``model`` uses in ``mode``, in table order (paper CV: 12, CA: 14; room: + 11;
+    ``"gtrack"``: gtrack's 20, whatever the mode)."""
     if model == GTRACK:
         return GTRACK_SPACE
     check_model(model)
-    return tuple(p for p in SEARCH_SPACE if model in p.models)
+    check_mode(mode)
+    return tuple(p for p in SEARCH_SPACE if model in p.models and mode in p.modes)
+
+
+#: The room tracker's own parameters (table order).
+ROOM_NAMES: tuple[str, ...] = tuple(p.name for p in SEARCH_SPACE if p.modes == ("room",))
 
 
 def p0_names(model: str) -> tuple[str, ...]:
@@ -223,9 +272,9 @@ def p0_names(model: str) -> tuple[str, ...]:
     return tuple(p.name for p in search_space(model) if p.name in P0_NAMES)
 
 
-def defaults(model: str) -> dict[str, float]:
-    """Default value of every parameter ``model`` uses, by name (flat: ``p0_ii`` keys)."""
-    return {p.name: p.default for p in search_space(model)}
+def defaults(model: str, mode: str = "paper") -> dict[str, float]:
+    """Default value of every parameter ``model`` uses in ``mode``, by name (flat: ``p0_ii``)."""
+    return {p.name: p.default for p in search_space(model, mode)}
 
 
 def tracker_params_dict(flat: dict[str, Any], model: str) -> dict[str, Any]:

@@ -34,7 +34,7 @@ PAPER = {
 
 
 def test_bounds_are_the_papers() -> None:
-    assert {b.name: (b.low, b.high) for b in SEARCH_SPACE} == PAPER
+    assert {b.name: (b.low, b.high) for b in SEARCH_SPACE if "paper" in b.modes} == PAPER
 
 
 def test_cv_never_has_acceleration_entries_and_ca_has_all() -> None:

@@ -60,7 +60,8 @@ def test_stability_quick(capsys, monkeypatch, tmp_path):
     assert calls == [(0, "point"), (0, "walking")]
     assert "best_cv.json" in out and "walking-campaign/best_ca.json" in out and "defaults" in out
     doc = json.loads(out_json.read_text())
-    assert doc["ok"] is True and len(doc["sweep"]) == 8
+    assert doc["ok"] is True and len(doc["sweep"]) == 10  # 8 paper, 2 room scenes
+    assert [r["mode"] for r in doc["sweep"]].count("room") == 2
     cons = doc["consistency"]
     assert [(c["person_model"], c["model"]) for c in cons] == [
         ("point", "cv"), ("point", "ca"), *[("walking", "cv"), ("walking", "ca")] * 3

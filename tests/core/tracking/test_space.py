@@ -37,12 +37,13 @@ NAMES = {p.name for p in SEARCH_SPACE}
 
 
 def test_rows_are_unique_and_p0_follows_the_state() -> None:
-    assert len(NAMES) == len(SEARCH_SPACE) == 14
+    # the paper's 14 rows, then the room tracker's 11
+    assert len(NAMES) == len(SEARCH_SPACE) == 25
     assert P0_NAMES == ("p0_00", "p0_11", "p0_22", "p0_33", "p0_44", "p0_55")
     for model in MODELS:
         assert len(p0_names(model)) == STATE_DIM[model]
         assert [p.name for p in search_space(model)] == [
-            p.name for p in SEARCH_SPACE if model in p.models
+            p.name for p in SEARCH_SPACE if model in p.models and "paper" in p.modes
         ]
     assert parameter("p0_44").models == parameter("p0_55").models == ("ca",)
     with pytest.raises(InputError, match="'p_g' is not an optimised tracker parameter"):

@@ -176,3 +176,30 @@ def test_multi_person_scenes_sample_of_corners(model):
         rep = sweep(model, all_corners(model, 24, seed=2), ds)
         assert rep.ok, (name, rep.failures)
         assert rep.nonfinite_outputs == 0 and rep.bad_track_frames == 0
+
+
+def test_room_mode_corners_stay_healthy():
+    """A sample of the room mode's corners (its 11 rows with the paper's) on the four-people room
+    scene: no unhealthy track, no non-finite output; the sweep notices a corrupted record."""
+    from core.tracking.stability import _room_health, room_scenes
+
+    ds = room_scenes(60, seed=0)["room, 4 people circling"]
+    assert len(ds.frame) / ds.n_frames == 150  # four people, 25 points each, 50 clutter
+    corners = all_corners("cv", 24, seed=1, mode="room")
+    assert len(corners[0]) == 23
+    rep = sweep("cv", corners, ds, mode="room")
+    assert rep.ok and rep.bad_track_frames == 0 and rep.nonfinite_outputs == 0
+    assert rep.max_tracks_seen >= 1
+    # the health check itself fails on a non-PD covariance
+    from core.tracking.batch import room_points_of
+    from core.tracking.room import track_room_arrays
+
+    p = corner_params("cv", corners[0], "room")
+    rec = track_room_arrays(
+        room_points_of(ds), ds.frame_offsets, ds.trajectory_offsets, np.zeros(1, np.int64),
+        p, 0.1, record=True,
+    )[8]  # fmt: skip
+    f = int(np.argmax(rec.n_tracks))
+    assert _room_health(rec)[0] == 0
+    rec.covariance[f, 0] = -np.eye(rec.covariance.shape[-1])
+    assert _room_health(rec)[0] == 1

@@ -1,0 +1,78 @@
+"""The ghost rule (the room tracker, SPEC §7): tracks on wall multipath are not counted.
+
+A wall behind or beside a person returns the person a second time along a longer path: a cluster
+one to three metres further in range, at a nearby bearing, moving with the person, weaker
+(SPEC §7, measured on the walking recordings in docs/tracker.md). Track b is a *ghost candidate*
+of track a when
+
+- a is confirmed and not itself a candidate of another track,
+- b is further: ``r_b − r_a ≥ Δr_ghost``,
+- at a nearby bearing: ``|az_b − az_a| ≤ Δaz_ghost`` (wrapped),
+- moving with a: ``|vr_b − vr_a| ≤ Δv_ghost`` (radial velocities of the states),
+- weaker: its strength (the smoothed SNR sum of its points) is below a's.
+
+Tracks are visited in range order (nearest first), so a person in front is decided before what
+lies behind it. A candidate is neither confirmed nor counted while it is one (its existence runs
+on; it may be confirmed later if the rule no longer holds). Runs as plain Python and inside the
+compiled room kernel (``register_jitable``).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba.extending import register_jitable
+
+from core import jit_guard  # noqa: F401  (before any kernel compiles: see core/jit_guard.py)
+from core.tracking import ekf
+
+__all__ = ["ghost_candidates"]
+
+
+@register_jitable
+def ghost_candidates(
+    X: np.ndarray,
+    confirmed: np.ndarray,
+    strength: np.ndarray,
+    nt: int,
+    gap: float,
+    bearing: float,
+    velocity: float,
+    ghost: np.ndarray,
+) -> None:
+    """Flag the ghost candidates among the first ``nt`` tracks.
+
+    Parameters
+    ----------
+    X
+        (cap, d) states; confirmed (cap,) bool; strength (cap,) smoothed SNR sums (dB).
+    nt
+        Live tracks (slots 0 … nt − 1).
+    gap, bearing, velocity
+        Δr_ghost (m), Δaz_ghost (rad), Δv_ghost (m/s).
+    ghost
+        (cap,) bool output.
+    """
+    zr = np.zeros(nt)
+    za = np.zeros(nt)
+    zv = np.zeros(nt)
+    for k in range(nt):
+        z = ekf.measure(X[k])
+        zr[k], za[k], zv[k] = z[0], z[1], z[2]
+        ghost[k] = False
+    order = np.argsort(zr, kind="mergesort")
+    for ib in range(nt):
+        b = order[ib]
+        for ia in range(ib):
+            a = order[ia]
+            if not confirmed[a] or ghost[a]:
+                continue
+            if zr[b] - zr[a] < gap:
+                continue
+            dz = ((za[b] - za[a] + math.pi) % (2.0 * math.pi)) - math.pi
+            if abs(dz) > bearing or abs(zv[b] - zv[a]) > velocity:
+                continue
+            if strength[b] < strength[a]:
+                ghost[b] = True
+                break
