@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import math
 import os
+from collections.abc import Collection
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -124,8 +125,12 @@ def parse_ti_cfg(text: str, source: str = "<cfg>") -> list[TiCommand]:
     return commands
 
 
-def _ti_fields(cmd: TiCommand, source: str) -> dict[str, float | int]:
-    names = TI_COMMAND_FIELDS[cmd.name]
+def _fields(
+    cmd: TiCommand, source: str, names: tuple[str, ...], int_fields: Collection[str]
+) -> dict[str, float | int]:
+    """The leading fields ``names`` of a TI command, converted (integers where ``int_fields``
+    names them, finite numbers otherwise); a missing or malformed field is one
+    :class:`InputError` naming file, line and field."""
     where = f"{source}:{cmd.line}"
     if len(cmd.args) < len(names):
         missing = names[len(cmd.args)]
@@ -137,9 +142,9 @@ def _ti_fields(cmd: TiCommand, source: str) -> dict[str, float | int]:
     out: dict[str, float | int] = {}
     for i, (name, text) in enumerate(zip(names, cmd.args), start=1):
         try:
-            value = int(text, 0) if name in _TI_INT_FIELDS else float(text)
+            value = int(text, 0) if name in int_fields else float(text)
         except ValueError:
-            kind = "an integer" if name in _TI_INT_FIELDS else "a number"
+            kind = "an integer" if name in int_fields else "a number"
             raise InputError(
                 f"{cmd.name} field {i} {name!r}: expected {kind}, got {text!r}", where
             ) from None
@@ -149,12 +154,27 @@ def _ti_fields(cmd: TiCommand, source: str) -> dict[str, float | int]:
     return out
 
 
-def _ti_require(cond: bool, cmd: TiCommand, field_name: str, message: str, source: str) -> None:
+def _require(
+    cond: bool,
+    cmd: TiCommand,
+    names: tuple[str, ...],
+    field_name: str,
+    message: str,
+    source: str,
+) -> None:
     if not cond:
-        index = TI_COMMAND_FIELDS[cmd.name].index(field_name) + 1
+        index = names.index(field_name) + 1
         raise InputError(
             f"{cmd.name} field {index} {field_name!r}: {message}", f"{source}:{cmd.line}"
         )
+
+
+def _ti_fields(cmd: TiCommand, source: str) -> dict[str, float | int]:
+    return _fields(cmd, source, TI_COMMAND_FIELDS[cmd.name], _TI_INT_FIELDS)
+
+
+def _ti_require(cond: bool, cmd: TiCommand, field_name: str, message: str, source: str) -> None:
+    _require(cond, cmd, TI_COMMAND_FIELDS[cmd.name], field_name, message, source)
 
 
 def radar_from_ti_commands(
@@ -681,35 +701,11 @@ _CFAR_MODES = {0: "ca", 1: "cago", 2: "caso"}
 
 
 def _chain_fields(cmd: TiCommand, source: str) -> dict[str, float | int]:
-    names = TI_CHAIN_FIELDS[cmd.name]
-    where = f"{source}:{cmd.line}"
-    if len(cmd.args) < len(names):
-        raise InputError(
-            f"{cmd.name} needs {len(names)} fields, got {len(cmd.args)} "
-            f"(field {len(cmd.args) + 1} {names[len(cmd.args)]!r} missing)",
-            where,
-        )
-    out: dict[str, float | int] = {}
-    for i, (name, text) in enumerate(zip(names, cmd.args), start=1):
-        try:
-            value = int(text, 0) if name in _CHAIN_INT_FIELDS else float(text)
-        except ValueError:
-            kind = "an integer" if name in _CHAIN_INT_FIELDS else "a number"
-            raise InputError(
-                f"{cmd.name} field {i} {name!r}: expected {kind}, got {text!r}", where
-            ) from None
-        if isinstance(value, float) and not math.isfinite(value):
-            raise InputError(f"{cmd.name} field {i} {name!r}: not finite, got {text!r}", where)
-        out[name] = value
-    return out
+    return _fields(cmd, source, TI_CHAIN_FIELDS[cmd.name], _CHAIN_INT_FIELDS)
 
 
 def _chain_require(cond: bool, cmd: TiCommand, field_name: str, message: str, source: str) -> None:
-    if not cond:
-        index = TI_CHAIN_FIELDS[cmd.name].index(field_name) + 1
-        raise InputError(
-            f"{cmd.name} field {index} {field_name!r}: {message}", f"{source}:{cmd.line}"
-        )
+    _require(cond, cmd, TI_CHAIN_FIELDS[cmd.name], field_name, message, source)
 
 
 def antenna_geometry(
