@@ -28,7 +28,7 @@ from core.tracking.inputs import Frames, TrackerConstants, packed_frames
 from core.tracking.jipda import MAX_JOINT_EVENTS
 from core.tracking.kernel_jit import KernelConstants, KernelFrames, KernelOutputs, track_kernel
 from core.tracking.params import TrackerParams
-from core.tracking.results import FrameTracks, TrackerResult, TrackRecord
+from core.tracking.results import TrackerResult, TrackRecord
 
 __all__ = ["run_tracker_compiled", "track_frames"]
 
@@ -180,22 +180,7 @@ def run_tracker_compiled(
     est_id[rows] = rec.ids[rows, rec.estimate[rows]]
     kept = None
     if keep_tracks:
-        kept = tuple(
-            FrameTracks(
-                ids=rec.ids[f, :n],
-                state=rec.state[f, :n],
-                covariance=rec.covariance[f, :n],
-                psi=rec.psi[f, :n],
-                confirmed=rec.confirmed[f, :n],
-                gate_center_xy=rec.gate_center_xy[f, :n],
-                gate_shape_xy=rec.gate_shape_xy[f, :n],
-                birth_frame=rec.birth_frame[f, :n],
-                n_associated=rec.n_associated[f, :n],
-                nis=rec.nis[f, :n],
-                estimate=int(rec.estimate[f]),
-            )
-            for f, n in enumerate(rec.n_tracks.tolist())
-        )
+        kept = rec.frames()
     return TrackerResult(
         estimate_xy=est_xy,
         has_estimate=has,

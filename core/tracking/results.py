@@ -183,3 +183,27 @@ class TrackRecord(NamedTuple):
             nis=np.full((n_frames, cap), np.nan),
             estimate=np.full(n_frames, -1, dtype=np.int64),
         )
+
+    def frames(
+        self, height_m: np.ndarray | None = None, ghost: np.ndarray | None = None
+    ) -> tuple[FrameTracks, ...]:
+        """The recorded frames as :class:`FrameTracks` (views into the arrays); ``height_m`` and
+        ``ghost`` ``(F, cap)``: the room mode's per-track height and ghost flag."""
+        return tuple(
+            FrameTracks(
+                ids=self.ids[f, :n],
+                state=self.state[f, :n],
+                covariance=self.covariance[f, :n],
+                psi=self.psi[f, :n],
+                confirmed=self.confirmed[f, :n],
+                gate_center_xy=self.gate_center_xy[f, :n],
+                gate_shape_xy=self.gate_shape_xy[f, :n],
+                birth_frame=self.birth_frame[f, :n],
+                n_associated=self.n_associated[f, :n],
+                nis=self.nis[f, :n],
+                estimate=int(self.estimate[f]),
+                height_m=None if height_m is None else height_m[f, :n],
+                ghost=None if ghost is None else ghost[f, :n],
+            )
+            for f, n in enumerate(self.n_tracks.tolist())
+        )

@@ -35,7 +35,7 @@ import numpy as np
 from core.errors import InputError
 from core.tracking.groups import COLUMNS
 from core.tracking.params import TrackerParams
-from core.tracking.results import FrameTracks, TrackerResult, TrackRecord
+from core.tracking.results import TrackerResult, TrackRecord
 from core.tracking.room_loop import room_constants, room_frames
 from core.tracking.zones import Zones
 
@@ -210,24 +210,7 @@ def run_room_tracker(
     est_id = np.full(n_f, -1, dtype=np.int64)
     rows = np.flatnonzero(rec.estimate >= 0)
     est_id[rows] = rec.ids[rows, rec.estimate[rows]]
-    kept = tuple(
-        FrameTracks(
-            ids=rec.ids[f, :n],
-            state=rec.state[f, :n],
-            covariance=rec.covariance[f, :n],
-            psi=rec.psi[f, :n],
-            confirmed=rec.confirmed[f, :n],
-            gate_center_xy=rec.gate_center_xy[f, :n],
-            gate_shape_xy=rec.gate_shape_xy[f, :n],
-            birth_frame=rec.birth_frame[f, :n],
-            n_associated=rec.n_associated[f, :n],
-            nis=rec.nis[f, :n],
-            estimate=int(rec.estimate[f]),
-            height_m=height[f, :n],
-            ghost=ghost[f, :n],
-        )
-        for f, n in enumerate(rec.n_tracks.tolist())
-    )
+    kept = rec.frames(height, ghost)
     return TrackerResult(
         estimate_xy=est_xy,
         has_estimate=has,
