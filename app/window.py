@@ -362,6 +362,7 @@ class MainWindow(QtWidgets.QMainWindow):
             info.aoi["min_range_m"], info.aoi["max_range_m"], info.aoi["max_azimuth_deg"]
         )
         self.top_view.set_reflectors(info.reflectors_xy_m)
+        self.top_view.set_room(info.room_outline_xy_m)
         self.top_view.set_truth_paths(info.truth_paths)
         self._show_selected_waypoints()
         self.top_view.set_selected_person(self.scene_model.selected_person)

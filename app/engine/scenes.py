@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import json
 import os
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -48,6 +48,25 @@ class SceneInfo:
     reflectors_xy_m: np.ndarray  # (n, 2)
     aoi: dict
     radar: RadarConfig
+    #: (n, 2) m: the room's walls and the furniture's footprints as one NaN-separated outline
+    #: (empty in the open field)
+    room_outline_xy_m: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))
+
+
+def room_outline(room) -> np.ndarray:
+    """Walls (segments) and furniture (footprint rectangles) of a ``core.scene.Room`` as one
+    NaN-separated x–y polyline, m; empty for ``None``."""
+    if room is None:
+        return np.zeros((0, 2))
+    gap = [np.full((1, 2), np.nan)]
+    parts: list[np.ndarray] = []
+    for w in room.walls:
+        parts += [np.array([w.from_m, w.to_m], dtype=float), *gap]
+    for f in room.furniture:
+        hx, hy = f.width_m / 2, f.depth_m / 2
+        corners = [(-hx, -hy), (hx, -hy), (hx, hy), (-hx, hy), (-hx, -hy)]
+        parts += [np.array([(f.x_m + dx, f.y_m + dy) for dx, dy in corners]), *gap]
+    return np.concatenate(parts) if parts else np.zeros((0, 2))
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -96,6 +115,7 @@ def scene_info(scene) -> SceneInfo:
         reflectors_xy_m=refl,
         aoi=scene.aoi.to_dict(),
         radar=scene.radar,
+        room_outline_xy_m=room_outline(scene.room),
     )
 
 

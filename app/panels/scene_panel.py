@@ -39,12 +39,14 @@ def _dspin(lo, hi, decimals, suffix="", name="") -> QtWidgets.QDoubleSpinBox:
 
 
 class XYTable(QtWidgets.QTableWidget):
-    """A small numeric table (rows of floats) with add/remove."""
+    """A small numeric table (rows of floats) with add/remove. The last ``n_optional`` columns
+    may be left blank: a row ends at its first blank optional cell (a waypoint's hold time)."""
 
     edited = QtCore.Signal()
 
-    def __init__(self, headers: list[str], name: str) -> None:
+    def __init__(self, headers: list[str], name: str, n_optional: int = 0) -> None:
         super().__init__(0, len(headers))
+        self.n_optional = n_optional
         self.setObjectName(name)
         self.setHorizontalHeaderLabels(headers)
         self.horizontalHeader().setSectionResizeMode(QtWidgets.QHeaderView.Stretch)
@@ -56,8 +58,9 @@ class XYTable(QtWidgets.QTableWidget):
         self.blockSignals(True)
         self.setRowCount(len(rows))
         for i, row in enumerate(rows):
-            for j, v in enumerate(row):
-                self.setItem(i, j, QtWidgets.QTableWidgetItem(f"{float(v):.3f}"))
+            for j in range(self.columnCount()):
+                text = f"{float(row[j]):.3f}" if j < len(row) else ""
+                self.setItem(i, j, QtWidgets.QTableWidgetItem(text))
         self.blockSignals(False)
 
     def rows(self) -> list[list[float]]:
@@ -66,7 +69,9 @@ class XYTable(QtWidgets.QTableWidget):
             row = []
             for j in range(self.columnCount()):
                 item = self.item(i, j)
-                text = item.text() if item is not None else ""
+                text = item.text().strip() if item is not None else ""
+                if not text and j >= self.columnCount() - self.n_optional:
+                    break
                 try:
                     row.append(float(text))
                 except ValueError:
@@ -166,7 +171,9 @@ class ScenePanel(QtWidgets.QWidget):
         wp_page = QtWidgets.QWidget()
         wl = QtWidgets.QVBoxLayout(wp_page)
         wl.setContentsMargins(0, 0, 0, 0)
-        self.waypoints = XYTable(["x [m]", "y [m]", "speed [m/s]"], "waypointTable")
+        self.waypoints = XYTable(
+            ["x [m]", "y [m]", "speed [m/s]", "hold [s]"], "waypointTable", n_optional=1
+        )
         wl.addWidget(self.waypoints)
         wrow = QtWidgets.QHBoxLayout()
         self.draw_button = QtWidgets.QPushButton("Draw on top view")

@@ -97,6 +97,9 @@ class TopView(pg.PlotWidget):
     def _add_scene_items(self) -> None:
         """The scene: area outline, static reflectors, truth paths."""
         self.aoi = self.plot(pen=pg.mkPen((120, 120, 120), width=1, style=QtCore.Qt.DashLine))
+        self.room = self.plot(
+            pen=pg.mkPen((170, 150, 120), width=2), connect="finite", name="walls"
+        )
         self.reflectors = pg.ScatterPlotItem(
             symbol="s",
             size=10,
@@ -150,8 +153,9 @@ class TopView(pg.PlotWidget):
     def _stack_items(self) -> None:
         """Drawing order: gates and tracks under the points, truth and estimate on top."""
         for z, item in enumerate(
-            (self.aoi, self.truth_path, self.trails, self.gates_tentative, self.gates_confirmed,
-             self.tracks, self.reflectors, self.points, self.truth_now, self.estimate)
+            (self.aoi, self.room, self.truth_path, self.trails, self.gates_tentative,
+             self.gates_confirmed, self.tracks, self.reflectors, self.points, self.truth_now,
+             self.estimate)
         ):  # fmt: skip
             item.setZValue(z)
         for item in self.identity_trails:
@@ -177,6 +181,11 @@ class TopView(pg.PlotWidget):
 
     def _stop_auto_fit(self, *_args) -> None:
         self._auto_fit = False
+
+    def set_room(self, outline_xy_m: np.ndarray) -> None:
+        """The room's walls and furniture footprints, one NaN-separated outline (m)."""
+        xy = np.asarray(outline_xy_m, dtype=float).reshape(-1, 2)
+        self.room.setData(xy[:, 0], xy[:, 1], connect="finite")
 
     def set_reflectors(self, xy_m: np.ndarray) -> None:
         xy = np.asarray(xy_m, dtype=float).reshape(-1, 2)
@@ -228,9 +237,9 @@ class TopView(pg.PlotWidget):
             item.sigPositionChangeFinished.connect(self._on_waypoint_dragged)
             self.addItem(item)
             self._waypoint_items.append(item)
-        for item, (x, y, _v) in zip(self._waypoint_items, rows):
+        for item, row in zip(self._waypoint_items, rows):
             item.blockSignals(True)
-            item.setPos(x, y)
+            item.setPos(row[0], row[1])
             item.blockSignals(False)
         xy = np.array([r[:2] for r in rows]).reshape(-1, 2)
         self.waypoint_line.setData(xy[:, 0], xy[:, 1])
@@ -239,7 +248,7 @@ class TopView(pg.PlotWidget):
         rows = []
         for item, row in zip(self._waypoint_items, self._waypoint_rows):
             p = item.pos()
-            rows.append([round(p.x(), 3), round(p.y(), 3), row[2]])
+            rows.append([round(p.x(), 3), round(p.y(), 3), *row[2:]])  # speed (and hold)
         self.waypoints_moved.emit(rows)
 
     def _on_click(self, event) -> None:
