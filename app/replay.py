@@ -37,7 +37,10 @@ class ReplayEngine(Engine):
     """The engine with ``simulate`` yielding a data set's frames instead of simulating."""
 
     def __init__(self, dataset: Dataset) -> None:
+        from core.formats.recording import has_truth
+
         self.dataset = dataset
+        self.has_truth = has_truth(dataset)
         radar = json.loads(dataset.radar_json) if dataset.radar_json else {}
         self.radar = RadarConfig.from_dict(radar) if radar else RadarConfig()
 

@@ -93,6 +93,7 @@ class MainWindow(QtWidgets.QMainWindow):
         self.top_view = TopView()
         self.rd_view = RangeDopplerView()
         self.psi_view = PsiView()
+        self.psi_view.has_truth = self.engine.has_truth
         right = QtWidgets.QSplitter(QtCore.Qt.Vertical)
         right.setObjectName("rightSplitter")
         right.addWidget(self.rd_view)
@@ -523,6 +524,9 @@ class MainWindow(QtWidgets.QMainWindow):
         self._update_fps()
 
     def _show_metrics(self, index: int, result) -> None:
+        if not self.engine.has_truth:
+            self.metrics_label.setText("no ground truth: no loss, RMSE or OSPA")
+            return
         if result is None or index >= result.n_frames:
             self.metrics_label.setText("loss – · RMSE – · OSPA –")
             return

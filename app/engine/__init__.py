@@ -67,6 +67,10 @@ def describe(exc: BaseException) -> str:
 class Engine:
     """The functions above as one object (tests may substitute parts of it)."""
 
+    #: whether the frames carry ground truth (a simulation always; a recording when imported
+    #: with it): without it the app shows "no ground truth" instead of a loss or an OSPA
+    has_truth = True
+
     paper_document = staticmethod(paper_document)
     scene_from_document = staticmethod(scene_from_document)
     scene_info = staticmethod(scene_info)

@@ -17,6 +17,8 @@ class PsiView(pg.GraphicsLayoutWidget):
     def __init__(self, parent=None) -> None:
         super().__init__(parent)
         self.setObjectName("psiView")
+        #: False for a recording without ground truth: no loss, RMSE or OSPA drawn
+        self.has_truth = True
         self.psi_plot = self.addPlot(row=0, col=0)
         self.psi_plot.setTitle("existence probability ψ", size="9pt")
         self.psi_plot.setLabel("left", "ψ")
@@ -85,8 +87,12 @@ class PsiView(pg.GraphicsLayoutWidget):
             result.psi_confirmed_t_s, result.psi_confirmed_value, connect="finite"
         )
         t = np.arange(result.n_frames) * frame_period_s
-        self.rmse_curve.setData(t, result.running_rmse_m, connect="finite")
-        self.ospa_curve.setData(t, result.ospa_m, connect="finite")
+        if self.has_truth:
+            self.rmse_curve.setData(t, result.running_rmse_m, connect="finite")
+            self.ospa_curve.setData(t, result.ospa_m, connect="finite")
+        else:
+            self.rmse_curve.setData([], [])
+            self.ospa_curve.setData([], [])
         self.psi_plot.setXRange(0.0, max(t[-1], frame_period_s), padding=0.02)
 
     def set_frame(self, index: int) -> None:
@@ -95,7 +101,9 @@ class PsiView(pg.GraphicsLayoutWidget):
         self.cursor.setValue(t)
         self.cursor2.setValue(t)
         r = self._result
-        if r is None or index >= r.n_frames:
+        if not self.has_truth:
+            text = f"t = {t:.2f} s · no ground truth<br>(no loss, RMSE or OSPA)"
+        elif r is None or index >= r.n_frames:
             text = "running loss –<br>RMSE – · OSPA –"
         else:
             rmse = r.running_rmse_m[index]

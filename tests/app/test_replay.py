@@ -63,6 +63,15 @@ def test_replay_plays_a_uart_log(qtbot, settings, tmp_path) -> None:
         est = result.estimate_xy_m[-1]
         y_end = 3.0 + (N_FRAMES - 1) * PAPER_RADAR.frame_period_s
         assert np.hypot(est[0] - 0.5, est[1] - y_end) < 0.5
+        # a recording without truth shows no loss, RMSE or OSPA (it once showed L = 1 m²)
+        assert not engine.has_truth
+        w._show_metrics(w.playback.frame, result)
+        assert w.metrics_label.text().startswith("no ground truth")
+        w.psi_view.set_frame(w.playback.frame)
+        assert "no ground truth" in w.psi_view._metric_text
+        assert w.psi_view.ospa_curve.getData()[0] is None or not len(
+            w.psi_view.ospa_curve.getData()[0]
+        )
     finally:
         w.playback.set_playing(False)
         w.shutdown()
