@@ -30,6 +30,7 @@ if TYPE_CHECKING:
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
     from core.optimization.storage import DEFAULT_STORAGE
+    from core.tracking.space import MODES
 
     p = sub.add_parser(
         "tune",
@@ -44,6 +45,13 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         default="paper",
         help="paper: the (J)IPDA with --model; gtrack: TI's people tracker rebuilt, its own "
         "parameter table (default: paper)",
+    )
+    p.add_argument(
+        "--mode",
+        choices=MODES,
+        default="paper",
+        help="the (J)IPDA's mode: paper (one point a person) or room (groups of points, static "
+        "points, ghosts; also tunes the room tracker's 11 parameters). Default: paper",
     )
     p.add_argument("--trials", type=int, default=300, help="total trials (all workers)")
     p.add_argument("--jobs", type=int, default=1, help="worker processes (default: %(default)s)")
@@ -222,6 +230,7 @@ def run(args: argparse.Namespace) -> int:
         loss=args.loss,
         people=args.people,
         recording_loss=args.recording_loss or "",
+        mode=args.mode,
     )
     # every data set is resolved and checked before any study is touched
     plans: list[tuple[StudySettings, str | None]] = []
@@ -268,7 +277,7 @@ def run(args: argparse.Namespace) -> int:
         record: dict = {"study": settings.name}
         if best is not None:
             record.update(best_trial=best.number, best_loss=best.value)
-            record["params"] = best.tracker_params(settings.model)
+            record["params"] = best.tracker_params(settings.model, settings.mode)
         if code != EXIT_OK:
             # interrupted or a worker lost: the best so far, not validated, and the study's code
             print(json.dumps({"loss": args.loss, "studies": [*chosen, record]}))

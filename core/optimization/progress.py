@@ -37,9 +37,9 @@ class TrialSummary:
     #: why a FAIL trial failed (``"TypeName: message"``, recorded by the worker); "" otherwise
     error: str = ""
 
-    def tracker_params(self, model: str) -> dict[str, Any]:
-        """The trial's parameters as TrackerParams JSON."""
-        return tracker_params_dict(self.params, model)
+    def tracker_params(self, model: str, mode: str = "paper") -> dict[str, Any]:
+        """The trial's parameters as TrackerParams JSON (``mode``: the study's tracker mode)."""
+        return tracker_params_dict(self.params, model, mode)
 
 
 def _summary(t: Any) -> TrialSummary:

@@ -44,12 +44,13 @@ class SuggestsFloats(Protocol):
     def suggest_int(self, name: str, low: int, high: int, *, log: bool = False) -> int: ...
 
 
-def suggest_params(trial: SuggestsFloats, model: str) -> dict[str, float]:
+def suggest_params(trial: SuggestsFloats, model: str, mode: str = "paper") -> dict[str, float]:
     """Sample one point of the space with the trial's sampler; flat dict by Optuna name
-    (whole numbers for integer rows: gtrack's counters and point threshold)."""
+    (whole numbers for integer rows: gtrack's counters and point threshold). The room mode
+    suggests the paper's rows, then the room tracker's (the paper mode never samples those)."""
     return {
         b.name: trial.suggest_int(b.name, int(b.low), int(b.high), log=b.log)
         if b.integer
         else trial.suggest_float(b.name, b.low, b.high, log=b.log)
-        for b in search_space(model)
+        for b in search_space(model, mode)
     }

@@ -53,7 +53,7 @@ from core.optimization.storage import (
     open_storage,
     redact,
 )
-from core.tracking.space import tracker_params_dict
+from core.tracking.space import GTRACK, check_mode, tracker_params_dict
 
 SAMPLERS = ("tpe", "random", "cmaes", "gp")
 #: samplers that need a package Optuna does not install itself: sampler -> module
@@ -127,9 +127,13 @@ class StudySettings:
     people: int | None = None
     mix: tuple[tuple[str, float], ...] = ()
     recording_loss: str = ""
+    mode: str = "paper"
 
     def __post_init__(self) -> None:
         check_tuned(self.model)
+        check_mode(self.mode)
+        if self.model == GTRACK and self.mode != "paper":
+            raise InputError(f"mode {self.mode!r} is the IPDA tracker's: not with model gtrack")
         if self.recording_loss:
             check_objective(self.recording_loss)
         for path, weight in self.mix:
@@ -407,6 +411,7 @@ def prepare_study(settings: StudySettings, *, dataset_path: str | None = None) -
         "seed": int(settings.seed),
         "objective_options": dict(settings.objective_options),
         "loss": settings.loss,
+        "mode": settings.mode,
         "space": "paper-eq15",
     }
     if settings.people is not None:
@@ -429,9 +434,9 @@ def prepare_study(settings: StudySettings, *, dataset_path: str | None = None) -
                 f"study {settings.name!r} in {redact(settings.storage)} has people="
                 f"{old.get('people')!r}, asked {attrs.get('people')!r}; use another --study name"
             )
-        for key in ("model", "objective", "sampler", "pruner", "loss"):
-            # a study made before robust objectives existed minimised the paper's loss
-            if old.get(key, "paper" if key == "loss" else None) != attrs[key]:
+        for key in ("model", "objective", "sampler", "pruner", "loss", "mode"):
+            # a study made before robust objectives (room mode) minimised the paper's loss (paper)
+            if old.get(key, "paper" if key in ("loss", "mode") else None) != attrs[key]:
                 raise InputError(
                     f"study {settings.name!r} in {redact(settings.storage)} has {key}="
                     f"{old.get(key)!r}, asked {attrs[key]!r}; use another --study name"
@@ -577,6 +582,7 @@ def run_worker(
     if "model" not in attrs:
         raise InputError(f"study {study_name!r} was not created by radartune (no model attribute)")
     model = attrs["model"]
+    mode = str(attrs.get("mode", "paper"))
     n_total = int(attrs["n_trials"])
     base_seed = int(attrs.get("seed", 0)) if seed is None else int(seed)
 
@@ -630,7 +636,7 @@ def run_worker(
                 waiting = any(t.state == TrialState.WAITING for t in trials)
                 surplus = count_trials(study, below=trial.number) >= n_total
                 if not surplus:
-                    params = tracker_params_dict(suggest_params(trial, model), model)
+                    params = tracker_params_dict(suggest_params(trial, model, mode), model, mode)
             if surplus:
                 trial.set_user_attr("surplus", True)
                 study.tell(trial, state=TrialState.FAIL)

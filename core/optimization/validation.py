@@ -176,7 +176,9 @@ def validate_study(
     losses = tracker_losses(val_set, loss, people=people)
     out = []
     for t in best:
-        params = tracker_params_dict({k: float(v) for k, v in t.params.items()}, model)
+        params = tracker_params_dict(
+            {k: float(v) for k, v in t.params.items()}, model, str(attrs.get("mode", "paper"))
+        )
         if str(t.number) in known:
             value, paper = (float(x) for x in known[str(t.number)])
         else:

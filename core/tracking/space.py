@@ -277,13 +277,14 @@ def defaults(model: str, mode: str = "paper") -> dict[str, float]:
     return {p.name: p.default for p in search_space(model, mode)}
 
 
-def tracker_params_dict(flat: dict[str, Any], model: str) -> dict[str, Any]:
+def tracker_params_dict(flat: dict[str, Any], model: str, mode: str = "paper") -> dict[str, Any]:
     """Flat parameters (by table name) → TrackerParams JSON (SPEC §6): ``p0_ii`` become ``p0``.
 
     Keys not in the search space (``p_g``, thresholds, clutter density) are left out so that
-    they take the TrackerParams defaults.
+    they take the TrackerParams defaults. In the room mode the JSON carries ``"mode": "room"``
+    and the room rows; a paper-mode JSON is as it was (no ``mode`` key).
     """
-    names = [b.name for b in search_space(model)]
+    names = [b.name for b in search_space(model, mode)]
     missing = [n for n in names if n not in flat]
     if missing:
         raise InputError(f"parameters missing for model {model}: {', '.join(missing)}")
@@ -293,6 +294,8 @@ def tracker_params_dict(flat: dict[str, Any], model: str) -> dict[str, Any]:
             for b in search_space(model)
         }
     out: dict[str, Any] = {"model": model}
+    if mode == "room":
+        out["mode"] = mode
     for n in names:
         if n not in P0_NAMES:
             out[n] = float(flat[n])
@@ -317,12 +320,13 @@ def flat_params(params: dict[str, Any]) -> dict[str, float]:
             flat_g[b.name] = value
         return flat_g
     model = check_model(str(params.get("model", "cv")))
+    mode = check_mode(str(params.get("mode", "paper")))
     p0 = list(params.get("p0", []))
     n_p0 = STATE_DIM[model]
     if len(p0) != n_p0:
         raise InputError(f"p0 must have {n_p0} entries for model {model}, got {len(p0)}")
     flat: dict[str, float] = {}
-    for b in search_space(model):
+    for b in search_space(model, mode):
         if b.name in P0_NAMES:
             value = float(p0[P0_NAMES.index(b.name)])
         elif b.name in params:
