@@ -23,7 +23,7 @@ Per frame:
 :func:`core.tracking.room_loop.room_frames` is the whole loop over the trajectories of a data
 set, written once: it runs as plain Python (``engine="numpy"``, the readable reference) and
 compiled by numba (:mod:`core.tracking.room_kernel`, ``engine="numba"``);
-``tests/core/tracking/test_room.py`` checks both agree. Entry points: :func:`run_room_tracker`
+``tests/core/tracking/test_room_mode.py`` checks both agree. Entry points: :func:`run_room_tracker`
 (one sequence of frames, every track) and :func:`track_room_arrays` (selected trajectories, the
 data-set path).
 """
