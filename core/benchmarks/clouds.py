@@ -49,11 +49,11 @@ RD_CROP_BINS = 14
 def real_data_dir() -> Path:
     """The folder of real recordings.
 
-    ``$RADARTUNE_REAL_DATA`` if set, else the first of ``<repo>/../shared/real`` and
-    ``<repo>/../../shared/real`` that exists (a worktree sits one level deeper than the main
-    checkout).
+    ``$RADARTUNE_REAL_DATA`` (or ``$RADARTUNE_REAL``) if set, else the first of
+    ``<repo>/../shared/real`` and ``<repo>/../../shared/real`` that exists (a worktree sits one
+    level deeper than the main checkout). The one place every benchmark finds them.
     """
-    env = os.environ.get("RADARTUNE_REAL_DATA")
+    env = os.environ.get("RADARTUNE_REAL_DATA") or os.environ.get("RADARTUNE_REAL")
     if env:
         return Path(env)
     repo = Path(__file__).resolve().parents[2]

@@ -1,7 +1,7 @@
 """``radartune bench gtrack_ti``: RadarTune's gtrack against TI's own tracker on TI's points.
 
-The recording ``pc3_2023-06-21-12-27-01.csv`` (``$RADARTUNE_REAL``, default
-``/work/shared/real``, folder ``pc3_iwr6843``) holds, per frame, the points of TI's 3-D people
+The recording ``pc3_2023-06-21-12-27-01.csv`` (``$RADARTUNE_REAL``, default ``../shared/real``
+beside the checkout, folder ``pc3_iwr6843``) holds, per frame, the points of TI's 3-D people
 counting firmware (v6), TI's tracks (v7) and TI's point-to-track indices (v8). Its ``.cfg`` is
 not known. RadarTune's gtrack runs on TI's points with TI's published default tracker lines
 (``resources/gtrack/ti_people_counting_isk.cfg``) under two readings of the unknown pose:
@@ -23,7 +23,6 @@ the share left unassigned by both.
 
 from __future__ import annotations
 
-import os
 from dataclasses import replace
 from pathlib import Path
 
@@ -92,10 +91,11 @@ def _compare(rec, res, lag: int) -> dict:
 
 
 def run(quick: bool = False) -> dict:
+    from core.benchmarks.clouds import real_data_dir
     from core.recordings import read_recording
     from core.tracking.gtrack.tracker import run_gtrack
 
-    root = Path(os.environ.get("RADARTUNE_REAL", "/work/shared/real"))
+    root = real_data_dir()
     path = root / RECORDING
     rec = read_recording(path, fmt=None, cfg=None)
     if rec.ref_tracks is None or rec.ref_point_track is None:

@@ -26,7 +26,6 @@ parameters tuned on them or any of their points.
 
 from __future__ import annotations
 
-import os
 import tempfile
 import time
 from pathlib import Path
@@ -47,10 +46,13 @@ WAYS = ("defaults", "open field", "recording", "mixed")
 
 
 def real_folder() -> Path:
-    """The folder of the public recordings (``$RADARTUNE_REAL``, else ``../shared/real``)."""
-    for cand in (os.environ.get("RADARTUNE_REAL"), "../shared/real", "../../shared/real"):
-        if cand and (Path(cand) / TEST_WALKER).is_file():
-            return Path(cand)
+    """The folder of the public recordings (:func:`core.benchmarks.clouds.real_data_dir`:
+    ``$RADARTUNE_REAL``, else ``../shared/real`` beside the checkout)."""
+    from core.benchmarks.clouds import real_data_dir
+
+    root = real_data_dir()
+    if (root / TEST_WALKER).is_file():
+        return root
     raise InputError(
         "the public recordings were not found: set RADARTUNE_REAL to the folder holding "
         f"{TEST_WALKER} and {TEST_REFERENCE}"
