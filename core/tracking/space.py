@@ -309,7 +309,11 @@ def flat_params(params: dict[str, Any]) -> dict[str, float]:
     Used to enqueue known parameters in a study and to put a parameter file on the app's
     sliders; values outside the bounds are an error naming the field.
     """
-    if "model" not in params and any(b.name in params for b in search_space(GTRACK)):
+    tracker_names = {b.name for b in SEARCH_SPACE}
+    gtrack_only = [b.name for b in GTRACK_SPACE if b.name not in tracker_names]
+    # a GtrackParams JSON: no model or mode key, and a name only gtrack's table has (the room
+    # mode's allocation rows share two names with it)
+    if "model" not in params and "mode" not in params and any(n in params for n in gtrack_only):
         flat_g: dict[str, float] = {}
         for b in search_space(GTRACK):
             if b.name not in params:

@@ -221,3 +221,15 @@ def test_no_module_restates_the_table() -> None:
         for where in restatements(path.read_text()):
             problems.append(f"{path.relative_to(ROOT)} {where}")
     assert not problems, "derive these from core/tracking/space.py:\n" + "\n".join(problems)
+
+
+def test_a_room_file_without_model_is_not_read_as_gtrack() -> None:
+    # the room mode's allocation rows share names with gtrack's table: a room-mode parameter
+    # file without "model" is still the tracker's (CV by default), and gtrack's is gtrack's
+    from core.tracking.gtrack.params import GtrackParams
+    from core.tracking.space import GTRACK_SPACE, defaults, flat_params, tracker_params_dict
+
+    room = tracker_params_dict(defaults("cv", "room"), "cv", "room")
+    room.pop("model")
+    assert set(flat_params(room)) == set(defaults("cv", "room"))
+    assert set(flat_params(GtrackParams().to_dict())) == {b.name for b in GTRACK_SPACE}
