@@ -34,8 +34,9 @@ MODULES = {"import": "import_"}
 #: not part of ``all``: hours of studies (16 x 1000 trials); person clouds (a calibration, not
 #: a speed figure); the desktop app (needs Qt); held-out loss against run time per sampler
 #: (60 studies); the objective comparison and the CV-against-CA design (hours of studies)
-#: transfer: tuned parameters judged on held-out public recordings (needs them: $RADARTUNE_REAL)
-LONG = ("cvca_seeds", "clouds", "gui", "samplers", "campaign", "transfer")
+#: transfer: tuned parameters judged on held-out public recordings (needs them: $RADARTUNE_REAL);
+#: trackers: four trackers, tuned and not, on held-out simulated rooms and recordings
+LONG = ("cvca_seeds", "clouds", "gui", "samplers", "campaign", "transfer", "trackers")
 #: benchmarks whose tables and plots ``--render-only`` re-writes from their stored JSON
 RENDERABLE = ("fidelity", "clouds", "samplers", "campaign")
 
