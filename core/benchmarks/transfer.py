@@ -83,7 +83,7 @@ def real_folder() -> Path:
     )
 
 
-def _import(src: Path, out: Path) -> str:
+def import_recording(src: Path, out: Path) -> str:
     """A recording as a data set in the temporary folder (never in the repository)."""
     from core.formats.recording import to_dataset
     from core.recordings import read_recording
@@ -93,7 +93,7 @@ def _import(src: Path, out: Path) -> str:
     return str(out)
 
 
-def _study(
+def run_study(
     tmp: str,
     name: str,
     dataset: str,
@@ -181,21 +181,23 @@ def run(quick: bool = False) -> dict:
     room_train, room_val = room_dataset(0, n_room), room_dataset(1000, n_room)
     per_seed: dict[str, list[dict[str, Any]]] = {w: [] for w in WAYS}
     with tempfile.TemporaryDirectory(prefix="radartune-transfer-") as tmp:
-        train = _import(real / TRAIN_RECORDING, Path(tmp) / "train.npz")
-        val = _import(real / VALIDATION_RECORDING, Path(tmp) / "val.npz")
-        walker = Dataset.load(_import(real / TEST_WALKER, Path(tmp) / "walker.npz"))
-        reference = Dataset.load(_import(real / TEST_REFERENCE, Path(tmp) / "reference.npz"))
+        train = import_recording(real / TRAIN_RECORDING, Path(tmp) / "train.npz")
+        val = import_recording(real / VALIDATION_RECORDING, Path(tmp) / "val.npz")
+        walker = Dataset.load(import_recording(real / TEST_WALKER, Path(tmp) / "walker.npz"))
+        reference = Dataset.load(
+            import_recording(real / TEST_REFERENCE, Path(tmp) / "reference.npz")
+        )
         default = TrackerParams.default(MODEL).to_dict()
         per_seed["defaults"].append({"seed": None, **_scores(default, walker, reference)})
         for seed in seeds:
             runs = {
-                "open field": _study(tmp, "open", open_field, open_val, seed, n_trials,
+                "open field": run_study(tmp, "open", open_field, open_val, seed, n_trials,
                                      loss="trimmed"),
-                "simulated rooms": _study(tmp, "room", room_train, room_val, seed, n_trials,
+                "simulated rooms": run_study(tmp, "room", room_train, room_val, seed, n_trials,
                                           loss="trimmed"),
-                "recording": _study(tmp, "rec", train, val, seed, n_trials,
+                "recording": run_study(tmp, "rec", train, val, seed, n_trials,
                                     loss="fragmentation", people=1),
-                "mixed": _study(tmp, "mixed", open_field, val, seed, n_trials, loss="trimmed",
+                "mixed": run_study(tmp, "mixed", open_field, val, seed, n_trials, loss="trimmed",
                                 people=1, mix=((train, 1.0),)),
             }  # fmt: skip
             for way, r in runs.items():
