@@ -12,9 +12,11 @@ within a frame:
 - ``track_id``: unique over the file. The tracker numbers the tracks of each run (trajectory)
   from 0 in order of birth; the ids of a run are offset past the largest id of the runs before
   it, so a sensor restart never reuses an id;
-- ``status``: ``tentative`` or ``confirmed``; ``existence``: the track's existence probability ψ;
+- ``status``: ``tentative`` or ``confirmed``; ``existence``: the track's existence probability ψ
+  (empty for a tracker without one: gtrack);
 - ``x_m, y_m, vx_mps, vy_mps``: the state after the frame's update, m and m/s;
-- ``z_m``: empty: the tracker works in the ground plane (x–y) and has no height;
+- ``z_m``: empty for the paper's tracker (it works in the ground plane, x–y); gtrack's 3-D
+  state's height;
 - ``n_points``: the measurements inside the track's gate in this frame (those that took part in
   its update; 0 for a track born in the frame).
 
@@ -79,6 +81,8 @@ class TrackRows:
         (R,) int64 measurements gated in the frame.
     nis
         (R,) NIS of the frame's update (NaN when no measurement was gated or the track was born).
+    z_m
+        (R,) height, m, or None (the column left empty).
     """
 
     frame: np.ndarray
@@ -89,12 +93,15 @@ class TrackRows:
     existence: np.ndarray
     n_points: np.ndarray
     nis: np.ndarray
+    z_m: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         r = np.shape(self.frame)
         for name in ("time_s", "track_id", "confirmed", "existence", "n_points", "nis"):
             if np.shape(getattr(self, name)) != r:
                 raise ValueError(f"TrackRows.{name} must have shape {r} like frame")
+        if self.z_m is not None and np.shape(self.z_m) != r:
+            raise ValueError(f"TrackRows.z_m must have shape {r} like frame")
         if np.shape(self.state) != (*r, 4):
             raise ValueError(f"TrackRows.state must have shape {(*r, 4)}, got {self.state.shape}")
 
@@ -152,9 +159,12 @@ def format_tracks_csv(rows: TrackRows) -> str:
     status = np.where(rows.confirmed, "confirmed", "tentative")
     for i in range(len(rows)):
         x, y, vx, vy = rows.state[i]
+        z = "" if rows.z_m is None else f"{rows.z_m[i]:.4f}"
+        psi = rows.existence[i]
+        e = f"{psi:.6f}" if np.isfinite(psi) else ""
         lines.append(
             f"{rows.frame[i]},{rows.time_s[i]:.4f},{rows.track_id[i]},{status[i]},"
-            f"{x:.4f},{y:.4f},,{vx:.4f},{vy:.4f},{rows.existence[i]:.6f},{rows.n_points[i]}"
+            f"{x:.4f},{y:.4f},{z},{vx:.4f},{vy:.4f},{e},{rows.n_points[i]}"
         )
     return "\n".join(lines) + "\n"
 

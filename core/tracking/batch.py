@@ -301,7 +301,7 @@ def track_dataset(
             est_xy[s], has[s], psi[s] = res.estimate_xy, res.has_estimate, res.estimate_psi
             conf_xy[s], n_conf[s], n_tr[s] = res.confirmed_xy, res.n_confirmed, res.n_tracks
             for j, ft in enumerate(res.frames or ()):
-                _record_frame(rec, offsets[i] + j, ft)
+                record_frame(rec, offsets[i] + j, ft)
         if with_tracks:
             record = rec._replace(n_tracks=n_tr.copy())
             tracks = ConfirmedTracks.from_slots(
@@ -325,7 +325,7 @@ def track_dataset(
     )
 
 
-def _record_frame(rec: TrackRecord, row: int, ft: FrameTracks) -> None:
+def record_frame(rec: TrackRecord, row: int, ft: FrameTracks) -> None:
     """Write one frame of the readable tracker (:class:`FrameTracks`) into row ``row`` of a
     :class:`TrackRecord`, as the compiled kernel records it."""
     n = len(ft)
