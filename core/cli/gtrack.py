@@ -139,5 +139,5 @@ def gtrack_track_rows(
         existence=np.full(len(f), np.nan),
         n_points=cat(n_pts, np.int64),
         nis=cat(nis, np.float64),
-        z_m=cat(z, np.float64) if dims == 3 else None,
+        height_m=cat(z, np.float64) if dims == 3 else None,
     )
