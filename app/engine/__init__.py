@@ -44,6 +44,7 @@ from app.engine.studies import (
 from app.engine.tracking import (
     EXTRA_FIELDS,
     TRACKER_COMPILED,
+    TRACKERS,
     default_extra,
     default_values,
     load_params,
@@ -103,6 +104,7 @@ __all__ = [
     "PAPER_SCENE_FILE",
     "ROOT",
     "TRACKER_COMPILED",
+    "TRACKERS",
     "ClassParamSpec",
     "Dashboard",
     "Engine",
