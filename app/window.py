@@ -414,7 +414,8 @@ class MainWindow(QtWidgets.QMainWindow):
 
     def load_params(self, path: str | Path) -> bool:
         try:
-            model, values, extra = self.engine.load_params(path)
+            tracker, model, values, extra = self.engine.load_tracker_file(path)
+            self.params_model.set_tracker(tracker)
             self.params_model.set_values(values, model=model, extra=extra)
             return True
         except (OSError, json.JSONDecodeError) as exc:

@@ -48,6 +48,7 @@ from app.engine.tracking import (
     default_extra,
     default_values,
     load_params,
+    load_tracker_file,
     make_params,
     param_specs,
     track,
@@ -83,6 +84,7 @@ class Engine:
     default_extra = staticmethod(default_extra)
     make_params = staticmethod(make_params)
     load_params = staticmethod(load_params)
+    load_tracker_file = staticmethod(load_tracker_file)
     simulate = staticmethod(simulate)
     fidelity_levels = staticmethod(fidelity_levels)
     processing_settings = staticmethod(processing_settings)
@@ -121,6 +123,7 @@ __all__ = [
     "fidelity_levels",
     "frame_views",
     "load_params",
+    "load_tracker_file",
     "make_params",
     "paper_document",
     "param_specs",

@@ -7,6 +7,7 @@ import os
 import threading
 import time
 from collections.abc import Sequence
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -86,6 +87,29 @@ def load_params(path: str | os.PathLike) -> tuple[str, dict[str, float], dict]:
     except InputError as exc:
         raise InputError(exc.message, str(path)) from None
     return d["model"], values, {k: d[k] for k in EXTRA_FIELDS}
+
+
+def load_tracker_file(path: str | os.PathLike) -> tuple[str, str, dict[str, float], dict]:
+    """A tracker parameter file of any of the app's trackers: (tracker, model, flat values,
+    fixed settings). A gtrack file (``GtrackParams`` JSON, recognised by
+    :func:`core.tracking.space.flat_params`) is ``("gtrack", "cv", values, {})``; a
+    ``TrackerParams`` file is ``(its mode, its model, ...)`` as :func:`load_params` reads it."""
+    from core.files import read_json
+    from core.tracking.space import GTRACK, flat_params, search_space
+
+    doc = read_json(Path(path), what="tracker parameters")
+    if isinstance(doc, dict) and "model" not in doc and "mode" not in doc:
+        try:
+            flat = flat_params(doc)
+        except InputError:
+            flat = {}
+        if set(flat) == {p.name for p in search_space(GTRACK)}:
+            from core.tracking.gtrack import GtrackParams
+
+            values = flat_params(GtrackParams.load(path).to_dict())  # validated, file named
+            return GTRACK, "cv", values, {}
+    model, values, extra = load_params(path)
+    return _tracker_params_class().load(path).mode, model, values, extra
 
 
 def _truth0(frames: Sequence[FrameData]) -> np.ndarray:

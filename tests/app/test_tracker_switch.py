@@ -106,3 +106,40 @@ def test_switching_trackers_retracks(qtbot, window, long_scene_doc, fill_cache) 
     result = w.tracking_model.result
     assert np.isnan(result.frames[-1].psi).all()  # gtrack has no existence probability
     assert result.frames[-1].confirmed.sum() == 1
+
+
+def test_parameter_files_and_workspaces_keep_the_tracker(window, tmp_path) -> None:
+    """Save tracker parameters of room mode or gtrack, load them: the tracker switches with
+    them and every value comes back; a workspace stores the tracker too."""
+    from core.tracking.gtrack import GtrackParams
+
+    w = window
+    w.scene_control.load_paper_scene()
+    pm = w.params_model
+    pm.set_tracker("gtrack")
+    pm.set_value("alloc_points", 12.0)
+    g = tmp_path / "g.json"
+    pm.params().save(g)
+    pm.set_tracker("room")
+    pm.set_value("ghost_gap", 0.7)
+    room_values = pm.values
+    r = tmp_path / "r.json"
+    pm.params().save(r)
+    pm.set_tracker("paper")
+    assert w.load_params(g)
+    assert pm.tracker == "gtrack" and pm.params().alloc_points == 12
+    assert isinstance(pm.params(), GtrackParams)
+    assert w.load_params(r)
+    assert pm.tracker == "room" and pm.values == pytest.approx(room_values)
+    # a workspace: the tracker and its values round-trip
+    ws = tmp_path / "ws.json"
+    assert w.record.save_workspace(ws)
+    assert json.loads(ws.read_text())["tracker"]["tracker"] == "room"
+    pm.set_tracker("paper")
+    assert w.record.open_workspace(ws)
+    assert pm.tracker == "room" and pm.values == pytest.approx(room_values)
+    doc = json.loads(ws.read_text())
+    doc["tracker"]["tracker"] = "kalman"
+    ws.write_text(json.dumps(doc))
+    assert not w.record.open_workspace(ws)
+    assert "tracker.tracker" in w.errors[-1] and pm.tracker == "room"
