@@ -450,6 +450,7 @@ class MainWindow(QtWidgets.QMainWindow):
             self.show_error("no completed trial yet")
             return
         try:
+            self.params_model.set_tracker("paper")  # the study tunes the paper tracker
             self.params_model.set_values(p.best_params, model=p.best_model)
             self.statusBar().showMessage(f"applied best trial (loss {p.best_loss:.4g} m²)", 5000)
         except InputError as exc:
@@ -590,6 +591,12 @@ class MainWindow(QtWidgets.QMainWindow):
             self.show_error(f"cannot start study: {one_line(exc)}")
 
     def enqueue_current(self) -> None:
+        if self.params_model.tracker != "paper":
+            self.show_error(
+                "cannot enqueue: the study tunes the paper tracker; the tracker panel shows "
+                f"{self.params_model.tracker}"
+            )
+            return
         self.study.enqueue(
             self.params_model.values,
             self.params_model.model,

@@ -143,3 +143,14 @@ def test_parameter_files_and_workspaces_keep_the_tracker(window, tmp_path) -> No
     ws.write_text(json.dumps(doc))
     assert not w.record.open_workspace(ws)
     assert "tracker.tracker" in w.errors[-1] and pm.tracker == "room"
+
+
+def test_study_and_live_link_refuse_another_tracker(window) -> None:
+    """The study and the live link run the paper tracker: with gtrack chosen they say so in
+    one line instead of failing inside (the live link is not started)."""
+    w = window
+    w.params_model.set_tracker("gtrack")
+    w.enqueue_current()
+    assert "study tunes the paper tracker" in w.errors[-1]
+    w.live.start(None)  # refused before the settings are looked at
+    assert "choose 'paper'" in w.errors[-1] and not w.live.running
