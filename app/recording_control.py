@@ -136,16 +136,36 @@ class RecordingController(QtCore.QObject):
         w = self._w
         self.panel = RecordingPanel()
         self.panel.close_requested.connect(self.close_recording)
-        w._dock("Recording", self.panel, QtCore.Qt.LeftDockWidgetArea)
-        w.tabifyDockWidget(w.docks["Scene"], w.docks["Recording"])
-        w.docks["Recording"].hide()
+        # not one of the window's arranged panels (w.docks): hidden until a recording plays,
+        # then put where the scene editor is
+        scroll = QtWidgets.QScrollArea()
+        scroll.setWidget(self.panel)
+        scroll.setWidgetResizable(True)
+        scroll.setFrameShape(QtWidgets.QFrame.NoFrame)
+        self.dock = QtWidgets.QDockWidget("Recording", w)
+        self.dock.setObjectName("dockRecording")
+        self.dock.setWidget(scroll)
+        self.dock.setMinimumWidth(300)
+        self.dock.hide()
         self.stats_panel = StatsPanel()
-        w._dock("Statistics", self.stats_panel, QtCore.Qt.RightDockWidgetArea)
-        w.tabifyDockWidget(w.docks["Tracker"], w.docks["Statistics"])
-        w.docks["Tracker"].raise_()
+        # a tab beside the track table (bottom): in the panels' tab group on the right it made
+        # the first start's window taller than a 1366x768 screen at 150 %
+        scroll = QtWidgets.QScrollArea()
+        scroll.setWidget(self.stats_panel)
+        scroll.setWidgetResizable(True)
+        scroll.setFrameShape(QtWidgets.QFrame.NoFrame)
+        self.stats_dock = QtWidgets.QDockWidget("Statistics", w)
+        self.stats_dock.setObjectName("dockStatistics")
+        self.stats_dock.setWidget(scroll)
+        tracks = w.views_control.tracks_dock
+        w.addDockWidget(QtCore.Qt.BottomDockWidgetArea, self.stats_dock)
+        w.tabifyDockWidget(tracks, self.stats_dock)
+        tracks.raise_()
+        if tracks.isHidden():  # a small screen: the bottom docks start closed
+            self.stats_dock.hide()
         view_menu = next(a.menu() for a in w.menuBar().actions() if a.text() == "&View")
-        view_menu.addAction(w.docks["Recording"].toggleViewAction())
-        view_menu.addAction(w.docks["Statistics"].toggleViewAction())
+        view_menu.addAction(self.dock.toggleViewAction())
+        view_menu.addAction(self.stats_dock.toggleViewAction())
 
     def _build_view_bar(self) -> None:
         bar = self._w.findChild(QtWidgets.QToolBar, "viewBar")
@@ -259,12 +279,15 @@ class RecordingController(QtCore.QObject):
             i = w.colour_combo.findData("doppler")
             w.colour_combo.setCurrentIndex(i)  # its signal recolours the view
         w.psi_view.has_truth = replay.has_truth
-        scene_dock, rec_dock = w.docks["Scene"], w.docks["Recording"]
-        if scene_dock.isVisible():
-            self._scene_dock_was_visible = True
-        scene_dock.hide()
+        scene_dock, rec_dock = w.docks["Scene"], self.dock
+        if w.dockWidgetArea(rec_dock) == QtCore.Qt.NoDockWidgetArea:
+            w.addDockWidget(w.dockWidgetArea(scene_dock), rec_dock)
+            w.tabifyDockWidget(scene_dock, rec_dock)
+        if rec_dock.isHidden():  # not when one recording follows another
+            self._scene_dock_was_visible = not scene_dock.isHidden()
         rec_dock.show()
         rec_dock.raise_()
+        scene_dock.hide()
         self._set_views_unavailable(True)
         self._align_scene_radar(replay.radar)
         self.act_close.setEnabled("replay" in w.engine.__dict__)
@@ -313,10 +336,10 @@ class RecordingController(QtCore.QObject):
         w.top_view.set_reference(None)
         self.reference_check.setEnabled(False)
         w.psi_view.has_truth = w.engine.has_truth
-        w.docks["Recording"].hide()
         if self._scene_dock_was_visible:
             w.docks["Scene"].show()
             w.docks["Scene"].raise_()
+        self.dock.hide()
         self._set_views_unavailable(False)
         self.act_close.setEnabled(False)
         w.scene_model.changed.emit()
@@ -437,6 +460,6 @@ class RecordingController(QtCore.QObject):
         """The people count on the top view and the statistics panel (the window's draw)."""
         stats = self.frame_stats(index, frame, result)
         self._w.top_view.set_count(stats.count_html() if frame is not None else None)
-        dock = self._w.docks["Statistics"]
+        dock = self.stats_dock
         if dock.isVisible() and not dock.visibleRegion().isEmpty():
             self.stats_panel.show_stats(stats)

@@ -92,7 +92,7 @@ def main(argv: list[str] | None = None) -> int:
 
     w.colour_combo.setCurrentIndex(w.colour_combo.findData(args.colour))
     w.playback.set_frame(min(args.frame, len(w.cache) - 1))
-    w.docks["Statistics"].raise_()
+    w.recording.stats_dock.raise_()
     qa.processEvents()
     view = w.top_view
     if args.zoom > 0:  # the person in this recording stays within 1 m of the sensor
@@ -100,7 +100,7 @@ def main(argv: list[str] | None = None) -> int:
         view.getPlotItem().vb.setRange(xRange=(-args.zoom, args.zoom), yRange=(-0.3, args.zoom))
     w.redraw()
     save(w, "recording_window.png")
-    save(w.docks["Recording"], "recording_panel.png")
+    save(w.recording.dock, "recording_panel.png")
     if args.compare:
         compare(w)
     w.shutdown()

@@ -86,7 +86,7 @@ def test_open_recording_replays_it_with_its_facts(qtbot, window, tmp_path) -> No
     assert w.recording.replaying and not w.engine.has_truth
     np.testing.assert_allclose(w.cache.frames[4].cloud.x_m, [0.5, -2.0], atol=1e-6)
     assert "walk.dat" in w.windowTitle()
-    assert w.docks["Recording"].isVisibleTo(w) and not w.docks["Scene"].isVisibleTo(w)
+    assert w.recording.dock.isVisibleTo(w) and not w.docks["Scene"].isVisibleTo(w)
     facts = dict(w.recording.facts.rows())
     assert facts["frames"] == str(N_FRAMES)
     assert facts["format"] == "uart"
@@ -112,7 +112,7 @@ def test_open_recording_replays_it_with_its_facts(qtbot, window, tmp_path) -> No
     w.recording.close_recording()
     assert not w.recording.replaying and w.engine.has_truth
     assert "simulate" not in w.engine.__dict__
-    assert w.docks["Scene"].isVisibleTo(w) and not w.docks["Recording"].isVisibleTo(w)
+    assert w.docks["Scene"].isVisibleTo(w) and not w.recording.dock.isVisibleTo(w)
     assert unavailable_reason(w.rd_view) is None
     assert "RadarTune" in w.windowTitle() and "walk.dat" not in w.windowTitle()
 
@@ -256,7 +256,7 @@ def test_replay_given_on_the_command_line_can_be_closed(qtbot, settings, tmp_pat
     qtbot.addWidget(w)
     try:
         assert "cli.dat" in w.windowTitle() and w.recording.act_close.isEnabled()
-        assert w.docks["Recording"].isVisibleTo(w) and unavailable_reason(w.rd_view)
+        assert w.recording.dock.isVisibleTo(w) and unavailable_reason(w.rd_view)
         qtbot.waitUntil(lambda: w.cache.complete and len(w.cache) == N_FRAMES, timeout=60000)
         w.recording.close_recording()
         qtbot.waitUntil(lambda: w.cache.expected != N_FRAMES, timeout=60000)
