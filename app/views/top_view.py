@@ -489,6 +489,8 @@ class TopView(pg.PlotWidget):
         if not html:
             self.count_label.hide()
             return
+        if html == self.count_label.text() and self.count_label.isVisibleTo(self):
+            return  # unchanged: no re-layout on every draw
         self.count_label.setText(html)
         self.count_label.adjustSize()
         self._place_count()
