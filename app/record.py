@@ -55,6 +55,7 @@ class RecordController(QtCore.QObject):
             tracker_values=w.params_model.values,
             tracker_extra=w.params_model.extra,
             study=w.study_model.form,
+            tracker_kind=w.params_model.tracker,
         )
 
     def save_workspace(self, path: str | Path) -> bool:
@@ -75,6 +76,7 @@ class RecordController(QtCore.QObject):
         try:
             ws = load_workspace(path, w.engine)
             w.scene_model.set_document(ws.scene, base_dir=Path(path).parent, source=str(path))
+            w.params_model.set_tracker(ws.tracker_kind)
             w.params_model.set_values(ws.tracker_values, model=ws.tracker_model)
             if ws.tracker_extra:
                 w.params_model.set_extra(**ws.tracker_extra)
