@@ -117,7 +117,7 @@ def test_parameter_files_and_workspaces_keep_the_tracker(window, tmp_path) -> No
     w.scene_control.load_paper_scene()
     pm = w.params_model
     pm.set_tracker("gtrack")
-    pm.set_value("alloc_points", 12.0)
+    pm.set_value("points_thre", 12.0)
     g = tmp_path / "g.json"
     pm.params().save(g)
     pm.set_tracker("room")
@@ -127,7 +127,7 @@ def test_parameter_files_and_workspaces_keep_the_tracker(window, tmp_path) -> No
     pm.params().save(r)
     pm.set_tracker("paper")
     assert w.load_params(g)
-    assert pm.tracker == "gtrack" and pm.params().alloc_points == 12
+    assert pm.tracker == "gtrack" and pm.params().points_thre == 12
     assert isinstance(pm.params(), GtrackParams)
     assert w.load_params(r)
     assert pm.tracker == "room" and pm.values == pytest.approx(room_values)
