@@ -81,7 +81,11 @@ def test_short_study_from_panel_keeps_event_loop_alive(
 
     # the dashboard serves this storage (the browser call is intercepted)
     opened = []
-    monkeypatch.setattr("webbrowser.open", lambda url: opened.append(url))
+    from PySide6 import QtGui
+
+    monkeypatch.setattr(
+        QtGui.QDesktopServices, "openUrl", lambda url: opened.append(url.toString())
+    )
     panel.dashboard_button.click()
     qtbot.waitUntil(lambda: bool(opened), timeout=10000)
     import json
