@@ -91,6 +91,7 @@ def run(quick: bool = False) -> dict:
 
     from app.window import MainWindow
 
+    QtCore.QCoreApplication.setAttribute(QtCore.Qt.AA_ShareOpenGLContexts)  # as app.main
     qa = QtWidgets.QApplication.instance() or QtWidgets.QApplication(sys.argv[:1])
     pg.setConfigOptions(imageAxisOrder="row-major")
     tmp = Path(tempfile.mkdtemp(prefix="radartune-bench-gui-"))
