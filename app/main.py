@@ -175,6 +175,9 @@ def run(
     from app.errors import install_excepthooks
     from app.window import MainWindow
 
+    # one OpenGL share group: pyqtgraph keeps a shader per item class, which a floated (new
+    # context) 3-D view could not use otherwise
+    QtCore.QCoreApplication.setAttribute(QtCore.Qt.AA_ShareOpenGLContexts)
     app = QtWidgets.QApplication.instance() or QtWidgets.QApplication(sys.argv[:1])
     app.setOrganizationName("RadarTune")
     app.setApplicationName("RadarTune")

@@ -7,7 +7,6 @@ from __future__ import annotations
 
 import json
 import time
-import webbrowser
 from collections import deque
 from pathlib import Path
 
@@ -614,7 +613,8 @@ class MainWindow(QtWidgets.QMainWindow):
             self.show_error(f"cannot start the dashboard: {one_line(exc)}")
             return
         self.statusBar().showMessage(f"dashboard at {url}", 10000)
-        QtCore.QTimer.singleShot(1500, lambda: webbrowser.open(url))
+        # Qt starts the browser detached: webbrowser.open left its child defunct (never reaped)
+        QtCore.QTimer.singleShot(1500, lambda: QtGui.QDesktopServices.openUrl(QtCore.QUrl(url)))
 
     def browse_storage(self) -> None:
         path, _ = QtWidgets.QFileDialog.getSaveFileName(

@@ -118,6 +118,19 @@ def _truth0(frames: Sequence[FrameData]) -> np.ndarray:
     ).reshape(-1, 2)
 
 
+def running_pair_rmse(error_p: np.ndarray, p: float) -> np.ndarray:
+    """Running position RMSE (m) over frames ``0..k`` of several persons, each scored against
+    the track GOSPA pairs with it (``error_p``: ``(N, P)`` ‖x̂ − x‖^p, NaN where unpaired, from
+    :func:`core.evaluation.people.frame_metrics`); NaN while no pair yet. With two people the
+    one scene estimate against person 0 read 2–5 m while each was tracked to 0.1 m."""
+    e2 = np.abs(np.asarray(error_p, dtype=float)) ** (2.0 / p)
+    ok = np.isfinite(e2)
+    total = np.cumsum(np.where(ok, e2, 0.0).sum(axis=1))
+    count = np.cumsum(ok.sum(axis=1))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.where(count > 0, np.sqrt(total / np.maximum(count, 1)), np.nan)
+
+
 def _people(frames: Sequence[FrameData], track_frames) -> Any:
     """Several-person metrics of the run (:func:`core.evaluation.people.people_run`); None
     without persons."""
@@ -201,8 +214,11 @@ def track(
     est = np.where(has[:, None], np.asarray(res.estimate_xy, dtype=float), np.nan)
     truth0 = _truth0(frames)
     loss, rmse = running_trajectory_loss(est, has, truth0)
+    people = _people(frames, res.frames)
+    if people is not None and len(people.persons) > 1:
+        rmse = running_pair_rmse(people.frames.gospa_error2, people.frames.p)
     return TrackingResult(
-        people=_people(frames, res.frames),
+        people=people,
         frames=tuple(tfs),
         estimate_xy_m=est,
         truth_xy_m=truth0,
