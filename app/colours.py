@@ -15,7 +15,7 @@ IDENTITY_PALETTE: tuple[tuple[int, int, int], ...] = (
     (78, 161, 235),
     (255, 146, 52),
     (80, 200, 90),
-    (240, 80, 80),
+    (120, 230, 190),  # mint, not red: red is the estimate's cross and the CFAR marks
     (180, 130, 230),
     (190, 130, 100),
     (245, 130, 200),

@@ -58,6 +58,9 @@ class FrameData:
     #: where the fidelity level runs them apart (exact), else NaN
     synthesis_s: float = float("nan")
     processing_s: float = float("nan")
+    #: ``(n_points,)`` int: the id of TI's track the sensor's firmware gave each point (-1: none),
+    #: for a recording that carries it; ``None`` otherwise
+    point_track: np.ndarray | None = None
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)

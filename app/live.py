@@ -204,6 +204,12 @@ class LiveController(QtCore.QObject):
         if self.running:
             w.show_error("live sensor: a sensor is connected; stop it before connecting again")
             return
+        if w.params_model.tracker != "paper":  # core.live tracks frame by frame with the IPDA
+            w.show_error(
+                f"live sensor: the live link tracks with the paper tracker, not "
+                f"{w.params_model.tracker}; choose 'paper' in the tracker panel"
+            )
+            return
         try:
             params = w.params_model.params()
         except Exception as exc:  # noqa: BLE001 - bad parameters are a message

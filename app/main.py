@@ -139,11 +139,13 @@ def run(
     """Create the QApplication and the main window, play, and run the event loop."""
     engine = None
     if replay is not None:
+        from app.engine import Engine
         from app.errors import log_exception, one_line
-        from app.replay import ReplayEngine, load_recording
+        from app.replay import ReplayEngine, attach_recording, load_recording
 
         try:
-            engine = ReplayEngine(load_recording(replay, cfg))
+            engine = Engine()  # simulating again after File → Close recording
+            attach_recording(engine, ReplayEngine(load_recording(replay, cfg), path=replay))
         except Exception as exc:
             log_exception(f"cannot replay {replay}", exc)
             print(f"radartune gui: error: {one_line(exc, replay)}", file=sys.stderr)
@@ -173,6 +175,9 @@ def run(
     from app.errors import install_excepthooks
     from app.window import MainWindow
 
+    # one OpenGL share group: pyqtgraph keeps a shader per item class, which a floated (new
+    # context) 3-D view could not use otherwise
+    QtCore.QCoreApplication.setAttribute(QtCore.Qt.AA_ShareOpenGLContexts)
     app = QtWidgets.QApplication.instance() or QtWidgets.QApplication(sys.argv[:1])
     app.setOrganizationName("RadarTune")
     app.setApplicationName("RadarTune")

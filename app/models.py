@@ -166,7 +166,9 @@ class SceneModel(QtCore.QObject):
 
 
 class TrackerParamsModel(QtCore.QObject):
-    """Tracker parameters as flat search-space values (``q_coeff``, ``p0_00`` …) plus the model.
+    """Tracker parameters as flat search-space values (``q_coeff``, ``p0_00`` …) plus the model
+    and the tracker (``"paper"``, ``"room"`` or ``"gtrack"``: the values are that tracker's
+    search-space rows, :func:`core.tracking.space.search_space`).
 
     ``changed`` fires on every edit. Every edit builds (and so validates) the core
     ``TrackerParams`` once; :meth:`params` returns that object.
@@ -178,6 +180,7 @@ class TrackerParamsModel(QtCore.QObject):
         super().__init__(parent)
         self._engine = engine
         self._model = "cv"
+        self._tracker = "paper"
         self._values: dict[str, float] = engine.default_values("cv")
         self._extra: dict = {}
         self._params = engine.make_params(self._model, self._values, self._extra)
@@ -190,15 +193,44 @@ class TrackerParamsModel(QtCore.QObject):
     def values(self) -> dict[str, float]:
         return dict(self._values)
 
+    @property
+    def tracker(self) -> str:
+        """``"paper"`` (the paper's IPDA), ``"room"`` (the tracker for real rooms) or
+        ``"gtrack"`` (TI's people tracker rebuilt)."""
+        return self._tracker
+
+    def _table(self, tracker: str, model: str) -> tuple[str, str]:
+        """(table, mode) of core's search space for ``tracker`` with motion ``model``."""
+        return ("gtrack", "paper") if tracker == "gtrack" else (model, tracker)
+
+    def _defaults(self, tracker: str, model: str) -> dict[str, float]:
+        return self._engine.default_values(*self._table(tracker, model))
+
     def specs(self) -> list[ParamSpec]:
-        return self._engine.param_specs(self._model)
+        return self._engine.param_specs(*self._table(self._tracker, self._model))
+
+    def set_tracker(self, tracker: str) -> None:
+        """Switch trackers: the sliders become its search space (shared rows keep their
+        values, the others take the table's defaults)."""
+        if tracker not in ("paper", "room", "gtrack"):
+            raise InputError(
+                f"tracker must be 'paper', 'room' or 'gtrack', got {tracker!r}", "tracker"
+            )
+        if tracker == self._tracker:
+            return
+        defaults = self._defaults(tracker, self._model)
+        values = {k: self._values.get(k, v) for k, v in defaults.items()}
+        try:
+            self._set(self._model, values, self._extra, tracker)
+        except InputError:  # a shared name with another meaning out of range: the defaults
+            self._set(self._model, defaults, self._extra, tracker)
 
     def set_model(self, model: str) -> None:
         if model not in ("cv", "ca"):
             raise InputError(f"model must be 'cv' or 'ca', got {model!r}", "model")
         if model == self._model:
             return
-        defaults = self._engine.default_values(model)
+        defaults = self._defaults(self._tracker, model)
         # keep what both models share, take defaults for the rest (p0_44, p0_55 for CA)
         self._set(model, {k: self._values.get(k, v) for k, v in defaults.items()}, self._extra)
 
@@ -215,7 +247,7 @@ class TrackerParamsModel(QtCore.QObject):
         """Set the flat values (missing ones take the table's defaults), the model and (merged
         into the current ones) the non-optimised settings, in one edit."""
         model = model or self._model
-        full = self._engine.default_values(model)
+        full = self._defaults(self._tracker, model)
         unknown = sorted(set(values) - set(full))
         if unknown:
             raise InputError(f"unknown tracker parameter(s) {unknown}", "tracker parameters")
@@ -226,10 +258,18 @@ class TrackerParamsModel(QtCore.QObject):
         """Non-optimised settings (thresholds, clutter density)."""
         self._set(self._model, self._values, {**self._extra, **extra})
 
-    def _set(self, model: str, values: dict[str, float], extra: dict) -> None:
+    def _set(
+        self, model: str, values: dict[str, float], extra: dict, tracker: str | None = None
+    ) -> None:
         """Build the ``TrackerParams`` (InputError, nothing changed, if invalid), then take it."""
-        params = self._engine.make_params(model, values, extra)
+        tracker = tracker or self._tracker
+        table, mode = self._table(tracker, model)
+        if tracker == "paper":
+            params = self._engine.make_params(model, values, extra)
+        else:
+            params = self._engine.make_params(table, values, extra, mode)
         self._model, self._values, self._extra, self._params = model, values, extra, params
+        self._tracker = tracker
         self.changed.emit()
 
     @property
@@ -241,14 +281,16 @@ class TrackerParamsModel(QtCore.QObject):
         return {**self._engine.default_extra(), **self._extra}
 
     def reset(self) -> None:
-        self._set(self._model, self._engine.default_values(self._model), self._extra)
+        self._set(self._model, self._defaults(self._tracker, self._model), self._extra)
 
     def params(self):
         """The core ``TrackerParams`` of the current values (built at the last edit)."""
         return self._params
 
     def key(self) -> str:
-        return json.dumps([self._model, sorted(self._values.items()), sorted(self._extra.items())])
+        return json.dumps(
+            [self._tracker, self._model, sorted(self._values.items()), sorted(self._extra.items())]
+        )
 
 
 class FrameCache(QtCore.QObject):

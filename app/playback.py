@@ -151,8 +151,8 @@ class PlaybackController(QtCore.QObject):
         total = self.cache.expected or len(self.cache)
         t = self.model.frame * self.frame_period_s
         n = len(self.cache)
-        # the total once: "(of N)" only while the simulation still fills the cache
-        filling = f" (of {total} simulated)" if n < total else ""
+        # out of the scene's frames; how many are simulated only while the cache fills
+        filling = f" ({n} simulated so far)" if n < total else ""
         self.frame_label.setText(
-            f" frame {self.model.frame + 1 if n else 0} / {n}{filling} · {t:5.2f} s"
+            f" frame {self.model.frame + 1 if n else 0} / {total}{filling} · {t:5.2f} s"
         )

@@ -13,6 +13,23 @@ from app.errors import log_exception, one_line
 from app.workspace import Workspace, load_workspace, save_workspace
 from core.errors import InputError
 
+#: exported plots are drawn this wide (px), whatever their size on screen
+EXPORT_WIDTH_PX = 1600
+
+
+def plot_image(widget: QtWidgets.QWidget) -> QtGui.QPixmap:
+    """A plot drawn anew at :data:`EXPORT_WIDTH_PX` wide (pyqtgraph's image exporter, aspect
+    kept: text and lines redrawn, not a screen grab enlarged); other widgets grabbed as shown."""
+    import pyqtgraph as pg
+    from pyqtgraph.exporters import ImageExporter
+
+    if not isinstance(widget, pg.GraphicsView):
+        return widget.grab()
+    exporter = ImageExporter(widget.scene())
+    exporter.parameters()["width"] = max(EXPORT_WIDTH_PX, widget.width())
+    image = exporter.export(toBytes=True)
+    return QtGui.QPixmap.fromImage(image)
+
 
 class RecordController(QtCore.QObject):
     """File → Save workspace …, Open workspace …, Export …, Export plots as PNG …,
@@ -55,6 +72,7 @@ class RecordController(QtCore.QObject):
             tracker_values=w.params_model.values,
             tracker_extra=w.params_model.extra,
             study=w.study_model.form,
+            tracker_kind=w.params_model.tracker,
         )
 
     def save_workspace(self, path: str | Path) -> bool:
@@ -75,6 +93,7 @@ class RecordController(QtCore.QObject):
         try:
             ws = load_workspace(path, w.engine)
             w.scene_model.set_document(ws.scene, base_dir=Path(path).parent, source=str(path))
+            w.params_model.set_tracker(ws.tracker_kind)
             w.params_model.set_values(ws.tracker_values, model=ws.tracker_model)
             if ws.tracker_extra:
                 w.params_model.set_extra(**ws.tracker_extra)
@@ -162,7 +181,7 @@ class RecordController(QtCore.QObject):
             for name, widget in self.plot_widgets().items():
                 if widget.width() < 50 or widget.height() < 50:
                     widget.resize(900, 600)  # a hidden tab has no size yet
-                out.append(self._save_png(widget.grab(), folder / f"{name}.png"))
+                out.append(self._save_png(plot_image(widget), folder / f"{name}.png"))
         except InputError as exc:
             w.show_error(str(exc))
         except OSError as exc:

@@ -8,6 +8,7 @@ from __future__ import annotations
 import numpy as np
 from PySide6 import QtCore, QtWidgets
 
+from app.views.cloud3d_view import Cloud3DView
 from app.views.elevation_view import ElevationView
 from app.views.people_table import PeopleTable
 from app.views.ra_view import RangeAzimuthView
@@ -45,6 +46,14 @@ class ViewsController(QtCore.QObject):
                        self.profile_view, self.spectrogram_view, self.elevation_view):  # fmt: skip
             widget.setMinimumSize(80, 40)
         self.views_dock = self._dock("Radar views", self.tabs)
+        # the 3-D point cloud: starts closed (View → 3-D view), OpenGL only on a display
+        self.cloud3d = Cloud3DView()
+        self.cloud3d.setMinimumSize(80, 40)
+        self.cloud3d_dock = self._dock("3-D view", self.cloud3d)
+        self.cloud3d_dock.hide()
+        self.cloud3d.reset_button.clicked.connect(window._mark_dirty)
+        self.cloud3d.colour_combo.currentIndexChanged.connect(lambda _i: window._mark_dirty())
+        self.cloud3d_dock.visibilityChanged.connect(lambda _v: window._mark_dirty())
         self.tracks_dock = self._dock("Tracks", tracks_and_people)
         # side by side under the central views: the track table beside the radar views
         window.splitDockWidget(self.views_dock, self.tracks_dock, QtCore.Qt.Horizontal)
@@ -62,6 +71,7 @@ class ViewsController(QtCore.QObject):
         if view_menu is not None:
             view_menu.addAction(self.views_dock.toggleViewAction())
             view_menu.addAction(self.tracks_dock.toggleViewAction())
+            view_menu.addAction(self.cloud3d_dock.toggleViewAction())
         window.scene_control.info_changed.connect(self._on_scene_info)
         window.scene_model.selection_changed.connect(self._on_person)
         window.cache.reset.connect(self.spectrogram_view.reset)
@@ -91,6 +101,7 @@ class ViewsController(QtCore.QObject):
         ).reshape(-1, 3)
         measures = bool(scene is not None and radar.has_elevation and not scene.is_planar)
         self.elevation_view.set_scene(max_r, xyz, measures_elevation=measures)
+        self.cloud3d.set_scene(scene)
 
     def _on_person(self, index: int) -> None:
         self.spectrogram_view.set_person(index)
@@ -110,10 +121,17 @@ class ViewsController(QtCore.QObject):
             elif current is self.elevation_view:
                 self.elevation_view.persistence = self._window.top_view.persistence
                 self.elevation_view.show_frame(index, frames)
+        if self.cloud3d_dock.isVisible() and not self.cloud3d_dock.visibleRegion().isEmpty():
+            self._draw_cloud3d(index, frames, result)
         if self.tracks_dock.isVisible() and not self.tracks_dock.visibleRegion().isEmpty():
             tf = result.frames[index] if result is not None and index < result.n_frames else None
             self.track_table.show_tracks(tf, index)
             self.people_table.show_people(None if result is None else result.people, index)
+
+    def _draw_cloud3d(self, index: int, frames, result) -> None:
+        top = self._window.top_view
+        self.cloud3d.persistence, self.cloud3d.trail_length = top.persistence, top.trail_length
+        self.cloud3d.show_frame(index, frames, result)
 
     def draw_all(self, index: int, frame, result) -> None:
         """Draw every view whether visible or not (exports, tests)."""
@@ -123,6 +141,7 @@ class ViewsController(QtCore.QObject):
         self.spectrogram_view.show_frame(index, frames)
         self.elevation_view.persistence = self._window.top_view.persistence
         self.elevation_view.show_frame(index, frames)
+        self._draw_cloud3d(index, frames, result)
         tf = result.frames[index] if result is not None and index < result.n_frames else None
         self.track_table.show_tracks(tf, index)
         self.people_table.show_people(None if result is None else result.people, index)

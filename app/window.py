@@ -7,7 +7,6 @@ from __future__ import annotations
 
 import json
 import time
-import webbrowser
 from collections import deque
 from pathlib import Path
 
@@ -156,6 +155,9 @@ class MainWindow(QtWidgets.QMainWindow):
         from app.live import LiveController  # File → Connect sensor … (a live TI sensor)
 
         self.live = LiveController(self)
+        from app.recording_control import RecordingController  # File → Open recording …
+
+        self.recording = RecordingController(self)
 
         # ---- wiring ----------------------------------------------------------------------------
         self.scene_control.info_changed.connect(self._on_scene_info)
@@ -237,6 +239,9 @@ class MainWindow(QtWidgets.QMainWindow):
         self.colour_combo.setObjectName("colourCombo")
         self.colour_combo.addItem("SNR", "snr")
         self.colour_combo.addItem("label (person / clutter / noise)", "label")
+        self.colour_combo.addItem("Doppler", "doppler")
+        self.colour_combo.addItem("height", "height")
+        self.colour_combo.addItem("TI's track", "track")
         bar.addWidget(self.colour_combo)
         bar.addWidget(QtWidgets.QLabel("  persistence "))
         self.persistence_spin = QtWidgets.QSpinBox()
@@ -408,7 +413,8 @@ class MainWindow(QtWidgets.QMainWindow):
 
     def load_params(self, path: str | Path) -> bool:
         try:
-            model, values, extra = self.engine.load_params(path)
+            tracker, model, values, extra = self.engine.load_tracker_file(path)
+            self.params_model.set_tracker(tracker)
             self.params_model.set_values(values, model=model, extra=extra)
             return True
         except (OSError, json.JSONDecodeError) as exc:
@@ -443,6 +449,7 @@ class MainWindow(QtWidgets.QMainWindow):
             self.show_error("no completed trial yet")
             return
         try:
+            self.params_model.set_tracker("paper")  # the study tunes the paper tracker
             self.params_model.set_values(p.best_params, model=p.best_model)
             self.statusBar().showMessage(f"applied best trial (loss {p.best_loss:.4g} m²)", 5000)
         except InputError as exc:
@@ -516,6 +523,7 @@ class MainWindow(QtWidgets.QMainWindow):
         self.rd_view.show_frame(frame)
         self.psi_view.set_frame(index)
         self.views_control.redraw(index, frame, result)  # radar views and track table
+        self.recording.redraw(index, frame, result)  # people count and statistics
         self._show_metrics(index, result)
         self.n_draws += 1
         now = time.perf_counter()
@@ -542,7 +550,8 @@ class MainWindow(QtWidgets.QMainWindow):
         now = time.perf_counter()
         recent = [t for t in self._draw_times if now - t <= 1.0]
         rendered = len(recent)
-        text = f" rendered {rendered:d} fps · simulated {self.sim.rate_fps:.1f} fps" + (
+        source = "read" if self.recording.replaying else "simulated"
+        text = f" rendered {rendered:d} fps · {source} {self.sim.rate_fps:.1f} fps" + (
             " (done)" if self.cache.complete else ""
         )
         if text != self.fps_label.text():  # a label's setText re-lays out its bar
@@ -581,6 +590,12 @@ class MainWindow(QtWidgets.QMainWindow):
             self.show_error(f"cannot start study: {one_line(exc)}")
 
     def enqueue_current(self) -> None:
+        if self.params_model.tracker != "paper":
+            self.show_error(
+                "cannot enqueue: the study tunes the paper tracker; the tracker panel shows "
+                f"{self.params_model.tracker}"
+            )
+            return
         self.study.enqueue(
             self.params_model.values,
             self.params_model.model,
@@ -598,7 +613,8 @@ class MainWindow(QtWidgets.QMainWindow):
             self.show_error(f"cannot start the dashboard: {one_line(exc)}")
             return
         self.statusBar().showMessage(f"dashboard at {url}", 10000)
-        QtCore.QTimer.singleShot(1500, lambda: webbrowser.open(url))
+        # Qt starts the browser detached: webbrowser.open left its child defunct (never reaped)
+        QtCore.QTimer.singleShot(1500, lambda: QtGui.QDesktopServices.openUrl(QtCore.QUrl(url)))
 
     def browse_storage(self) -> None:
         path, _ = QtWidgets.QFileDialog.getSaveFileName(
@@ -627,6 +643,7 @@ class MainWindow(QtWidgets.QMainWindow):
         s.setValue("view/persistence", int(self.top_view.persistence))
         s.setValue("view/trail_length", int(self.top_view.trail_length))
         s.setValue("tracker/model", self.params_model.model)
+        s.setValue("tracker/tracker", self.params_model.tracker)
         s.setValue("tracker/values", json.dumps(self.params_model.values))
         s.setValue("tracker/extra", json.dumps(self.params_model.extra))
         f = self.study_model.form
@@ -661,12 +678,13 @@ class MainWindow(QtWidgets.QMainWindow):
         except InputError:
             pass
         colour = s.value("view/colour_by", "snr", type=str)
-        self.top_view.set_colour_by(colour if colour in ("snr", "label") else "snr")
+        self.top_view.set_colour_by(colour)  # an unknown mode is SNR
         self.top_view.persistence = max(1, min(100, s.value("view/persistence", 5, type=int)))
         self.top_view.trail_length = max(1, min(1000, s.value("view/trail_length", 25, type=int)))
         self._sync_view_options()
         try:
             model = s.value("tracker/model", "cv", type=str)
+            self.params_model.set_tracker(s.value("tracker/tracker", "paper", type=str))
             values, extra = (stored_json(s, key) for key in JSON_SETTINGS)
             if values:
                 self.params_model.set_values(values, model=model)

@@ -6,7 +6,7 @@ File layout (``schema: "radartune-workspace"``, ``version: 1``)::
 
     {"schema": "radartune-workspace", "version": 1,
      "scene": {...scene document...}, "radar": {...RadarConfig...},
-     "tracker": {"model": "cv", "values": {...}, "extra": {...}},
+     "tracker": {"model": "cv", "values": {...}, "extra": {...}, "tracker": "paper"},
      "study": {"model": "cv", "n_trials": 50, "n_jobs": 1, "storage": "/abs/path.db", ...}}
 """
 
@@ -37,6 +37,8 @@ class Workspace:
     tracker_values: dict
     tracker_extra: dict
     study: StudyForm
+    #: the tracker the values are for: "paper", "room" or "gtrack" (absent in older files: paper)
+    tracker_kind: str = "paper"
 
     def to_dict(self) -> dict:
         scene = copy.deepcopy(self.scene)
@@ -50,6 +52,7 @@ class Workspace:
                 "model": self.tracker_model,
                 "values": dict(self.tracker_values),
                 "extra": dict(self.tracker_extra),
+                "tracker": self.tracker_kind,
             },
             "study": {name: getattr(self.study, name) for name in STUDY_FIELDS},
         }
@@ -94,12 +97,19 @@ def workspace_from_dict(doc, engine, source: str, base_dir: Path) -> Workspace:
         raise InputError(
             f"workspace field 'tracker.model' must be 'cv' or 'ca', got {model!r}", source
         )
+    kind = tracker.get("tracker", "paper")
+    if kind not in ("paper", "room", "gtrack"):
+        raise InputError(
+            f"workspace field 'tracker.tracker' must be 'paper', 'room' or 'gtrack', got {kind!r}",
+            source,
+        )
+    table, mode = ("gtrack", "paper") if kind == "gtrack" else (model, kind)
     values = tracker.get("values", {})
     extra = tracker.get("extra", {})
     for name, d in (("values", values), ("extra", extra)):
         if not isinstance(d, dict):
             raise InputError(f"workspace field 'tracker.{name}' must be an object", source)
-    full = engine.default_values(model)
+    full = engine.default_values(table, mode)
     for key, v in values.items():
         if key not in full:
             raise InputError(f"workspace field 'tracker.values.{key}': unknown parameter", source)
@@ -110,7 +120,7 @@ def workspace_from_dict(doc, engine, source: str, base_dir: Path) -> Workspace:
     if unknown:
         raise InputError(f"workspace field 'tracker.extra.{unknown[0]}': unknown setting", source)
     try:
-        engine.make_params(model, full, extra)
+        engine.make_params(table, full, extra, mode)
     except (InputError, TypeError, ValueError) as exc:
         msg = exc.message if isinstance(exc, InputError) else str(exc)
         raise InputError(f"workspace field 'tracker': {msg}", source) from None
@@ -135,6 +145,7 @@ def workspace_from_dict(doc, engine, source: str, base_dir: Path) -> Workspace:
         tracker_values=full,
         tracker_extra=dict(extra),
         study=study,
+        tracker_kind=kind,
     )
 
 

@@ -44,9 +44,11 @@ from app.engine.studies import (
 from app.engine.tracking import (
     EXTRA_FIELDS,
     TRACKER_COMPILED,
+    TRACKERS,
     default_extra,
     default_values,
     load_params,
+    load_tracker_file,
     make_params,
     param_specs,
     track,
@@ -82,6 +84,7 @@ class Engine:
     default_extra = staticmethod(default_extra)
     make_params = staticmethod(make_params)
     load_params = staticmethod(load_params)
+    load_tracker_file = staticmethod(load_tracker_file)
     simulate = staticmethod(simulate)
     fidelity_levels = staticmethod(fidelity_levels)
     processing_settings = staticmethod(processing_settings)
@@ -103,6 +106,7 @@ __all__ = [
     "PAPER_SCENE_FILE",
     "ROOT",
     "TRACKER_COMPILED",
+    "TRACKERS",
     "ClassParamSpec",
     "Dashboard",
     "Engine",
@@ -119,6 +123,7 @@ __all__ = [
     "fidelity_levels",
     "frame_views",
     "load_params",
+    "load_tracker_file",
     "make_params",
     "paper_document",
     "param_specs",

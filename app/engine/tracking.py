@@ -7,6 +7,7 @@ import os
 import threading
 import time
 from collections.abc import Sequence
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -16,10 +17,14 @@ from core.errors import InputError
 
 #: Non-optimised TrackerParams fields the tracker panel edits.
 EXTRA_FIELDS = ("p_g", "confirm_threshold", "delete_threshold", "clutter_density")
+#: The trackers the app switches between: the paper's one-point IPDA, RadarTune's tracker for
+#: real rooms (:mod:`core.tracking.room`) and TI's people tracker rebuilt (gtrack).
+TRACKERS = ("paper", "room", "gtrack")
 
 
-def param_specs(model: str) -> list[ParamSpec]:
-    """Sliders: the search space of eq. (15) for ``model`` (bounds, log flags, labels from core)."""
+def param_specs(model: str, mode: str = "paper") -> list[ParamSpec]:
+    """Sliders: the search space of ``model`` in ``mode`` (``model="gtrack"``: gtrack's table;
+    bounds, log flags, labels from core)."""
     from core.tracking.space import search_space
 
     return [
@@ -32,7 +37,7 @@ def param_specs(model: str) -> list[ParamSpec]:
             unit=p.unit,
             title=f"{p.symbol} {p.meaning}",
         )
-        for p in search_space(model)
+        for p in search_space(model, mode)
     ]
 
 
@@ -42,11 +47,11 @@ def _tracker_params_class():
     return TrackerParams
 
 
-def default_values(model: str) -> dict[str, float]:
+def default_values(model: str, mode: str = "paper") -> dict[str, float]:
     """The table's defaults as flat search-space values (all inside the bounds)."""
     from core.tracking.space import defaults
 
-    return defaults(model)
+    return defaults(model, mode)
 
 
 def default_extra() -> dict:
@@ -54,12 +59,19 @@ def default_extra() -> dict:
     return {k: getattr(tp, k) for k in EXTRA_FIELDS}
 
 
-def make_params(model: str, values: dict[str, float], extra: dict | None = None):
-    """Flat values + fixed settings → core ``TrackerParams`` (validated; InputError if bad)."""
-    from core.tracking.space import tracker_params_dict
+def make_params(
+    model: str, values: dict[str, float], extra: dict | None = None, mode: str = "paper"
+):
+    """Flat values + fixed settings → core ``TrackerParams`` of ``mode`` (validated; InputError
+    if bad); ``model="gtrack"``: a ``GtrackParams`` (the fixed settings are the IPDA's, unused)."""
+    from core.tracking.space import GTRACK, tracker_params_dict
 
+    if model == GTRACK:
+        from core.tracking.gtrack import GtrackParams
+
+        return GtrackParams.from_dict(tracker_params_dict(values, GTRACK))
     return _tracker_params_class().from_dict(
-        {**tracker_params_dict(values, model), **(extra or {})}
+        {**tracker_params_dict(values, model, mode), **(extra or {})}
     )
 
 
@@ -77,10 +89,46 @@ def load_params(path: str | os.PathLike) -> tuple[str, dict[str, float], dict]:
     return d["model"], values, {k: d[k] for k in EXTRA_FIELDS}
 
 
+def load_tracker_file(path: str | os.PathLike) -> tuple[str, str, dict[str, float], dict]:
+    """A tracker parameter file of any of the app's trackers: (tracker, model, flat values,
+    fixed settings). A gtrack file (``GtrackParams`` JSON, recognised by
+    :func:`core.tracking.space.flat_params`) is ``("gtrack", "cv", values, {})``; a
+    ``TrackerParams`` file is ``(its mode, its model, ...)`` as :func:`load_params` reads it."""
+    from core.files import read_json
+    from core.tracking.space import GTRACK, flat_params, search_space
+
+    doc = read_json(Path(path), what="tracker parameters")
+    if isinstance(doc, dict) and "model" not in doc and "mode" not in doc:
+        try:
+            flat = flat_params(doc)
+        except InputError:
+            flat = {}
+        if set(flat) == {p.name for p in search_space(GTRACK)}:
+            from core.tracking.gtrack import GtrackParams
+
+            values = flat_params(GtrackParams.load(path).to_dict())  # validated, file named
+            return GTRACK, "cv", values, {}
+    model, values, extra = load_params(path)
+    return _tracker_params_class().load(path).mode, model, values, extra
+
+
 def _truth0(frames: Sequence[FrameData]) -> np.ndarray:
     return np.array(
         [f.truth_xy_m[0] if len(f.truth_xy_m) else (np.nan, np.nan) for f in frames], dtype=float
     ).reshape(-1, 2)
+
+
+def running_pair_rmse(error_p: np.ndarray, p: float) -> np.ndarray:
+    """Running position RMSE (m) over frames ``0..k`` of several persons, each scored against
+    the track GOSPA pairs with it (``error_p``: ``(N, P)`` ‖x̂ − x‖^p, NaN where unpaired, from
+    :func:`core.evaluation.people.frame_metrics`); NaN while no pair yet. With two people the
+    one scene estimate against person 0 read 2–5 m while each was tracked to 0.1 m."""
+    e2 = np.abs(np.asarray(error_p, dtype=float)) ** (2.0 / p)
+    ok = np.isfinite(e2)
+    total = np.cumsum(np.where(ok, e2, 0.0).sum(axis=1))
+    count = np.cumsum(ok.sum(axis=1))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.where(count > 0, np.sqrt(total / np.maximum(count, 1)), np.nan)
 
 
 def _people(frames: Sequence[FrameData], track_frames) -> Any:
@@ -136,23 +184,15 @@ def track(
     :data:`TRACKER_COMPILED` is set, so that a cold start shows tracks while numba compiles).
     """
     from core.evaluation import ospa_per_frame, running_trajectory_loss
-    from core.tracking import run_tracker
 
     t0 = time.perf_counter()
-    counts = np.array([len(f.cloud) for f in frames], dtype=np.int64)
-    z = (
-        np.concatenate([f.cloud.measurements() for f in frames])
-        if len(frames)
-        else np.zeros((0, 3))
-    )
-    f_off = np.concatenate(([0], np.cumsum(counts))).astype(np.int64)
-    res = run_tracker((z, f_off), params, frame_period_s, keep_tracks=True, engine=engine)
+    res, velocity_col = _run(frames, params, frame_period_s, engine)
     tfs, conf_list = [], []
     ids_l, t_l, xy_l, psi_l, conf_l = [], [], [], [], []
     for k, ft in enumerate(res.frames):
         xy = np.asarray(ft.state, dtype=float)[:, :2].reshape(-1, 2)
         confirmed = np.asarray(ft.confirmed, dtype=bool)
-        tfs.append(track_frame(ft))
+        tfs.append(track_frame(ft, velocity_col=velocity_col))
         conf_list.append(xy[confirmed])
         ids_l.append(np.asarray(ft.ids, dtype=np.int64))
         t_l.append(np.full(len(ft.ids), k, dtype=np.int64))
@@ -174,8 +214,11 @@ def track(
     est = np.where(has[:, None], np.asarray(res.estimate_xy, dtype=float), np.nan)
     truth0 = _truth0(frames)
     loss, rmse = running_trajectory_loss(est, has, truth0)
+    people = _people(frames, res.frames)
+    if people is not None and len(people.persons) > 1:
+        rmse = running_pair_rmse(people.frames.gospa_error2, people.frames.p)
     return TrackingResult(
-        people=_people(frames, res.frames),
+        people=people,
         frames=tuple(tfs),
         estimate_xy_m=est,
         truth_xy_m=truth0,
@@ -195,8 +238,114 @@ def track(
     )
 
 
-def track_frame(ft) -> TrackFrame:
-    """A core ``FrameTracks`` as the overlay and the track table draw it.
+#: the room and gtrack kernels compiled (or loaded from numba's cache) so far; until then
+#: :func:`track` runs their readable form (the same result) while a thread compiles them, so
+#: that a first switch shows tracks at once instead of after a compilation of a minute or two
+_COMPILED: set[str] = set()
+_WARMING: set[str] = set()
+_WARM_LOCK = threading.Lock()
+
+
+def _kernel_ready(kind: str, warm) -> bool:
+    """True once ``kind``'s compiled kernel is ready; else start ``warm()`` in a thread."""
+    with _WARM_LOCK:
+        if kind in _COMPILED:
+            return True
+        if kind not in _WARMING:
+            _WARMING.add(kind)
+
+            def run() -> None:
+                warm()
+                with _WARM_LOCK:
+                    _COMPILED.add(kind)
+
+            threading.Thread(target=run, name=f"warm-{kind}", daemon=True).start()
+    return False
+
+
+def _warm_points() -> tuple[np.ndarray, np.ndarray]:
+    """Two frames of one point ``[r, az, el, vr, snr]``: a problem small enough to compile on."""
+    pts = np.array([[3.0, 0.1, 0.0, 0.5, 100.0], [3.04, 0.1, 0.0, 0.5, 100.0]])
+    return pts, np.array([0, 1, 2], dtype=np.int64)
+
+
+def _warm_gtrack() -> None:
+    from core.tracking.gtrack import GtrackParams
+    from core.tracking.gtrack.compiled import run_gtrack_compiled
+
+    run_gtrack_compiled(*_warm_points(), GtrackParams())
+
+
+def _warm_room() -> None:
+    from core.tracking import TrackerParams
+    from core.tracking.room import room_points, run_room_tracker
+
+    p, off = _warm_points()
+    pts = room_points(p[:, 0], p[:, 1], p[:, 3], np.zeros(2), p[:, 0], np.zeros(2), p[:, 4])
+    run_room_tracker((pts, off), TrackerParams(mode="room"), 0.08, engine="numba")
+
+
+class _Run:
+    """What :func:`track` reads of a tracker's result (gtrack's has no estimate arrays)."""
+
+    def __init__(self, frames) -> None:
+        self.frames = frames
+        n = len(frames)
+        self.has_estimate = np.zeros(n, dtype=bool)
+        self.estimate_xy = np.full((n, 2), np.nan)
+        for k, ft in enumerate(frames):
+            if ft.estimate >= 0:
+                self.has_estimate[k] = True
+                self.estimate_xy[k] = np.asarray(ft.state, dtype=float)[ft.estimate, :2]
+
+
+def _run(frames: Sequence[FrameData], params, frame_period_s: float, engine: str):
+    """Run the tracker ``params`` belong to over the cached frames: (result, the first velocity
+    column of its state)."""
+    import dataclasses
+
+    from core.tracking import run_tracker
+    from core.tracking.gtrack import GtrackParams
+
+    counts = np.array([len(f.cloud) for f in frames], dtype=np.int64)
+    f_off = np.concatenate(([0], np.cumsum(counts))).astype(np.int64)
+    clouds = [f.cloud for f in frames]
+
+    def column(name: str) -> np.ndarray:
+        return np.concatenate([getattr(c, name) for c in clouds]) if clouds else np.zeros(0)
+
+    if isinstance(params, GtrackParams):
+        from core.limits import FRAME_PERIOD_RANGE_S
+
+        lo, hi = FRAME_PERIOD_RANGE_S
+        if lo <= frame_period_s <= hi:  # the cfg's trackingCfg frame period is the data's
+            params = dataclasses.replace(params, frame_period_s=frame_period_s)
+        points = np.column_stack(
+            [column("range_m"), column("azimuth_rad"), column("elevation_rad"),
+             column("radial_velocity_mps"), 10.0 ** (column("snr_db") / 10.0)]
+        ).reshape(-1, 5)  # fmt: skip
+        if engine == "numba" and _kernel_ready("gtrack", _warm_gtrack):
+            from core.tracking.gtrack.compiled import run_gtrack_compiled as run
+        else:
+            from core.tracking.gtrack import run_gtrack as run
+        return _Run(run(points, f_off, params).frames), params.dims
+    if getattr(params, "mode", "paper") == "room":
+        from core.tracking.room import room_points, run_room_tracker
+
+        pts = room_points(
+            *(column(n) for n in ("range_m", "azimuth_rad", "radial_velocity_mps", "x_m",
+                                  "y_m", "z_m", "snr_db"))
+        )  # fmt: skip
+        if engine == "numba" and not _kernel_ready("room", _warm_room):
+            engine = "numpy"
+        return run_room_tracker((pts, f_off), params, frame_period_s, engine=engine), 2
+    z = np.concatenate([c.measurements() for c in clouds]) if clouds else np.zeros((0, 3))
+    return run_tracker((z, f_off), params, frame_period_s, keep_tracks=True, engine=engine), 2
+
+
+def track_frame(ft, *, velocity_col: int = 2) -> TrackFrame:
+    """A core ``FrameTracks`` as the overlay and the track table draw it (the velocity is
+    ``state[:, velocity_col : velocity_col + 2]``: 2 for the IPDA's, 3 for 3-D gtrack's).
 
     ``n_associated`` and ``nis`` are taken when the tracker reports them (attributes of the same
     names, per track); otherwise −1 and NaN.
@@ -217,7 +366,7 @@ def track_frame(ft) -> TrackFrame:
         gate_shape_xy_m2=np.asarray(ft.gate_shape_xy, dtype=float).reshape(-1, 2, 2),
         psi=np.asarray(ft.psi, dtype=float),
         confirmed=np.asarray(ft.confirmed, dtype=bool),
-        velocity_xy_mps=state[:, 2:4],
+        velocity_xy_mps=state[:, velocity_col : velocity_col + 2],
         # sigma_x = sqrt(P_xx), sigma_y = sqrt(P_yy)
         sigma_xy_m=np.sqrt(np.maximum(cov[:, [0, 1], [0, 1]], 0.0)),
         birth_frame=np.asarray(ft.birth_frame, dtype=np.int64),

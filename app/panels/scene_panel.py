@@ -483,7 +483,7 @@ class ScenePanel(QtWidgets.QWidget):
                 desc = f"drawn, {len(t['waypoints'])} waypoints"
             else:
                 desc = "explicit profile"
-            self.person_list.addItem(f"person {k}: {desc}")
+            self.person_list.addItem(f"person {k + 1}: {desc}")
             swatch = QtGui.QPixmap(12, 12)
             swatch.fill(QtGui.QColor(*person_colour(k)))
             self.person_list.item(k).setIcon(QtGui.QIcon(swatch))

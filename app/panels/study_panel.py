@@ -12,6 +12,12 @@ from PySide6 import QtCore, QtWidgets
 from app.study import StudyModel, StudyProgress
 from core.errors import InputError
 
+#: what a study minimises (core/optimization/objective.py), said under its curve
+LOSS_TEXT = (
+    "minimises L_t: the mean over the data set's trajectories of each one's loss "
+    "L = MSE / N_c (m², the paper's eq. 13–14)"
+)
+
 
 class StudyPanel(QtWidgets.QWidget):
     start_requested = QtCore.Signal()
@@ -24,6 +30,7 @@ class StudyPanel(QtWidgets.QWidget):
 
     def __init__(self, model: StudyModel, parent=None) -> None:
         super().__init__(parent)
+        self.stopping = False
         self.setObjectName("studyPanel")
         self.model = model
         outer = QtWidgets.QVBoxLayout(self)
@@ -88,7 +95,7 @@ class StudyPanel(QtWidgets.QWidget):
 
         self.curve_plot = pg.PlotWidget()
         self.curve_plot.setObjectName("studyCurve")
-        self.curve_plot.setTitle("best loss so far")
+        self.curve_plot.setTitle("best L_t so far")
         self.curve_plot.setLabel("bottom", "wall-clock time", units="s")
         self.curve_plot.setLabel("left", "loss L_t [m²]")
         self.curve_plot.setLogMode(y=True)
@@ -100,6 +107,10 @@ class StudyPanel(QtWidgets.QWidget):
             pen=pg.mkPen((255, 140, 0), width=2), symbol="o", symbolSize=4, stepMode=None
         )
         outer.addWidget(self.curve_plot, 1)
+        self.loss_label = QtWidgets.QLabel(LOSS_TEXT)
+        self.loss_label.setObjectName("studyLoss")
+        self.loss_label.setWordWrap(True)
+        outer.addWidget(self.loss_label)
 
         self.table = QtWidgets.QTableWidget(0, 2)
         self.table.setObjectName("bestParams")
@@ -129,7 +140,7 @@ class StudyPanel(QtWidgets.QWidget):
         self.storage.editingFinished.connect(lambda: self._set(storage=self.storage.text().strip()))
         self.browse.clicked.connect(self.browse_requested)
         self.start_button.clicked.connect(self.start_requested)
-        self.stop_button.clicked.connect(self.stop_requested)
+        self.stop_button.clicked.connect(self._on_stop)
         self.apply_button.clicked.connect(self.apply_best_requested)
         self.enqueue_button.clicked.connect(self.enqueue_requested)
         self.dashboard_button.clicked.connect(self.dashboard_requested)
@@ -138,6 +149,11 @@ class StudyPanel(QtWidgets.QWidget):
         model.running_changed.connect(lambda _r: self.sync())
         self.sync()
         self.show_progress(model.progress)
+
+    def _on_stop(self) -> None:
+        self.stopping = True
+        self.sync()
+        self.stop_requested.emit()
 
     def _set(self, **changes) -> None:
         try:
@@ -163,7 +179,11 @@ class StudyPanel(QtWidgets.QWidget):
         for w in (self.model_combo, self.trials, self.jobs, self.dataset, self.storage):
             w.setEnabled(not running)
         self.start_button.setEnabled(not running)
-        self.stop_button.setEnabled(running)
+        if not running:
+            self.stopping = False
+        # while the workers finish their current trials: "Stopping …", not clickable again
+        self.stop_button.setEnabled(running and not self.stopping)
+        self.stop_button.setText("Stopping …" if self.stopping else "Stop")
         self.progress_bar.setMaximum(f.n_trials)
 
     def _decade_ticks(self, values: np.ndarray) -> None:
@@ -205,6 +225,9 @@ class StudyPanel(QtWidgets.QWidget):
                 self._decade_ticks(p.curve_best[ok])
         else:
             self.curve.setData([], [])
+            # no trial yet: two decades labelled, not the log axis' empty default (its labels
+            # ran into the title)
+            self._decade_ticks(np.array([1e-3, 1e-1]))
         items = sorted(p.best_params.items())
         self.table.setRowCount(len(items))
         for i, (k, v) in enumerate(items):

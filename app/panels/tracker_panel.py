@@ -1,5 +1,6 @@
-"""Tracker sliders: every TrackerParams field with its search-space range (log where the search
-space is logarithmic), the CV/CA switch, the non-optimised settings, reset and apply-best."""
+"""Tracker sliders: the tracker switch (the paper's IPDA, the room tracker, TI's gtrack), every
+parameter of the chosen tracker's search space with its range (log where the search space is
+logarithmic), the CV/CA switch, the non-optimised settings, reset and apply-best."""
 
 from __future__ import annotations
 
@@ -12,6 +13,15 @@ from app.models import TrackerParamsModel
 from core.errors import InputError
 
 SLIDER_STEPS = 1000
+
+#: The tracker switch: (key, text, the sliders' group title)
+TRACKER_CHOICES = (
+    ("paper", "paper (one-point IPDA)", "Optimised parameters (eq. 15 ranges)"),
+    ("room", "room mode (groups of points, static, ghosts)",
+     "Optimised parameters (eq. 15 ranges + the room tracker's)"),
+    ("gtrack", "gtrack (TI's people tracker)",
+     "gtrack's parameters (TI's defaults, RadarTune's ranges)"),
+)  # fmt: skip
 
 
 def to_slider(spec: ParamSpec, value: float) -> int:
@@ -122,6 +132,14 @@ class TrackerPanel(QtWidgets.QWidget):
         self.setObjectName("trackerPanel")
         self.model = model
         outer = QtWidgets.QVBoxLayout(self)
+        switch = QtWidgets.QHBoxLayout()
+        switch.addWidget(QtWidgets.QLabel("Tracker"))
+        self.tracker_combo = QtWidgets.QComboBox()
+        self.tracker_combo.setObjectName("trackerCombo")
+        for key, text, _title in TRACKER_CHOICES:
+            self.tracker_combo.addItem(text, key)
+        switch.addWidget(self.tracker_combo, 1)
+        outer.addLayout(switch)
         top = QtWidgets.QHBoxLayout()
         top.addWidget(QtWidgets.QLabel("Motion model"))
         self.model_combo = QtWidgets.QComboBox()
@@ -131,13 +149,15 @@ class TrackerPanel(QtWidgets.QWidget):
         top.addWidget(self.model_combo, 1)
         outer.addLayout(top)
 
-        group = QtWidgets.QGroupBox("Optimised parameters (eq. 15 ranges)")
+        group = QtWidgets.QGroupBox(TRACKER_CHOICES[0][2])
+        self.params_group = group
         self.grid = QtWidgets.QGridLayout(group)
         self.grid.setColumnStretch(1, 1)
         outer.addWidget(group)
         self.rows: dict[str, ParamRow] = {}
 
         other = QtWidgets.QGroupBox("Fixed settings")
+        self.fixed_group = other
         form = QtWidgets.QFormLayout(other)
         self.p_g = self._spin(0.5, 0.9999, 4, "p_g")
         self.confirm = self._spin(0.01, 1.0, 3, "confirm_threshold")
@@ -169,6 +189,7 @@ class TrackerPanel(QtWidgets.QWidget):
         outer.addStretch(1)
 
         self.model_combo.currentIndexChanged.connect(self._on_model_combo)
+        self.tracker_combo.currentIndexChanged.connect(self._on_tracker_combo)
         self.reset_button.clicked.connect(model.reset)
         self.apply_best_button.clicked.connect(self.apply_best_requested)
         for w in (self.p_g, self.confirm, self.delete, self.rho):
@@ -193,7 +214,14 @@ class TrackerPanel(QtWidgets.QWidget):
         self.rows = {}
         for k, spec in enumerate(self.model.specs()):
             self.rows[spec.name] = ParamRow(spec, self.model, self.grid, k, self.error.emit)
-        self._rows_model = self.model.model
+        self._rows_model = (self.model.tracker, self.model.model)
+
+    def _on_tracker_combo(self, index: int) -> None:
+        try:
+            self.model.set_tracker(self.tracker_combo.itemData(index))
+        except InputError as exc:
+            self.error.emit(str(exc))
+            self.sync()
 
     def _on_model_combo(self, index: int) -> None:
         try:
@@ -218,11 +246,20 @@ class TrackerPanel(QtWidgets.QWidget):
 
     def sync(self) -> None:
         """Model → widgets (signals blocked while syncing)."""
-        if self._rows_model != self.model.model:
+        if self._rows_model != (self.model.tracker, self.model.model):
             self._rebuild_rows()
-        self.model_combo.blockSignals(True)
-        self.model_combo.setCurrentIndex(0 if self.model.model == "cv" else 1)
-        self.model_combo.blockSignals(False)
+        tracker = self.model.tracker
+        for combo, index in (
+            (self.model_combo, 0 if self.model.model == "cv" else 1),
+            (self.tracker_combo, self.tracker_combo.findData(tracker)),
+        ):
+            combo.blockSignals(True)
+            combo.setCurrentIndex(index)
+            combo.blockSignals(False)
+        gtrack = tracker == "gtrack"  # its own motion model (3-D constant acceleration)
+        self.model_combo.setEnabled(not gtrack)
+        self.fixed_group.setVisible(not gtrack)  # the IPDA's ψ thresholds, P_G and ρ
+        self.params_group.setTitle(next(t for k, _x, t in TRACKER_CHOICES if k == tracker))
         for row in self.rows.values():
             row.sync()
         extra = self.model.extra_effective()

@@ -33,7 +33,7 @@ def people_rows(people: Any) -> list[list[str]]:
     for m in people.persons:
         rows.append(
             [
-                str(m.person),
+                str(m.person + 1),  # 1-based for users, as the scene panel
                 _num(m.loss * 1e3, ".4g"),
                 _num(m.rmse_m, ".3f"),
                 str(m.frames_present),

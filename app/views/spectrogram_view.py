@@ -52,7 +52,7 @@ class MicroDopplerView(pg.GraphicsLayoutWidget):
     def _set_title(self) -> None:
         c = hex_colour(person_colour(self.person))
         self.plot.setTitle(
-            f"Micro-Doppler at the range of <span style='color:{c}'>person {self.person}</span>"
+            f"Micro-Doppler at the range of <span style='color:{c}'>person {self.person + 1}</span>"
             " (dB)"
         )
 
@@ -96,7 +96,7 @@ class MicroDopplerView(pg.GraphicsLayoutWidget):
         shown = self._buffer[:, : self._filled]
         if not np.isfinite(shown).any():
             self.message.setText(
-                f"no range-Doppler maps, or person {self.person} is not in the scene"
+                f"no range-Doppler maps, or person {self.person + 1} is not in the scene"
             )
             self.message.show()
             self.image.clear()

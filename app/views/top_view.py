@@ -1,4 +1,6 @@
-"""Top view (x-y): AOI, ground-truth paths, point cloud with persistence, tracker overlay.
+"""Top view (x-y): AOI, the radar, ground-truth paths, point cloud with persistence (coloured by
+SNR, label, Doppler, height or TI's track association, with a colour bar), tracker overlay, TI's
+own tracks as a layer of their own, and the people count.
 
 All pyqtgraph items are created once in ``__init__`` and updated with ``setData``. Point and
 track colours come from pre-built brush palettes (per-point brush construction is ~8× slower).
@@ -10,7 +12,7 @@ from collections.abc import Sequence
 
 import numpy as np
 import pyqtgraph as pg
-from PySide6 import QtCore, QtGui
+from PySide6 import QtCore, QtGui, QtWidgets
 
 from app.colours import IDENTITY_PALETTE, LABEL_COLOURS, identity_colour, identity_index, label_key
 from app.data import FrameData, TrackFrame, TrackingResult
@@ -24,12 +26,38 @@ SNR_MIN_DB = 10.0
 SNR_MAX_DB = 50.0
 N_SNR_COLOURS = 32
 N_PSI_LEVELS = 11
+#: Fixed scales of the other colourings: Doppler (radial velocity, m/s, symmetric) and height z (m)
+DOPPLER_SPAN_MPS = 3.0
+HEIGHT_MIN_M, HEIGHT_MAX_M = -1.0, 2.5
+
+#: colour-by modes: key -> (title of the plot, colour map name or "" for categories, unit, span)
+COLOUR_MODES: dict[str, tuple[str, str, str, tuple[float, float]]] = {
+    "snr": ("SNR", "plasma", "dB", (SNR_MIN_DB, SNR_MAX_DB)),
+    "label": ("person / clutter / false alarm", "", "", (0.0, 1.0)),
+    "doppler": (
+        "Doppler (radial velocity)",
+        "CET-D1",
+        "m/s",
+        (-DOPPLER_SPAN_MPS, DOPPLER_SPAN_MPS),
+    ),  # noqa: E501
+    "height": ("height z", "viridis", "m", (HEIGHT_MIN_M, HEIGHT_MAX_M)),
+    "track": ("TI's track of each point (grey: none)", "", "", (0.0, 1.0)),
+}
+#: TI's tracks (the reference layer): magenta hollow diamonds, dashed trails (a colour of no
+#: track identity, no point colouring and no person)
+REFERENCE_RGB = (255, 60, 255)
 
 
-def _snr_palette() -> list[QtGui.QBrush]:
-    cmap = pg.colormap.get("plasma")
+def _snr_palette(name: str = "plasma") -> list[QtGui.QBrush]:
+    cmap = pg.colormap.get(name)
     colours = cmap.getLookupTable(0.0, 1.0, N_SNR_COLOURS, alpha=False)
     return [pg.mkBrush(int(r), int(g), int(b), 230) for r, g, b in colours]
+
+
+def _brush_array(brushes: list[QtGui.QBrush]) -> np.ndarray:
+    a = np.empty(len(brushes), dtype=object)
+    a[:] = brushes
+    return a
 
 
 def _psi_palette(rgb: tuple[int, int, int]) -> list[QtGui.QBrush]:
@@ -53,7 +81,7 @@ class TopView(pg.PlotWidget):
         self.setAspectLocked(True)
         self.setLabel("bottom", "x", units="m")
         self.setLabel("left", "y", units="m")
-        self.setTitle("Top view · points: SNR 10–50 dB")
+        self.setTitle("Top view · points: SNR")
         self.showGrid(x=True, y=True, alpha=0.2)
         # two columns, translucent: half the height over the plot
         self.addLegend(offset=(5, 5), colCount=2, brush=pg.mkBrush(0, 0, 0, 140))
@@ -61,6 +89,8 @@ class TopView(pg.PlotWidget):
         self._add_scene_items()
         self._add_track_items()
         self._labels: list[pg.TextItem] = []
+        self._add_reference_items()
+        self._add_colour_bar()
         self._stack_items()
         self.waypoint_line = self.plot(
             pen=pg.mkPen((255, 0, 255), width=1, style=QtCore.Qt.DashLine), symbol=None
@@ -70,7 +100,7 @@ class TopView(pg.PlotWidget):
         self.draw_mode = False
         self.scene().sigMouseClicked.connect(self._on_click)
 
-        self.colour_by = "snr"  # or "label"
+        self.colour_by = "snr"  # a key of COLOUR_MODES
         self.persistence = 5
         self.trail_length = 25
         self.n_draws = 0
@@ -80,6 +110,14 @@ class TopView(pg.PlotWidget):
         cache_axes(self.getPlotItem())
         # once the user pans or zooms, the view stays where they put it
         self.getPlotItem().vb.sigRangeChangedManually.connect(self._stop_auto_fit)
+        # the people count, large, in the top right corner (set_count)
+        self.count_label = QtWidgets.QLabel(self)
+        self.count_label.setObjectName("peopleCount")
+        self.count_label.setStyleSheet(
+            "background: rgba(0, 0, 0, 150); color: white; padding: 4px 8px; border-radius: 4px"
+        )
+        self.count_label.hide()
+        self.set_colour_by(self.colour_by)
 
     def _make_brushes(self) -> None:
         """Brushes made once: SNR colours, labels, identities by ψ."""
@@ -93,6 +131,16 @@ class TopView(pg.PlotWidget):
         ]
         # per identity (app.colours), opacity by ψ: [identity palette index][ψ level]
         self._identity_brushes = [_psi_palette(rgb) for rgb in IDENTITY_PALETTE]
+        # continuous colourings (colour map per mode) and TI's track ids (identity palette)
+        self._map_arrays = {
+            mode: _brush_array(_snr_palette(cmap))
+            for mode, (_t, cmap, _u, _s) in COLOUR_MODES.items()
+            if cmap and mode != "snr"
+        }
+        self._map_arrays["snr"] = self._snr_array
+        self._track_array = _brush_array(
+            [pg.mkBrush(*rgb, 230) for rgb in IDENTITY_PALETTE] + [pg.mkBrush(130, 130, 130, 160)]
+        )
 
     def _add_scene_items(self) -> None:
         """The scene: area outline, static reflectors, truth paths."""
@@ -116,6 +164,48 @@ class TopView(pg.PlotWidget):
         self._selected_person = 0
         self._n_persons = 0
         self._truth_brushes = [pg.mkPen(person_colour(k), width=1.5) for k in range(MAX_PERSONS)]
+
+    def _add_reference_items(self) -> None:
+        """TI's own tracks (a recording's reference layer), off until :meth:`set_reference`."""
+        pen = pg.mkPen(REFERENCE_RGB, width=3)
+        self.reference = pg.ScatterPlotItem(
+            symbol="d", size=20, pen=pen, brush=None, name="TI's tracks"
+        )
+        self.addItem(self.reference)
+        self.reference_trails = self.plot(
+            pen=pg.mkPen((*REFERENCE_RGB, 170), width=1.5, style=QtCore.Qt.DashLine),
+            connect="finite",
+        )
+        self._reference = None  # app.replay.ReferenceLayer
+        self._reference_sorted: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
+        self.show_reference = True
+        self._reference_labels: list[pg.TextItem] = []
+        self.legend_entry_visible("TI's tracks", False)
+
+    def legend_entry_visible(self, name: str, visible: bool) -> None:
+        """Show or hide one legend row by its name (items without data keep no row)."""
+        legend = self.getPlotItem().legend
+        for sample, label in legend.items:
+            if label.text == name:
+                sample.setVisible(visible)
+                label.setVisible(visible)
+        legend.updateSize()
+
+    def _add_colour_bar(self) -> None:
+        """The radar (a marker at the origin, boresight along y) and the points' colour bar."""
+        self.radar_marker = pg.ScatterPlotItem(
+            [0.0], [0.0], symbol="t1", size=16, pen=pg.mkPen("w", width=1),
+            brush=pg.mkBrush(40, 200, 255), name="radar",
+        )  # fmt: skip
+        self.addItem(self.radar_marker)
+        self.colour_bar = pg.ColorBarItem(
+            values=(SNR_MIN_DB, SNR_MAX_DB),
+            colorMap=pg.colormap.get("plasma"),
+            width=12,
+            interactive=False,
+        )
+        # the plot's own layout, right of the view box (where setImageItem(insert_in=) puts it)
+        self.getPlotItem().layout.addItem(self.colour_bar, 2, 5)
 
     def _add_track_items(self) -> None:
         """Points, trails, gates, truth now, tracks and the estimate."""
@@ -154,8 +244,9 @@ class TopView(pg.PlotWidget):
         """Drawing order: gates and tracks under the points, truth and estimate on top."""
         for z, item in enumerate(
             (self.aoi, self.room, self.truth_path, self.trails, self.gates_tentative,
-             self.gates_confirmed, self.tracks, self.reflectors, self.points, self.truth_now,
-             self.estimate)
+             self.gates_confirmed, self.tracks, self.reflectors, self.points,
+             self.reference_trails, self.reference, self.truth_now, self.estimate,
+             self.radar_marker)
         ):  # fmt: skip
             item.setZValue(z)
         for item in self.identity_trails:
@@ -178,6 +269,8 @@ class TopView(pg.PlotWidget):
         super().resizeEvent(event)
         if getattr(self, "_auto_fit", False):
             self.fit_aoi()
+        if hasattr(self, "count_label"):
+            self._place_count()
 
     def _stop_auto_fit(self, *_args) -> None:
         self._auto_fit = False
@@ -259,12 +352,18 @@ class TopView(pg.PlotWidget):
 
     # ---- per frame ----------------------------------------------------------------------------
     def set_colour_by(self, mode: str) -> None:
+        """Colour the points by ``mode`` (a key of :data:`COLOUR_MODES`); the colour bar shows
+        the scale of the continuous ones."""
+        if mode not in COLOUR_MODES:
+            mode = "snr"
         self.colour_by = mode
-        self.setTitle(
-            "Top view · points: SNR 10–50 dB"
-            if mode == "snr"
-            else "Top view · points: person / clutter / false alarm"
-        )
+        title, cmap, unit, span = COLOUR_MODES[mode]
+        self.setTitle(f"Top view · points: {title}")
+        self.colour_bar.setVisible(bool(cmap))
+        if cmap:
+            self.colour_bar.setColorMap(pg.colormap.get(cmap))
+            self.colour_bar.setLevels(span)
+            self.colour_bar.axis.setLabel(f"{title.split(' (')[0]} ({unit})")
         # legend of the label colours (app.colours), shown while points are coloured by label
         legend = self.getPlotItem().legend
         if not hasattr(self, "_label_samples"):
@@ -285,16 +384,25 @@ class TopView(pg.PlotWidget):
             c = f.cloud
             xs.append(c.x_m)
             ys.append(c.y_m)
-            if self.colour_by == "snr":
-                k = (c.snr_db - SNR_MIN_DB) / (SNR_MAX_DB - SNR_MIN_DB) * (N_SNR_COLOURS - 1)
+            mode = self.colour_by
+            if mode in self._map_arrays:
+                value = {"snr": c.snr_db, "doppler": c.radial_velocity_mps, "height": c.z_m}[mode]
+                lo, hi = COLOUR_MODES[mode][3]
+                k = (np.asarray(value, dtype=float) - lo) / (hi - lo) * (N_SNR_COLOURS - 1)
                 keys.append(np.clip(np.round(k), 0, N_SNR_COLOURS - 1).astype(int))
+            elif mode == "track":
+                pt = f.point_track
+                ids = np.full(len(c), -1) if pt is None else np.asarray(pt)
+                keys.append(np.where(ids >= 0, identity_index(np.maximum(ids, 0)), -1))
             else:
                 keys.append(np.asarray(c.source))
         if not xs:
             return np.zeros(0), np.zeros(0), np.zeros(0, dtype=object)
         x, y, key = np.concatenate(xs), np.concatenate(ys), np.concatenate(keys)
-        if self.colour_by == "snr":
-            brushes = self._snr_array[key]
+        if self.colour_by in self._map_arrays:
+            brushes = self._map_arrays[self.colour_by][key]
+        elif self.colour_by == "track":
+            brushes = self._track_array[key]  # -1: the last entry, grey
         else:
             # source >= 0 person, -1 clutter, -2 false alarm  ->  palette index 0, 1, 2
             brushes = self._label_array[label_key(key)]
@@ -329,6 +437,69 @@ class TopView(pg.PlotWidget):
             self._show_tracks(tracking.frames[index], tracking, index)
         else:
             self._show_tracks(TrackFrame.empty(), None, index)
+        self._show_reference(index)
+
+    # ---- TI's tracks (reference layer) ---------------------------------------------------------
+    def set_reference(self, layer) -> None:
+        """TI's own tracks of a recording (:class:`app.replay.ReferenceLayer`), None: none."""
+        self._reference = layer
+        if layer is not None and len(layer.track_id):
+            order = np.lexsort((layer.frame, layer.track_id))
+            self._reference_sorted = (layer.track_id[order], layer.frame[order], layer.xy_m[order])
+        else:
+            self._reference_sorted = None
+        self.legend_entry_visible("TI's tracks", self._reference_sorted is not None)
+        self._show_reference(-1)
+
+    @property
+    def has_reference(self) -> bool:
+        return self._reference_sorted is not None
+
+    def set_show_reference(self, on: bool) -> None:
+        self.show_reference = bool(on)
+
+    def _show_reference(self, index: int) -> None:
+        layer = self._reference
+        if layer is None or not self.show_reference or index < 0:
+            self.reference.setData([], [])
+            self.reference_trails.setData([], [])
+            for label in self._reference_labels:
+                label.hide()
+            return
+        ids, xy = layer.at(index)
+        self.reference.setData(xy[:, 0], xy[:, 1])
+        assert self._reference_sorted is not None
+        t = trails_polyline(*self._reference_sorted, index, self.trail_length, ids)
+        self.reference_trails.setData(t[:, 0], t[:, 1], connect="finite")
+        while len(self._reference_labels) < len(ids):
+            label = pg.TextItem(color=REFERENCE_RGB, anchor=(1, 0))
+            self.addItem(label)
+            self._reference_labels.append(label)
+        for k, label in enumerate(self._reference_labels):
+            if k < len(ids):
+                label.setText(f"TI {ids[k]}")
+                label.setPos(float(xy[k, 0]) - 0.1, float(xy[k, 1]) - 0.1)
+                label.show()
+            else:
+                label.hide()
+
+    # ---- people count --------------------------------------------------------------------------
+    def set_count(self, html: str | None) -> None:
+        """The people count, large, in the top right corner (``None`` hides it)."""
+        if not html:
+            self.count_label.hide()
+            return
+        if html == self.count_label.text() and self.count_label.isVisibleTo(self):
+            return  # unchanged: no re-layout on every draw
+        self.count_label.setText(html)
+        self.count_label.adjustSize()
+        self._place_count()
+        self.count_label.show()
+        self.count_label.raise_()
+
+    def _place_count(self) -> None:
+        w = self.count_label.sizeHint().width()
+        self.count_label.move(max(0, self.width() - w - 70), 30)
 
     def _show_tracks(self, tf: TrackFrame, tracking: TrackingResult | None, index: int) -> None:
         n = len(tf)
@@ -380,7 +551,8 @@ class TopView(pg.PlotWidget):
         for k, label in enumerate(self._labels):
             if k < n:
                 label.setColor(identity_colour(int(tf.track_id[k])))
-                label.setText(f"{tf.track_id[k]} ψ={tf.psi[k]:.2f}")
+                psi = tf.psi[k]  # NaN: a tracker without ψ (gtrack)
+                label.setText(f"{tf.track_id[k]}" + ("" if psi != psi else f" ψ={psi:.2f}"))
                 label.setPos(float(tf.xy_m[k, 0]) + 0.1, float(tf.xy_m[k, 1]) + 0.1)
                 label.show()
             else:

@@ -29,6 +29,11 @@ from pathlib import Path
 import numpy as np
 
 RECORDING = "pc3_iwr6843/pc3_2023-06-21-12-27-01.csv"
+#: The folder's other two files: the overhead AOP one carries TI's tracks, the 2021-12 one not.
+OTHER_RECORDINGS = (
+    "pc3_iwr6843/pc3Aop2021-04-07-23-52-34.csv",
+    "pc3_iwr6843/pc3_2021-12-19-21-25-28.csv",
+)
 
 
 def _resource_params():
@@ -118,23 +123,7 @@ def run(quick: bool = False) -> dict:
     step = float(np.min(vr[vr > 1e-6])) if np.any(vr > 1e-6) else 0.1
     period = float(rec.radar.frame_period_s)
     base, cfg_path = _resource_params()
-    readings = {
-        "sensor frame": replace(
-            base,
-            sensor_height_m=0.0,
-            sensor_azimuth_tilt_deg=0.0,
-            sensor_elevation_tilt_deg=0.0,
-            boundary_z_min_m=-3.0,
-            boundary_z_max_m=3.0,
-            static_z_min_m=-3.0,
-            static_z_max_m=3.0,
-            presence_z_min_m=-3.0,
-            presence_z_max_m=3.0,
-            frame_period_s=period,
-            radial_velocity_resolution_mps=step,
-        ),
-        "TI default": base,
-    }
+    readings = {"sensor frame": _sensor_frame(base, period, step), "TI default": base}
     out: dict = {
         "recording": str(path),
         "frames": int(rec.n_frames),
@@ -165,7 +154,56 @@ def run(quick: bool = False) -> dict:
             "lag_1": _compare(rec, res, 1),
             "lag_0": _compare(rec, res, 0),
         }
+    out["other_recordings"] = {name: _other(root / name, base) for name in OTHER_RECORDINGS}
     return out
+
+
+def _sensor_frame(base, period: float, step: float):
+    """The 'sensor frame' reading of TI's lines: no pose, the boxes' z limits [−3, 3] m, the
+    file's frame period and Doppler step."""
+    return replace(
+        base,
+        sensor_height_m=0.0,
+        sensor_azimuth_tilt_deg=0.0,
+        sensor_elevation_tilt_deg=0.0,
+        boundary_z_min_m=-3.0,
+        boundary_z_max_m=3.0,
+        static_z_min_m=-3.0,
+        static_z_max_m=3.0,
+        presence_z_min_m=-3.0,
+        presence_z_max_m=3.0,
+        frame_period_s=period,
+        radial_velocity_resolution_mps=step,
+    )
+
+
+def _other(path: Path, base) -> dict:
+    """One of the folder's other files: its size and, when it carries TI's tracks, the
+    'sensor frame' reading's agreement (same figures as the main file)."""
+    from core.recordings import read_recording
+    from core.tracking.gtrack.tracker import run_gtrack
+
+    if not path.is_file():
+        return {"missing": True}
+    rec = read_recording(path, fmt=None, cfg=None)
+    doc: dict = {
+        "frames": int(rec.n_frames),
+        "points": int(len(rec.cloud.range_m)),
+        "max_points_a_frame": int(np.max(rec.counts, initial=0)),
+        "ti_tracks": rec.ref_tracks is not None and rec.ref_point_track is not None,
+    }
+    if not doc["ti_tracks"]:
+        return doc
+    vr = np.abs(rec.cloud.radial_velocity_mps)
+    step = float(np.min(vr[vr > 1e-6])) if np.any(vr > 1e-6) else 0.1
+    params = _sensor_frame(base, float(rec.radar.frame_period_s), step)
+    off = np.concatenate(([0], np.cumsum(rec.counts))).astype(np.int64)
+    res = run_gtrack(_recording_points(rec), off, params)
+    ref = rec.ref_tracks
+    assert ref is not None
+    doc["ti_track_ids"] = sorted({int(i) for i in ref["track_id"]})
+    doc["sensor frame"] = {"lag_1": _compare(rec, res, 1)}
+    return doc
 
 
 def _recording_points(rec) -> np.ndarray:
@@ -195,5 +233,20 @@ def summary(result: dict) -> str:
                 else "n/a"
             )
             + f", unassigned by both {a['share_unassigned_both']:.0%}"
+        )
+    for name, o in result.get("other_recordings", {}).items():
+        if o.get("missing"):
+            lines.append(f"  {name}: not found")
+            continue
+        head = f"  {name}: {o['frames']} frames, {o['points']} points (at most "
+        head += f"{o['max_points_a_frame']} a frame)"
+        if not o["ti_tracks"]:
+            lines.append(head + "; no TI tracks: not compared")
+            continue
+        a = o["sensor frame"]["lag_1"]
+        lines.append(
+            head + f"; TI's track ids {o['ti_track_ids']}; sensor frame: same track count in "
+            f"{a['count_agreement']:.0%} of frames (TI {a['mean_tracks_ti']:.2f}, ours "
+            f"{a['mean_tracks_ours']:.2f} a frame)"
         )
     return "\n".join(lines)

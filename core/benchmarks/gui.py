@@ -6,7 +6,9 @@ and once under Xvfb with the real ``xcb`` platform when ``xvfb-run`` is installe
 to overlay drawn (median, ms; target ≤ 100 on the paper scene), playback redraws per second at
 4× and 8× (target ≥ 45), and the event loop's longest gap and gaps over 100 ms while a study runs
 (target: none over 100 ms), with an idle probe of the same run as reference; a live link at 20
-frames/s over the sensor emulator (target: last byte to drawn ≤ 50 ms median, no dropped frame).
+frames/s over the sensor emulator (target: last byte to drawn ≤ 50 ms median, no dropped frame);
+the 3-D view's redraws per second with 2 000 points (target ≥ 30; xcb only, offscreen has no
+OpenGL).
 """
 
 from __future__ import annotations
@@ -55,6 +57,7 @@ def run(quick: bool = False) -> dict:
         "study_gaps_over_100_ms": 0,
         "live_latency_median_ms": 50,
         "live_dropped_frames": 0,
+        "cloud3d_redraws_per_s": 30,
     }
     return result
 
@@ -74,6 +77,16 @@ def summary(result: dict) -> str:
             f"longest gap {st['max_gap_ms']} ms, {st['n_gaps_over_100_ms']} over 100 ms "
             f"(idle: longest {r['idle']['max_gap_ms']} ms)"
         )
+        c3 = r.get("cloud3d")
+        if c3:
+            lines.append(
+                f"{platform} 3-D view: {c3['not_run']}"
+                if "not_run" in c3
+                else f"{platform} 3-D view, {c3['points']} points, {c3['gl_px'][0]}x"
+                f"{c3['gl_px'][1]} px: {c3['snr_redraws_per_s']} redraws/s coloured by SNR "
+                f"({c3['snr_cpu_ms_per_redraw']} ms CPU each), {c3['track_redraws_per_s']} by "
+                f"track ({c3['track_cpu_ms_per_redraw']} ms CPU)"
+            )
         lv = r.get("live")
         if lv:
             lat = lv["latency_ms"]

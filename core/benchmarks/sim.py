@@ -417,8 +417,8 @@ def _fast_stage_profile(
         patches_kernel,
         slow_time_sequences,
     )
-    from core.simulation.gaussian import state_from
     from core.simulation.link import received_power_w, signal_amplitude_v
+    from core.simulation.rng_kernels import state_from
 
     n_f = len(frames)
     rngs = [np.random.default_rng(100 + i) for i in range(n_f)]

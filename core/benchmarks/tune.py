@@ -103,6 +103,8 @@ def _rates(storage: str, name: str) -> dict[str, Any]:
         "trials": counted(summaries),
         "pruned": sum(1 for t in done if t.state == "PRUNED"),
         "failed": sum(1 for t in summaries if t.state == "FAIL"),
+        # opened by a worker after the total was reached, closed at once (not a failure)
+        "surplus": sum(1 for t in summaries if t.state == "SURPLUS"),
         "steady_s": steady,
         "trials_per_s_steady": (len(done) - 1) / steady if steady > 0 else float("nan"),
         "best_loss": None if best is None else best.value,

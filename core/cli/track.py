@@ -10,7 +10,6 @@ from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
     from core.dataset import Dataset
-    from core.evaluation.counting import RecordingScores
     from core.tracking import DatasetEstimates
 
 
@@ -76,6 +75,7 @@ def run(args: argparse.Namespace) -> int:
 
     import numpy as np
 
+    from core.cli.track_scores import per_frame, scores_without_positions
     from core.dataset import Dataset
     from core.errors import InputError
     from core.evaluation import evaluate
@@ -90,12 +90,6 @@ def run(args: argparse.Namespace) -> int:
             raise InputError(
                 "--mode and --zones set RadarTune's tracker; gtrack takes its boxes from --cfg"
             )
-        if args.tracks or args.people is not None:
-            raise InputError(
-                "--tracks and --people are not yet available with --tracker gtrack "
-                "(radartune bench gtrack_ti compares gtrack with a recording's own tracks)"
-            )
-
         return run_track(args)
     if args.cfg:
         raise InputError("--cfg sets gtrack's tracker lines: use it with --tracker gtrack")
@@ -145,7 +139,7 @@ def run(args: argparse.Namespace) -> int:
     elapsed = time.perf_counter() - t0
     from core.formats.recording import has_truth
 
-    scores = _scores_without_positions(ds, est, args.people)
+    scores = scores_without_positions(ds, est, args.people)
     if not has_truth(ds):
         n_conf = int(np.sum(np.isfinite(est.confirmed_xy[..., 0]).any(axis=1)))
         print(
@@ -163,7 +157,7 @@ def run(args: argparse.Namespace) -> int:
                 "elapsed_s": elapsed,
                 "frames_with_confirmed_track": n_conf,
                 "truth": False,
-                **_per_frame(est),
+                **per_frame(est),
                 "without_positions": scores.to_dict(),
             }
             write_json_atomic(Path(args.out), doc)
@@ -189,33 +183,12 @@ def run(args: argparse.Namespace) -> int:
             "elapsed_s": elapsed,
             "startup_s": startup,
             **ev.to_dict(),
-            **_per_frame(est),
+            **per_frame(est),
             "without_positions": scores.to_dict(),
         }
         write_json_atomic(out, doc)
         print(f"written: {out}")
     return 0
-
-
-def _scores_without_positions(
-    ds: Dataset, est: DatasetEstimates, people: int | None
-) -> RecordingScores:
-    """Count, fragmentation and NIS of the run (:mod:`core.evaluation.counting`)."""
-    from core.evaluation.counting import recording_scores
-    from core.tracking.batch import dataset_frame_period_s
-
-    return recording_scores(ds, est, dataset_frame_period_s(ds), people=people)
-
-
-def _per_frame(est: DatasetEstimates) -> dict:
-    """The JSON's per-frame counts: global frame index, confirmed and tentative tracks."""
-    return {
-        "per_frame": {
-            "frame": est.frame_index.tolist(),
-            "confirmed": est.n_confirmed.tolist(),
-            "tentative": (est.n_tracks - est.n_confirmed).tolist(),
-        }
-    }
 
 
 def _write_tracks(path: str | None, ds: Dataset, est: DatasetEstimates) -> None:

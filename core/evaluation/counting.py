@@ -282,9 +282,15 @@ class RecordingScores:
 
 
 def recording_scores(
-    dataset: Dataset, estimates: Any, frame_period_s: float, *, people: int | None = None
+    dataset: Dataset,
+    estimates: Any,
+    frame_period_s: float,
+    *,
+    people: int | None = None,
+    nis_dof: int = NIS_DOF,
 ) -> RecordingScores:
-    """Count, fragmentation (with a head count) and NIS of a tracker run on ``dataset``."""
+    """Count, fragmentation (with a head count) and NIS of a tracker run on ``dataset``
+    (``nis_dof``: the measurement's dimension, 4 for gtrack's 3-D ``[r, az, el, vr]``)."""
     counts = head_counts(dataset, people)
     count = None
     source = ""
@@ -305,7 +311,7 @@ def recording_scores(
         )
     return RecordingScores(
         count=count,
-        nis=consistency_stat(nis_samples(estimates), NIS_DOF),
+        nis=consistency_stat(nis_samples(estimates), nis_dof),
         people=source,
         reference=reference_agreement(dataset, estimates),
     )

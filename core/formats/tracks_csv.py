@@ -12,9 +12,13 @@ within a frame:
 - ``track_id``: unique over the file. The tracker numbers the tracks of each run (trajectory)
   from 0 in order of birth; the ids of a run are offset past the largest id of the runs before
   it, so a sensor restart never reuses an id;
-- ``status``: ``tentative`` or ``confirmed``; ``existence``: the track's existence probability ψ;
+- ``status``: ``tentative`` or ``confirmed``; ``existence``: the track's existence probability ψ
+  (empty for a tracker without one: gtrack);
 - ``x_m, y_m, vx_mps, vy_mps``: the state after the frame's update, m and m/s;
-- ``z_m``: empty: the tracker works in the ground plane (x–y) and has no height;
+- ``z_m``: the track's height (m) where the tracker gives one: the room mode's mean z of the
+  track's latest group of points (empty when every point of the data set has z = 0, a chain
+  without elevation), gtrack's 3-D state's height; empty for the paper mode, which tracks in
+  the ground plane (x–y);
 - ``n_points``: the measurements inside the track's gate in this frame (those that took part in
   its update; 0 for a track born in the frame).
 
@@ -79,6 +83,8 @@ class TrackRows:
         (R,) int64 measurements gated in the frame.
     nis
         (R,) NIS of the frame's update (NaN when no measurement was gated or the track was born).
+    height_m
+        (R,) height of the track (m), NaN where none (the ``z_m`` column is then empty).
     """
 
     frame: np.ndarray
@@ -89,10 +95,14 @@ class TrackRows:
     existence: np.ndarray
     n_points: np.ndarray
     nis: np.ndarray
+    height_m: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         r = np.shape(self.frame)
-        for name in ("time_s", "track_id", "confirmed", "existence", "n_points", "nis"):
+        if self.height_m is None:
+            object.__setattr__(self, "height_m", np.full(r, np.nan))
+        names = ("time_s", "track_id", "confirmed", "existence", "n_points", "nis", "height_m")
+        for name in names:
             if np.shape(getattr(self, name)) != r:
                 raise ValueError(f"TrackRows.{name} must have shape {r} like frame")
         if np.shape(self.state) != (*r, 4):
@@ -119,6 +129,10 @@ def track_rows(dataset: Dataset, estimates: Any) -> TrackRows:
     rows, slots = np.nonzero(ids_all >= 0)  # frames in order, tracks in the tracker's order
     ids = ids_all[rows, slots]
     frame = np.asarray(estimates.frame_index, dtype=np.int64)[rows]
+    height = np.full(len(rows), np.nan)
+    h = getattr(estimates, "height_m", None)
+    if h is not None and np.any(np.asarray(dataset.z_m) != 0.0):
+        height = np.asarray(h, dtype=np.float64)[rows, slots]
     return TrackRows(
         frame=frame,
         time_s=np.asarray(dataset.truth_t_s, dtype=np.float64)[frame],
@@ -128,6 +142,7 @@ def track_rows(dataset: Dataset, estimates: Any) -> TrackRows:
         existence=rec.psi[rows, slots].astype(np.float64),
         n_points=np.maximum(rec.n_associated[rows, slots], 0).astype(np.int64),
         nis=rec.nis[rows, slots].astype(np.float64),
+        height_m=height,
     )
 
 
@@ -150,11 +165,15 @@ def format_tracks_csv(rows: TrackRows) -> str:
     """The CSV text of ``rows`` (header line first, ``\\n`` line ends)."""
     lines = [",".join(TRACKS_HEADER)]
     status = np.where(rows.confirmed, "confirmed", "tentative")
+    height = rows.height_m if rows.height_m is not None else np.full(len(rows), np.nan)
     for i in range(len(rows)):
         x, y, vx, vy = rows.state[i]
+        z = f"{height[i]:.4f}" if np.isfinite(height[i]) else ""
+        psi = rows.existence[i]
+        e = f"{psi:.6f}" if np.isfinite(psi) else ""
         lines.append(
             f"{rows.frame[i]},{rows.time_s[i]:.4f},{rows.track_id[i]},{status[i]},"
-            f"{x:.4f},{y:.4f},,{vx:.4f},{vy:.4f},{rows.existence[i]:.6f},{rows.n_points[i]}"
+            f"{x:.4f},{y:.4f},{z},{vx:.4f},{vy:.4f},{e},{rows.n_points[i]}"
         )
     return "\n".join(lines) + "\n"
 

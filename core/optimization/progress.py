@@ -23,7 +23,9 @@ class TrialSummary:
 
     ``params`` are the flat Optuna parameters (``q_coeff``, ``p0_00``, …); ``value`` is L_t in m²
     (the running mean at the pruning point for a PRUNED trial); ``duration_s`` is None while
-    RUNNING.
+    RUNNING. ``state`` is Optuna's state name, except ``"SURPLUS"`` for a trial a worker opened
+    after the total was reached and closed at once (stored as FAIL with ``surplus=True``, since
+    Optuna cannot delete a trial): it neither counts nor failed.
     """
 
     number: int
@@ -52,7 +54,7 @@ def _summary(t: Any) -> TrialSummary:
         value = iv[max(iv)] if iv else None
     return TrialSummary(
         number=t.number,
-        state=t.state.name,
+        state="SURPLUS" if t.state.name == "FAIL" and t.user_attrs.get("surplus") else t.state.name,
         value=None if value is None else float(value),
         params={k: float(v) for k, v in t.params.items()},
         duration_s=dur,

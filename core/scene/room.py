@@ -32,9 +32,10 @@ SENSOR_HEIGHT_RANGE_M = (0.0, 10.0)
 SENSOR_TILT_RANGE_DEG = (-90.0, 90.0)
 FURNITURE_SIZE_RANGE_M = (0.01, 20.0)
 FURNITURE_RCS_RANGE_DBSM = (-60.0, 60.0)
-#: A wall without ``reflection_db`` loses this much power at a bounce (a plastered wall at
-#: 60 GHz; docs/rooms.md).
-DEFAULT_REFLECTION_DB = -6.0
+#: A wall without ``reflection_db`` loses this much power at a bounce: the effective loss fitted
+#: to the ghost fraction of a real walking recording through the out-of-box chain
+#: (``radartune bench chain_calibration``; docs/decisions/rooms-02-fitted-wall-loss.md).
+DEFAULT_REFLECTION_DB = -33.0
 #: The scatterers a piece of furniture is made of: its top face's four corners and centre.
 N_FURNITURE_SCATTERERS = 5
 

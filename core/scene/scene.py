@@ -379,109 +379,128 @@ def _parse_radar(spec: Any, base_dir: Path) -> RadarConfig:
 def _parse_trajectory(
     spec: Any, where: str, scene_seed: int, index: int, aoi: AOI, dt: float
 ) -> Trajectory:
+    """A person's trajectory from its JSON: a class a-e, waypoints or an explicit profile."""
     if not isinstance(spec, dict):
         raise InputError(f"{where} must be a JSON object, got {type(spec).__name__}")
     if "class" in spec:
-        params = {k: v for k, v in spec.items() if k not in ("class", "seed")}
-        cls = spec["class"]
-        if not isinstance(cls, str) or cls not in TRAJECTORY_CLASSES:
-            raise InputError(
-                f"{where}.class: unknown trajectory class {cls!r}; "
-                f"expected one of {list(TRAJECTORY_CLASSES)}"
-            )
-        checked = validate_class_parameters(cls, params, where)
-        _check_frames(checked.get("duration_s", CLASS_MAX_DEFAULT_DURATION_S) / dt, where)
-        if "seed" in spec:
-            seed = _integer(spec["seed"], f"{where}.seed")
-        else:
-            seed = person_seed(scene_seed, index)
-        try:
-            return generate_trajectory(
-                cls, np.random.default_rng(seed), aoi=aoi, frame_period_s=dt, **params
-            )
-        except InputError as exc:
-            raise InputError(f"{where}: {exc.message}") from None
+        return _parse_class_trajectory(spec, where, scene_seed, index, aoi, dt)
     if "waypoints" in spec:
-        _check_keys(spec, ("waypoints",), where)
-        w = spec["waypoints"]
-        if not isinstance(w, list) or len(w) < 2:
-            raise InputError(f"{where}.waypoints must list at least 2 [x_m, y_m, speed_mps]")
-        if len(w) > MAX_FRAMES:
-            raise InputError(f"{where}.waypoints lists {len(w)} points, more than {MAX_FRAMES}")
-        rows, holds = [], []
-        for i, row in enumerate(w):
-            f = f"{where}.waypoints[{i}]"
-            if not isinstance(row, list) or len(row) not in (3, 4):
-                raise InputError(
-                    f"{f} must be [x_m, y_m, speed_mps] or a stop [x_m, y_m, 0, hold_s], "
-                    f"got {row!r}"
-                )
-            x, y = _number(row[0], f"{f}[0]"), _number(row[1], f"{f}[1]")
-            if len(row) == 4:
-                _number(row[2], f"{f}[2] (speed_mps of a stop)", 0.0, 0.0)
-                s, hold = 0.0, _number(row[3], f"{f}[3] (hold_s)", *WAYPOINT_HOLD_RANGE_S)
-            else:
-                s = _number(row[2], f"{f}[2] (speed_mps)", *WAYPOINT_SPEED_RANGE_MPS)
-                hold = 0.0
-            if not aoi.contains(np.array([x, y])):
-                raise InputError(f"{f}: point ({x}, {y}) lies outside the AOI")
-            rows.append((x, y, s))
-            holds.append(hold)
-        if all(s == 0 for _, _, s in rows):
-            raise InputError(f"{where}.waypoints: stops only; give some waypoint a speed")
-        # the stops walked at the slowest speed given: an upper bound of the walking time
-        slowest = min(s for _, _, s in rows if s > 0)
-        walk = [r if r[2] > 0 else (r[0], r[1], slowest) for r in rows]
-        _check_frames((waypoint_duration_s(np.array(walk)) + sum(holds)) / dt, where)
-        try:
-            if any(holds):
-                return stopping_waypoint_trajectory(
-                    np.array(rows), np.array(holds), frame_period_s=dt
-                )
-            return waypoint_trajectory(np.array(rows), frame_period_s=dt)
-        except InputError as exc:
-            raise InputError(f"{where}: {exc.message}") from None
+        return _parse_waypoint_trajectory(spec, where, aoi, dt)
     if "initial_position_m" in spec:
-        keys = ("initial_position_m", "initial_velocity_mps", "acceleration_mps2", "frames")
-        _check_keys(spec, keys, where)
-        for k in keys[:3]:
-            if k not in spec:
-                raise InputError(f"{where}: missing key {k!r}")
-        # components bounded so that the integrated walk stays finite (checked whole below)
-        bound = (-MAX_PERSON_DISTANCE_M, MAX_PERSON_DISTANCE_M)
-        p0 = _vector(spec["initial_position_m"], f"{where}.initial_position_m", *bound)
-        v0 = _vector(spec["initial_velocity_mps"], f"{where}.initial_velocity_mps", *bound)
-        acc = spec["acceleration_mps2"]
-        if isinstance(acc, list) and len(acc) > MAX_PROFILE_FRAMES:
-            raise InputError(
-                f"{where}.acceleration_mps2 lists {len(acc)} rows, more than {MAX_PROFILE_FRAMES}"
-            )
-        if isinstance(acc, list) and acc and isinstance(acc[0], list):
-            a = np.array(
-                [
-                    _vector(row, f"{where}.acceleration_mps2[{i}]", *bound)
-                    for i, row in enumerate(acc)
-                ]
-            )
-        else:
-            a = _vector(acc, f"{where}.acceleration_mps2", *bound)
-        frames = spec.get("frames")
-        if frames is not None:
-            frames = _integer(frames, f"{where}.frames", 1, MAX_PROFILE_FRAMES)
-        try:
-            return profile_trajectory(
-                initial_position_m=p0,
-                initial_velocity_mps=v0,
-                acceleration_mps2=a,
-                frames=frames,
-                frame_period_s=dt,
-            )
-        except InputError as exc:
-            raise InputError(f"{where}: {exc.message}") from None
+        return _parse_profile_trajectory(spec, where, dt)
     raise InputError(
         f"{where} needs 'class' (a-e), 'waypoints' or 'initial_position_m' "
         f"(explicit profile), got keys {sorted(spec)}"
     )
+
+
+def _parse_class_trajectory(
+    spec: dict, where: str, scene_seed: int, index: int, aoi: AOI, dt: float
+) -> Trajectory:
+    """``{"class": "a".."e", "seed"?, class parameters...}``: a random walk of that class."""
+    params = {k: v for k, v in spec.items() if k not in ("class", "seed")}
+    cls = spec["class"]
+    if not isinstance(cls, str) or cls not in TRAJECTORY_CLASSES:
+        raise InputError(
+            f"{where}.class: unknown trajectory class {cls!r}; "
+            f"expected one of {list(TRAJECTORY_CLASSES)}"
+        )
+    checked = validate_class_parameters(cls, params, where)
+    _check_frames(checked.get("duration_s", CLASS_MAX_DEFAULT_DURATION_S) / dt, where)
+    if "seed" in spec:
+        seed = _integer(spec["seed"], f"{where}.seed")
+    else:
+        seed = person_seed(scene_seed, index)
+    try:
+        return generate_trajectory(
+            cls, np.random.default_rng(seed), aoi=aoi, frame_period_s=dt, **params
+        )
+    except InputError as exc:
+        raise InputError(f"{where}: {exc.message}") from None
+
+
+def _parse_waypoint_row(row: Any, f: str, aoi: AOI) -> tuple[tuple[float, float, float], float]:
+    """One waypoint ``[x_m, y_m, speed_mps]`` or stop ``[x_m, y_m, 0, hold_s]``:
+    ``((x, y, speed), hold_s)``."""
+    if not isinstance(row, list) or len(row) not in (3, 4):
+        raise InputError(
+            f"{f} must be [x_m, y_m, speed_mps] or a stop [x_m, y_m, 0, hold_s], got {row!r}"
+        )
+    x, y = _number(row[0], f"{f}[0]"), _number(row[1], f"{f}[1]")
+    if len(row) == 4:
+        _number(row[2], f"{f}[2] (speed_mps of a stop)", 0.0, 0.0)
+        s, hold = 0.0, _number(row[3], f"{f}[3] (hold_s)", *WAYPOINT_HOLD_RANGE_S)
+    else:
+        s = _number(row[2], f"{f}[2] (speed_mps)", *WAYPOINT_SPEED_RANGE_MPS)
+        hold = 0.0
+    if not aoi.contains(np.array([x, y])):
+        raise InputError(f"{f}: point ({x}, {y}) lies outside the AOI")
+    return (x, y, s), hold
+
+
+def _parse_waypoint_trajectory(spec: dict, where: str, aoi: AOI, dt: float) -> Trajectory:
+    """``{"waypoints": [[x, y, speed] | [x, y, 0, hold_s], ...]}``: straight legs and stops."""
+    _check_keys(spec, ("waypoints",), where)
+    w = spec["waypoints"]
+    if not isinstance(w, list) or len(w) < 2:
+        raise InputError(f"{where}.waypoints must list at least 2 [x_m, y_m, speed_mps]")
+    if len(w) > MAX_FRAMES:
+        raise InputError(f"{where}.waypoints lists {len(w)} points, more than {MAX_FRAMES}")
+    rows, holds = [], []
+    for i, row in enumerate(w):
+        point, hold = _parse_waypoint_row(row, f"{where}.waypoints[{i}]", aoi)
+        rows.append(point)
+        holds.append(hold)
+    if all(s == 0 for _, _, s in rows):
+        raise InputError(f"{where}.waypoints: stops only; give some waypoint a speed")
+    # the stops walked at the slowest speed given: an upper bound of the walking time
+    slowest = min(s for _, _, s in rows if s > 0)
+    walk = [r if r[2] > 0 else (r[0], r[1], slowest) for r in rows]
+    _check_frames((waypoint_duration_s(np.array(walk)) + sum(holds)) / dt, where)
+    try:
+        if any(holds):
+            return stopping_waypoint_trajectory(np.array(rows), np.array(holds), frame_period_s=dt)
+        return waypoint_trajectory(np.array(rows), frame_period_s=dt)
+    except InputError as exc:
+        raise InputError(f"{where}: {exc.message}") from None
+
+
+def _parse_profile_trajectory(spec: dict, where: str, dt: float) -> Trajectory:
+    """``{"initial_position_m", "initial_velocity_mps", "acceleration_mps2", "frames"?}``: an
+    explicit acceleration profile (one vector, or one row per frame)."""
+    keys = ("initial_position_m", "initial_velocity_mps", "acceleration_mps2", "frames")
+    _check_keys(spec, keys, where)
+    for k in keys[:3]:
+        if k not in spec:
+            raise InputError(f"{where}: missing key {k!r}")
+    # components bounded so that the integrated walk stays finite (checked whole below)
+    bound = (-MAX_PERSON_DISTANCE_M, MAX_PERSON_DISTANCE_M)
+    p0 = _vector(spec["initial_position_m"], f"{where}.initial_position_m", *bound)
+    v0 = _vector(spec["initial_velocity_mps"], f"{where}.initial_velocity_mps", *bound)
+    acc = spec["acceleration_mps2"]
+    if isinstance(acc, list) and len(acc) > MAX_PROFILE_FRAMES:
+        raise InputError(
+            f"{where}.acceleration_mps2 lists {len(acc)} rows, more than {MAX_PROFILE_FRAMES}"
+        )
+    if isinstance(acc, list) and acc and isinstance(acc[0], list):
+        a = np.array(
+            [_vector(row, f"{where}.acceleration_mps2[{i}]", *bound) for i, row in enumerate(acc)]
+        )
+    else:
+        a = _vector(acc, f"{where}.acceleration_mps2", *bound)
+    frames = spec.get("frames")
+    if frames is not None:
+        frames = _integer(frames, f"{where}.frames", 1, MAX_PROFILE_FRAMES)
+    try:
+        return profile_trajectory(
+            initial_position_m=p0,
+            initial_velocity_mps=v0,
+            acceleration_mps2=a,
+            frames=frames,
+            frame_period_s=dt,
+        )
+    except InputError as exc:
+        raise InputError(f"{where}: {exc.message}") from None
 
 
 def _check_frames(n_frames: float, where: str) -> None:
@@ -499,6 +518,7 @@ def person_seed(scene_seed: int, index: int) -> int:
 
 
 def _parse_scene(data: Any, base_dir: Path) -> Scene:
+    """A scene from its JSON object, every field checked (the first fault names its field)."""
     _check_keys(data, SCENE_KEYS, "scene")
     if data.get("schema_version") != SCHEMA_VERSION:
         raise InputError(
@@ -514,16 +534,37 @@ def _parse_scene(data: Any, base_dir: Path) -> Scene:
         0,
         1,
     )
-    aoi_d = _check_keys(
-        data.get("aoi", {}), ("min_range_m", "max_range_m", "max_azimuth_deg"), "aoi"
+    aoi = _parse_aoi(data.get("aoi", {}), radar)
+    reflectors = _parse_static_reflectors(data.get("static_reflectors", []), radar)
+    room = parse_room(data) if any(k in data for k in ROOM_KEYS) else None
+    persons = _parse_persons(data.get("persons", []), seed, aoi, radar)
+    _check_scene_work(persons, reflectors, room, aoi, density, radar)
+    return Scene(
+        seed=seed,
+        radar=radar,
+        radar_spec=radar_spec,
+        clutter_density_per_m2=density,
+        aoi=aoi,
+        static_reflectors=tuple(reflectors),
+        persons=tuple(persons),
+        room=room,
     )
+
+
+def _parse_aoi(spec: Any, radar: RadarConfig) -> AOI:
+    """The area of interest, within the radar's maximum range."""
+    aoi_d = _check_keys(spec, ("min_range_m", "max_range_m", "max_azimuth_deg"), "aoi")
     aoi = AOI(**{k: _number(v, f"aoi.{k}") for k, v in aoi_d.items()})
     if aoi.max_range_m > radar.max_range_m:
         raise InputError(
             f"aoi.max_range_m={aoi.max_range_m} exceeds the radar's maximum range "
             f"{radar.max_range_m:.3f} m"
         )
-    refl = data.get("static_reflectors", [])
+    return aoi
+
+
+def _parse_static_reflectors(refl: Any, radar: RadarConfig) -> list[StaticReflector]:
+    """``static_reflectors``: points at a range the radar sees."""
     if not isinstance(refl, list):
         raise InputError("static_reflectors must be a list")
     if len(refl) > MAX_STATIC_REFLECTORS:
@@ -551,62 +592,86 @@ def _parse_scene(data: Any, base_dir: Path) -> Scene:
                 rcs_dbsm=_number(r.get("rcs_dbsm", 10.0), f"{where}.rcs_dbsm", *RCS_RANGE_DBSM),
             )
         )
-    room = parse_room(data) if any(k in data for k in ROOM_KEYS) else None
-    persons_d = data.get("persons", [])
+    return reflectors
+
+
+def _parse_persons(persons_d: Any, seed: int, aoi: AOI, radar: RadarConfig) -> list[Person]:
+    """``persons``: 1 to :data:`MAX_PERSONS`, each a trajectory and its body."""
     if not isinstance(persons_d, list):
         raise InputError("persons must be a list")
     if len(persons_d) > MAX_PERSONS:
         raise InputError(f"persons lists {len(persons_d)}, more than the limit {MAX_PERSONS}")
     if not persons_d:
         raise InputError(f"persons lists none; a scene holds 1 to {MAX_PERSONS} persons")
-    persons = []
-    for i, p in enumerate(persons_d):
-        where = f"persons[{i}]"
-        _check_keys(p, PERSON_KEYS, where)
-        if "trajectory" not in p:
-            raise InputError(f"{where}: missing key 'trajectory'")
-        traj = _parse_trajectory(
-            p["trajectory"], f"{where}.trajectory", seed, i, aoi, radar.frame_period_s
+    return [_parse_person(p, f"persons[{i}]", seed, i, aoi, radar) for i, p in enumerate(persons_d)]
+
+
+def _parse_person(
+    p: Any, where: str, seed: int, index: int, aoi: AOI, radar: RadarConfig
+) -> Person:
+    """One person: the trajectory (kept in the radar's reach) and the optional body fields."""
+    _check_keys(p, PERSON_KEYS, where)
+    if "trajectory" not in p:
+        raise InputError(f"{where}: missing key 'trajectory'")
+    traj = _parse_trajectory(
+        p["trajectory"], f"{where}.trajectory", seed, index, aoi, radar.frame_period_s
+    )
+    _check_person_distance(traj, where)
+    rcs = p.get("rcs_dbsm")
+    if rcs is not None:
+        rcs = _number(rcs, f"{where}.rcs_dbsm", *RCS_RANGE_DBSM)
+    model = p.get("model", "point")
+    try:
+        person_model_kind(model)
+    except InputError as exc:
+        raise InputError(f"{where}.{exc.message}") from None
+    height = p.get("height_m")
+    if height is not None:
+        height = _number(height, f"{where}.height_m", *PERSON_HEIGHT_RANGE_M)
+    phase = p.get("gait_phase")
+    if phase is not None:
+        phase = _number(phase, f"{where}.gait_phase", 0.0, 1.0)
+    try:
+        return Person(
+            trajectory=traj,
+            rcs_dbsm=rcs,
+            model=model,
+            height_m=height,
+            gait_phase=phase,
+            spec=dict(p["trajectory"]),
         )
-        r = np.hypot(*traj.position_m.T)
-        r_min = float(r.min())
-        if not r.max() <= MAX_PERSON_DISTANCE_M:
-            far = int(np.argmax(~(r <= MAX_PERSON_DISTANCE_M)))
-            raise InputError(
-                f"{where}.trajectory is {r[far]:.3g} m from the radar at frame {far} "
-                f"(at most {MAX_PERSON_DISTANCE_M:g} m)"
-            )
-        if r_min < MIN_SCATTERER_RANGE_M:
-            raise InputError(
-                f"{where}.trajectory passes within {r_min:.3g} m of the radar "
-                f"(at least {MIN_SCATTERER_RANGE_M} m)"
-            )
-        rcs = p.get("rcs_dbsm")
-        if rcs is not None:
-            rcs = _number(rcs, f"{where}.rcs_dbsm", *RCS_RANGE_DBSM)
-        model = p.get("model", "point")
-        try:
-            person_model_kind(model)
-        except InputError as exc:
-            raise InputError(f"{where}.{exc.message}") from None
-        height = p.get("height_m")
-        if height is not None:
-            height = _number(height, f"{where}.height_m", *PERSON_HEIGHT_RANGE_M)
-        phase = p.get("gait_phase")
-        if phase is not None:
-            phase = _number(phase, f"{where}.gait_phase", 0.0, 1.0)
-        try:
-            person = Person(
-                trajectory=traj,
-                rcs_dbsm=rcs,
-                model=model,
-                height_m=height,
-                gait_phase=phase,
-                spec=dict(p["trajectory"]),
-            )
-        except InputError as exc:
-            raise InputError(f"{where}: {exc.message}") from None
-        persons.append(person)
+    except InputError as exc:
+        raise InputError(f"{where}: {exc.message}") from None
+
+
+def _check_person_distance(traj: Trajectory, where: str) -> None:
+    """Refuse a walk that leaves :data:`MAX_PERSON_DISTANCE_M` or comes closer than
+    :data:`MIN_SCATTERER_RANGE_M` to the radar."""
+    r = np.hypot(*traj.position_m.T)
+    r_min = float(r.min())
+    if not r.max() <= MAX_PERSON_DISTANCE_M:
+        far = int(np.argmax(~(r <= MAX_PERSON_DISTANCE_M)))
+        raise InputError(
+            f"{where}.trajectory is {r[far]:.3g} m from the radar at frame {far} "
+            f"(at most {MAX_PERSON_DISTANCE_M:g} m)"
+        )
+    if r_min < MIN_SCATTERER_RANGE_M:
+        raise InputError(
+            f"{where}.trajectory passes within {r_min:.3g} m of the radar "
+            f"(at least {MIN_SCATTERER_RANGE_M} m)"
+        )
+
+
+def _check_scene_work(
+    persons: list[Person],
+    reflectors: list[StaticReflector],
+    room: Room | None,
+    aoi: AOI,
+    density: float,
+    radar: RadarConfig,
+) -> None:
+    """Refuse a scene whose simulation would exceed one scene's work (frames x persons,
+    frames x scatterers, frames x radar cube)."""
     n_frames = max((p.trajectory.n_frames for p in persons), default=1)
     if len(persons) * n_frames > MAX_PERSON_FRAMES:
         raise InputError(
@@ -631,16 +696,6 @@ def _parse_scene(data: Any, base_dir: Path) -> Scene:
             f"frames x radar cube = {n_frames} x {cube} samples exceeds the limit "
             f"{MAX_SIMULATED_SAMPLES:.3g} of one scene's work"
         )
-    return Scene(
-        seed=seed,
-        radar=radar,
-        radar_spec=radar_spec,
-        clutter_density_per_m2=density,
-        aoi=aoi,
-        static_reflectors=tuple(reflectors),
-        persons=tuple(persons),
-        room=room,
-    )
 
 
 def class_scene(

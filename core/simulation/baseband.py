@@ -119,6 +119,74 @@ def signal_parameters(radar: RadarConfig, scatterers: Scatterers, antenna: Anten
     )
 
 
+#: Tolerance of :func:`coincident_tones`: ranges (m) and radial velocities (m/s) that differ by
+#: less are one tone. 1e-12 m is 2.5e-8 rad of carrier phase at 60 GHz, below complex64's
+#: resolution (6e-8), so merging two such scatterers changes the cube by rounding only.
+COINCIDENT_TOL = 1e-12
+
+
+def coincident_tones(position_m: np.ndarray, velocity_mps: np.ndarray, group=None) -> np.ndarray:
+    """``(N,)`` for each scatterer the first scatterer (in index order) whose tone it shares.
+
+    Two scatterers that move radially (``v`` parallel to ``p``) with the same range ``r`` and
+    radial velocity ``v_r`` have the same range at every chirp, ``|p + v t| = |r + v_r t|``,
+    hence the same beat tone and slow-time phase: they differ only in their channel weights
+    ``A a[v]``, which add, ``sum_i A_i a_i[v]``. A wall ghost's two contributions (out by the
+    wall and back directly, and the reverse; likewise the two second-order orders) are such a
+    pair (docs/rooms.md#speed). ``group`` ``(N,)`` (e.g. the frame): only scatterers of the same
+    group merge. A scatterer that shares nothing is its own first.
+    """
+    pos = np.asarray(position_m, dtype=np.float64).reshape(-1, 3)
+    vel = np.asarray(velocity_mps, dtype=np.float64).reshape(-1, 3)
+    n = len(pos)
+    first = np.arange(n, dtype=np.int64)
+    if n < 2:
+        return first
+    r = np.linalg.norm(pos, axis=1)
+    vr = np.einsum("ij,ij->i", pos, vel) / r
+    tangential = np.linalg.norm(vel - (vr / r)[:, None] * pos, axis=1)
+    radial = np.flatnonzero(tangential <= COINCIDENT_TOL)
+    if len(radial) < 2:
+        return first
+    g = np.zeros(n, dtype=np.int64) if group is None else np.asarray(group, dtype=np.int64)
+    # sorted by group, range, radial velocity: a tone's members are neighbours
+    order = radial[np.lexsort((vr[radial], r[radial], g[radial]))]
+    same = (
+        (g[order[1:]] == g[order[:-1]])
+        & (np.abs(r[order[1:]] - r[order[:-1]]) <= COINCIDENT_TOL)
+        & (np.abs(vr[order[1:]] - vr[order[:-1]]) <= COINCIDENT_TOL)
+    )
+    if not same.any():
+        return first
+    run = np.concatenate(([0], np.cumsum(~same)))  # run id along the sorted order
+    lowest = np.full(run[-1] + 1, n, dtype=np.int64)
+    np.minimum.at(lowest, run, order)
+    first[order] = lowest[run]
+    return first
+
+
+def merge_tones(first: np.ndarray, amp: np.ndarray, steer: np.ndarray):
+    """Scatterers that share a tone (:func:`coincident_tones`) as one: ``(keep, amp, steer)``.
+
+    ``keep`` ``(M,)``: the scatterers kept (each tone's first, in index order). A merged tone
+    gets the channel weights ``W[v] = sum_i A_i a_i[v]`` (members in index order) as
+    ``amp = max_v |W[v]|`` and ``steer = W / amp`` (``|steer[v]| <= 1``, so a level's per-channel
+    power bound ``amp^2`` still holds); a scatterer alone keeps its own ``amp`` and ``steer``.
+    """
+    n = len(first)
+    keep = np.flatnonzero(first == np.arange(n))
+    if len(keep) == n:
+        return keep, amp, steer
+    w = np.zeros((n, steer.shape[1]), dtype=np.complex128)
+    np.add.at(w, first, amp[:, None] * steer)
+    w = w[keep]
+    alone = np.bincount(first, minlength=n)[keep] == 1
+    big = np.max(np.abs(w), axis=1)
+    amp_k = np.where(alone, amp[keep], big)
+    steer_k = np.where(alone[:, None], steer[keep], w / np.where(big > 0, big, 1.0)[:, None])
+    return keep, amp_k, steer_k
+
+
 def visible(radar: RadarConfig, scatterers: Scatterers) -> np.ndarray:
     """``(N,)`` bool: in front of the antennas (|az| < 90 deg, the domain of eq. 1) and closer
     than the maximum range (the IF filter; beyond it complex sampling would alias the range)."""
@@ -128,7 +196,8 @@ def visible(radar: RadarConfig, scatterers: Scatterers) -> np.ndarray:
 def synthesize_signal(radar: RadarConfig, scatterers: Scatterers, antenna: AntennaGain):
     """Noise-free baseband cube ``[virtual channel, loop, ADC sample]``, complex64, volts.
 
-    Only :func:`visible` scatterers contribute.
+    Only :func:`visible` scatterers contribute; scatterers that share a tone
+    (:func:`coincident_tones`) are generated as one (:func:`merge_tones`).
     """
     out = np.zeros((radar.n_virtual, radar.n_loops, radar.n_samples), dtype=np.complex64)
     if len(scatterers) == 0:
@@ -143,7 +212,23 @@ def synthesize_signal(radar: RadarConfig, scatterers: Scatterers, antenna: Anten
         )
         if len(scatterers) == 0:
             return out
-    amp, ranges, steer = signal_parameters(radar, scatterers, antenna)
+    power = received_power_w(
+        radar, scatterers.range_m, scatterers.azimuth_rad, scatterers.rcs_dbsm, antenna
+    )
+    # a tone shared by several scatterers (a wall ghost's two contributions) is generated once
+    keep, amp, steer = merge_tones(
+        coincident_tones(scatterers.position_m, scatterers.velocity_mps),
+        signal_amplitude_v(radar, power),
+        steering_vectors(radar, scatterers),
+    )
+    if len(keep) < len(scatterers):
+        scatterers = Scatterers(
+            position_m=scatterers.position_m[keep],
+            velocity_mps=scatterers.velocity_mps[keep],
+            rcs_dbsm=scatterers.rcs_dbsm[keep],
+            source=scatterers.source[keep],
+        )
+    ranges = chirp_ranges_m(radar, scatterers)
     # phase 4 pi R / lambda;  beat phase per sample 2 pi (2 S R / c) / Fs
     phase_per_m = 4 * np.pi / radar.wavelength_m
     beat_per_m = TWO_PI * 2 * radar.slope_hz_per_s / (SPEED_OF_LIGHT_MPS * radar.sample_rate_hz)

@@ -35,6 +35,10 @@ from the exact conditional law given those draws (:func:`detected_channels`). Th
 angle, SNR and labelling stages as the
 exact chain then run unchanged.
 
+Scatterers of a frame that share a tone (the same range at every chirp: a wall ghost's two
+contributions) are one term with their channel weights summed (:func:`tones`), as the exact
+level synthesises them (:func:`core.simulation.baseband.coincident_tones`).
+
 Entry points: :func:`simulate_frame_fast` (one frame, the GUI's) and
 :func:`simulate_frames_fast` (all frames of a trajectory, the data-set path: per-scatterer inputs
 computed once, then one compiled call for every frame's noise map, patches, CFAR, detected
@@ -105,7 +109,7 @@ from core.processing.points import (
     points_kernel,
 )
 from core.simulation.antenna import AntennaGain
-from core.simulation.baseband import steering_vectors
+from core.simulation.baseband import coincident_tones, merge_tones, steering_vectors
 from core.simulation.fast_cfar import cfar_arguments, cfar_range_bins
 from core.simulation.fast_model import (
     PATCH_THRESHOLD,
@@ -198,24 +202,51 @@ def fast_spectrum(
         return Spectrum(
             rd, np.zeros((0, 2), dtype=np.int64), np.zeros((0, n_v), complex), e, e, state
         )
+    amp, theta, slow, slow1, steer, _ = tones(radar, scatterers, antenna, settings)
+    k_idx, d_idx, x, along, ortho = patches_kernel(
+        state, rd, amp, theta, slow, slow1, spec.wd, spec.b, spec.s2, steer, spec.slot,
+        spec.threshold, spec.half_r, spec.tw_d, spec.env, noise, n_use,
+    )  # fmt: skip
+    return Spectrum(rd, np.column_stack((k_idx, d_idx)).astype(np.int64), x, along, ortho, state)
+
+
+def tones(
+    radar: RadarConfig,
+    scatterers: Scatterers,
+    antenna: AntennaGain,
+    settings: ProcessingSettings,
+    frame: np.ndarray | None = None,
+):
+    """The tones the patches are built from: ``(amp, theta, slow, slow1, steer, keep)``.
+
+    One per scatterer, except that scatterers of one frame (``frame`` ``(N,)``, default all
+    one) that share a tone (:func:`core.simulation.baseband.coincident_tones`: a wall ghost's
+    two contributions) are one, with their summed channel weights
+    (:func:`core.simulation.baseband.merge_tones`); ``keep`` ``(M,)`` the scatterers kept (each
+    tone's first). ``amp`` ``(M,)`` V, ``theta`` ``(M,)`` beat tone rad/sample at mid-frame,
+    ``slow``/``slow1`` :func:`slow_time_sequences`, ``steer`` ``(M, L)`` complex128.
+    """
     power = received_power_w(
         radar, scatterers.range_m, scatterers.azimuth_rad, scatterers.rcs_dbsm, antenna
     )
-    amp = signal_amplitude_v(radar, power)  # (N,)
-    r_mid = np.linalg.norm(
-        scatterers.position_m
-        + scatterers.velocity_mps * (0.5 * radar.n_loops * radar.n_tx * radar.chirp_period_s),
-        axis=1,
+    keep, amp, steer = merge_tones(
+        coincident_tones(scatterers.position_m, scatterers.velocity_mps, frame),
+        signal_amplitude_v(radar, power),
+        steering_vectors(radar, scatterers),
     )
+    if len(keep) < len(scatterers):
+        scatterers = Scatterers(
+            position_m=scatterers.position_m[keep],
+            velocity_mps=scatterers.velocity_mps[keep],
+            rcs_dbsm=scatterers.rcs_dbsm[keep],
+            source=scatterers.source[keep],
+        )
+    t_mid = 0.5 * radar.n_loops * radar.n_tx * radar.chirp_period_s
+    r_mid = np.linalg.norm(scatterers.position_m + scatterers.velocity_mps * t_mid, axis=1)
     # theta = 2 pi (2 S R / c) / Fs   (rad per sample)
     theta = beat_rad_per_sample_per_m(radar) * r_mid
     slow, slow1 = slow_time_sequences(radar, scatterers, settings)
-    k_idx, d_idx, x, along, ortho = patches_kernel(
-        state, rd, amp, theta, slow, slow1, spec.wd, spec.b, spec.s2,
-        steering_vectors(radar, scatterers), spec.slot, spec.threshold, spec.half_r, spec.tw_d,
-        spec.env, noise, n_use,
-    )  # fmt: skip
-    return Spectrum(rd, np.column_stack((k_idx, d_idx)).astype(np.int64), x, along, ortho, state)
+    return amp, theta, slow, slow1, np.ascontiguousarray(steer), keep
 
 
 def simulate_frame_fast(
@@ -608,11 +639,12 @@ def _grow(f64, i64, i32, need):  # pragma: no cover
 
 @numba.njit(cache=True, nogil=True)
 def _frames_kernel(
-    states, start, elev, maps, keep, amp, theta, slow, slow1, steer, pos, vel, source, noise,
-    spec, has_cfar, cfar, pts,
+    states, start, t_start, elev, maps, keep, amp, theta, slow, slow1, steer, pos, vel, source,
+    noise, spec, has_cfar, cfar, pts,
 ):  # fmt: skip  # pragma: no cover
     """Every frame: noise map, then :func:`_frame_kernel`; frame ``f`` draws from ``states[f]``
-    and has the reflectors ``start[f]:start[f+1]`` (arguments as there).
+    and has the reflectors ``start[f]:start[f+1]`` (``pos``, ``vel``, ``source``: labels) and
+    the tones ``t_start[f]:t_start[f+1]`` (``amp`` … ``steer``: patches; arguments as there).
 
     Returns ``(det (n, 2), f64 (n, 8), source (n,), counts (F,))`` concatenated in frame order.
     """
@@ -631,8 +663,9 @@ def _frames_kernel(
         else:
             rd[:] = 0.0
         i0, i1 = start[f], start[f + 1]
+        j0, j1 = t_start[f], t_start[f + 1]
         r, d, f64, src = _frame_kernel(
-            s, rd, amp[i0:i1], theta[i0:i1], slow[i0:i1], slow1[i0:i1], steer[i0:i1],
+            s, rd, amp[j0:j1], theta[j0:j1], slow[j0:j1], slow1[j0:j1], steer[j0:j1],
             pos[i0:i1], vel[i0:i1], source[i0:i1], elev[f], noise, spec, has_cfar, cfar, pts,
         )  # fmt: skip
         n = r.shape[0]
@@ -670,15 +703,11 @@ def _frames_fast(
     start = np.zeros(n_f + 1, dtype=np.int64)
     np.cumsum(counts, out=start[1:])
     every = Scatterers.concatenate(list(frames)) if start[-1] else Scatterers.empty()
-    # per scatterer, all frames at once: link budget, beat tone, slow time, steering
-    power = received_power_w(radar, every.range_m, every.azimuth_rad, every.rcs_dbsm, antenna)
-    amp = signal_amplitude_v(radar, power)  # (N,)
+    # per tone, all frames at once: link budget, beat tone, slow time, steering
+    frame = np.repeat(np.arange(n_f), counts)
+    amp, theta, slow, slow1, steer, kept = tones(radar, every, antenna, settings, frame)
+    t_start = np.searchsorted(kept, start)  # frame f's tones: t_start[f]:t_start[f + 1]
     t_mid = 0.5 * radar.n_loops * radar.n_tx * radar.chirp_period_s
-    r_mid = np.linalg.norm(every.position_m + every.velocity_mps * t_mid, axis=1)
-    # theta = 2 pi (2 S R / c) / Fs   (rad per sample)
-    theta = beat_rad_per_sample_per_m(radar) * r_mid
-    slow, slow1 = slow_time_sequences(radar, every, settings)
-    steer = np.ascontiguousarray(steering_vectors(radar, every))
     pos = np.ascontiguousarray(every.position_m, dtype=np.float64)
     vel = np.ascontiguousarray(every.velocity_mps, dtype=np.float64)
     source = np.ascontiguousarray(every.source, dtype=np.int32)
@@ -698,9 +727,10 @@ def _frames_fast(
         states[f, :4] = state_from(rngs[f] if noise else None)
     maps = np.empty((n_f if keep_rd_map else 1, n_r, n_d), dtype=np.float32)
     det, f64, src, n_out = _frames_kernel(
-        states, start, elev, maps, bool(keep_rd_map), amp, theta, slow, slow1, steer, pos, vel,
-        source, bool(noise), spectrum_tables(radar, settings, bool(keep_rd_map)), has_cfar,
-        cfar if has_cfar else _NO_CFAR, point_tables(radar, settings, bool(elev.any()), t_mid),
+        states, start, t_start, elev, maps, bool(keep_rd_map), amp, theta, slow, slow1, steer,
+        pos, vel, source, bool(noise), spectrum_tables(radar, settings, bool(keep_rd_map)),
+        has_cfar, cfar if has_cfar else _NO_CFAR,
+        point_tables(radar, settings, bool(elev.any()), t_mid),
     )  # fmt: skip
     pc = cloud_from_rows(f64, src)
     out = FramesOutput(point_cloud=pc, counts=n_out, detections=det)

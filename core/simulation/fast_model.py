@@ -14,9 +14,8 @@ import scipy.fft
 from core import jit_guard  # noqa: F401  (before any kernel compiles: see core/jit_guard.py)
 from core.config import SPEED_OF_LIGHT_MPS, ProcessingSettings, RadarConfig
 from core.processing import window
-from core.simulation.gaussian import FI, KI, WI
 from core.simulation.link import noise_power_v2
-from core.simulation.rng_kernels import gamma_f32_l, gamma_l, normal_l
+from core.simulation.rng_kernels import FI, KI, WI, gamma_f32_l, gamma_l, normal_l
 from core.simulation.scatterers import Scatterers
 
 #: Per-channel signal power, relative to the cell's noise power, above which a cell gets

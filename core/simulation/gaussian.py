@@ -1,4 +1,4 @@
-"""Compiled Gaussian noise: xoshiro256++ bits turned into normals by the ziggurat method.
+"""Compiled Gaussian receiver noise for the exact chain, with the range window in the same loop.
 
 The exact chain draws ``2 x 12 x 32 x 256 = 196 608`` normals per frame. NumPy's
 ``Generator.standard_normal`` spends most of that time calling the bit generator through a
@@ -6,20 +6,12 @@ function pointer; here the generator is compiled into the loop that also adds th
 signal and applies the range window, at about 5 ns a normal (measured: 1.0 ms for a frame's
 noise with the window, against 2.3 ms for NumPy's draws alone in the chain it replaced).
 
-- Bits: xoshiro256++ (Blackman & Vigna, "Scrambled linear pseudorandom number generators",
-  ACM TOMS 47(4), 2021) with a 256-bit state seeded from the caller's
-  ``numpy.random.Generator`` (four ``uint64`` words), so a seed still fixes every frame. Each
-  64-bit word is used as two 32-bit words, low half first (as NumPy's ``next_uint32`` does).
-- Normals: the 256-layer ziggurat of Marsaglia & Tsang (J. Stat. Softw. 5(8), 2000) in single
-  precision, as NumPy's ``random_standard_normal_f`` (``standard_normal(dtype=float32)``) does
-  it: 8 bits choose the layer, 1 the sign, 23 the abscissa; wedges by a uniform test against
-  the density; the tail beyond ``r = 3.6541528853610088`` by Marsaglia's exponential method.
-  Fed the same words it returns NumPy's numbers bit for bit (the tests check this against
-  ``Generator(PCG64)`` fed its own raw stream), so the distribution is NumPy's; only the source
-  of the bits differs.
-
-The state is a ``uint64`` array: ``[s0, s1, s2, s3, buffered high half, has-buffer flag]``; a
-longer array is a recorded stream for tests (``[0, 0, 0, 0, 0, 0, read position, words...]``).
+The draws are NumPy's single-precision ziggurat normals (``standard_normal(dtype=float32)``) on
+xoshiro256++ bits seeded from the caller's ``numpy.random.Generator``; the generator, the
+ziggurat tables and the rare tail and wedge draws are :mod:`core.simulation.rng_kernels`, the
+one module of the simulation's compiled random numbers. Fed the same words the normals are
+NumPy's bit for bit (tested), so the distribution is NumPy's; only the source of the bits
+differs.
 """
 
 from __future__ import annotations
@@ -28,143 +20,7 @@ import numba
 import numpy as np
 
 from core import jit_guard  # noqa: F401  (before any kernel compiles: see core/jit_guard.py)
-
-#: edge of the ziggurat's base strip (256 layers) and the area of every layer: the base strip's
-#: rectangle plus the tail, ``v = r f(r) + sqrt(pi / 2) erfc(r / sqrt 2)``, f(x) = exp(-x^2 / 2)
-ZIGGURAT_R = 3.6541528853610088
-ZIGGURAT_V = 0.004928673233974658
-_STATE_WORDS = 6
-
-
-def ziggurat_tables(
-    layers: int = 256, r: float = ZIGGURAT_R, v: float = ZIGGURAT_V, bits: int = 23
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Ziggurat tables for N(0, 1) (Marsaglia & Tsang 2000, ``zigset``).
-
-    Layer ``i`` spans ``[0, x_i]`` under ``f(x) = exp(-x^2 / 2)``; every layer (and the base
-    strip with its tail beyond ``r``) has area ``v``:
-    ``x_{i-1} = sqrt(-2 ln(v / x_i + f(x_i)))``. Abscissae are ``bits``-bit integers.
-
-    Returns
-    -------
-    ki : numpy.ndarray
-        ``(layers,)`` int64 acceptance limits (``|abscissa| < ki[i]`` is inside the rectangle).
-    wi, fi : numpy.ndarray
-        ``(layers,)`` float64 abscissa scale ``x_i / 2^bits`` and density at the layer edges.
-    """
-    scale = 2.0**bits
-    ki = np.zeros(layers, dtype=np.int64)
-    wi = np.zeros(layers)
-    fi = np.zeros(layers)
-    dn = tn = r
-    # q = v / f(r): the base strip's width in units of r
-    q = v / np.exp(-0.5 * dn * dn)
-    ki[0] = int((dn / q) * scale)
-    wi[0] = q / scale
-    wi[-1] = dn / scale
-    fi[0] = 1.0
-    fi[-1] = np.exp(-0.5 * dn * dn)
-    for i in range(layers - 2, 0, -1):
-        # x_i from x_{i+1}: the layers have equal area v
-        dn = np.sqrt(-2.0 * np.log(v / dn + np.exp(-0.5 * dn * dn)))
-        ki[i + 1] = int((dn / tn) * scale)
-        tn = dn
-        fi[i] = np.exp(-0.5 * dn * dn)
-        wi[i] = dn / scale
-    return ki, wi, fi
-
-
-def _single_precision_tables() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    ki, wi, fi = ziggurat_tables()
-    out = (ki.astype(np.uint32), wi.astype(np.float32), fi.astype(np.float32))
-    for a in out:
-        a.flags.writeable = False
-    return out
-
-
-#: the single-precision tables (23-bit abscissae), as NumPy's ``ki_float``/``wi_float``/``fi_float``
-KI, WI, FI = _single_precision_tables()
-
-_R_F = np.float32(ZIGGURAT_R)
-_INV_R_F = np.float32(1.0 / ZIGGURAT_R)
-_TWO_M24_F = np.float32(2.0**-24)
-
-
-@numba.njit(inline="always")
-def _rotl(x, k):  # pragma: no cover
-    return (x << np.uint64(k)) | (x >> np.uint64(64 - k))
-
-
-@numba.njit(inline="always")
-def xoshiro_step(s0, s1, s2, s3):  # pragma: no cover
-    """One xoshiro256++ step on a state held in four locals: ``(word, s0, s1, s2, s3)``."""
-    out = _rotl(s0 + s3, 23) + s0
-    t = s1 << np.uint64(17)
-    s2 ^= s0
-    s3 ^= s1
-    s1 ^= s2
-    s0 ^= s3
-    s2 ^= t
-    s3 = _rotl(s3, 45)
-    return out, s0, s1, s2, s3
-
-
-@numba.njit(inline="always")
-def xoshiro_next(s):  # pragma: no cover
-    """Next 64-bit word of xoshiro256++ with the state ``s[0:4]`` (updated in place)."""
-    out, s[0], s[1], s[2], s[3] = xoshiro_step(s[0], s[1], s[2], s[3])
-    return out
-
-
-@numba.njit(inline="always")
-def _next_u64(s):  # pragma: no cover
-    if s.size == _STATE_WORDS:
-        return xoshiro_next(s)
-    # a recorded stream: s[6] is the read position
-    i = s[6]
-    s[6] = i + np.uint64(1)
-    return s[i]
-
-
-@numba.njit(inline="always")
-def next_u32(s):  # pragma: no cover
-    """Next 32-bit word: the low half of a fresh 64-bit word, then its buffered high half."""
-    if s[5]:
-        s[5] = np.uint64(0)
-        return np.uint32(s[4])
-    w = _next_u64(s)
-    s[4] = w >> np.uint64(32)
-    s[5] = np.uint64(1)
-    return np.uint32(w & np.uint64(0xFFFFFFFF))
-
-
-@numba.njit(inline="always")
-def _next_float(s):  # pragma: no cover
-    # NumPy's next_float: the 24 high bits, in [0, 1)
-    return np.float32(next_u32(s) >> np.uint32(8)) * _TWO_M24_F
-
-
-@numba.njit(nogil=True)
-def slow_draw(s, idx, rabs, x, fi):  # pragma: no cover
-    """The 1.5 % of draws outside their layer's rectangle: the tail or the wedge test.
-
-    Returns the draw, or NaN when it is rejected (the caller starts afresh). Kept out of line:
-    inlined, it slows the common path several times over.
-    """
-    if idx == 0:
-        # tail beyond r (Marsaglia 1964): x = r + E1 / r, accepted when 2 E2 > (E1 / r)^2
-        while True:
-            xx = -_INV_R_F * np.log1p(-_next_float(s))
-            yy = -np.log1p(-_next_float(s))
-            if yy + yy > xx * xx:
-                if (rabs >> np.uint32(8)) & np.uint32(1):
-                    return -(_R_F + xx)
-                return _R_F + xx
-    # wedge: accepted under the density f(x) = exp(-x^2 / 2) (evaluated in double, as NumPy)
-    xd = np.float64(x)
-    if (fi[idx - 1] - fi[idx]) * _next_float(s) + fi[idx] < np.exp(-0.5 * xd * xd):
-        return x
-    return np.float32(np.nan)
+from core.simulation.rng_kernels import FI, KI, WI, next_u32, recorded_stream, seed_state, slow_draw
 
 
 @numba.njit(cache=True, nogil=True)
@@ -172,7 +28,7 @@ def _accumulate_normals(f, sigma, w, s, ki, wi, fi):  # pragma: no cover
     """``f[i, j] = (f[i, j] + sigma g) w[j]`` with ``g`` the next N(0, 1) draw, row by row.
 
     The ziggurat's common path is written out here, in the loop, on purpose (see
-    :func:`slow_draw`).
+    :func:`core.simulation.rng_kernels.slow_draw`).
     """
     n_rows, n = f.shape
     sig = np.float32(sigma)
@@ -196,27 +52,6 @@ def _accumulate_normals(f, sigma, w, s, ki, wi, fi):  # pragma: no cover
             row[j] = (row[j] + sig * x) * w[j]
 
 
-def state_from(rng: np.random.Generator | None) -> np.ndarray:
-    """A 256-bit xoshiro state ``(4,)`` uint64 from four raw 64-bit draws of ``rng``.
-
-    Never all zero. ``None`` gives a fixed state (noise-free frames). Every compiled sampler
-    (this module's, the ``fast`` and ``measurement`` levels') seeds a frame this way.
-    """
-    if rng is None:
-        return np.array([1, 2, 3, 4], dtype=np.uint64)
-    s = rng.bit_generator.random_raw(4)
-    if not s.any():
-        s[0] = 1
-    return s
-
-
-def seed_state(rng: np.random.Generator) -> np.ndarray:
-    """A generator state (uint64[6], no buffered half) seeded from ``rng`` (:func:`state_from`)."""
-    s = np.zeros(_STATE_WORDS, dtype=np.uint64)
-    s[:4] = state_from(rng)
-    return s
-
-
 def _normals(state: np.ndarray, n: int) -> np.ndarray:
     out = np.zeros((1, int(n)), dtype=np.float32)
     _accumulate_normals(out, 1.0, np.ones(int(n), dtype=np.float32), state, KI, WI, FI)
@@ -234,8 +69,7 @@ def normals_from_stream(words: np.ndarray, n: int) -> np.ndarray:
     The caller supplies enough words: two draws take one word, the rare rejections more
     (``0.55 n`` words are plenty).
     """
-    head = np.array([0, 0, 0, 0, 0, 0, _STATE_WORDS + 1], dtype=np.uint64)
-    return _normals(np.concatenate((head, np.asarray(words, dtype=np.uint64))), n)
+    return _normals(recorded_stream(words), n)
 
 
 def add_complex_noise(

@@ -86,9 +86,9 @@ from core.simulation.false_alarm_pool import chain_false_alarms
 from core.simulation.fast import FramesOutput
 from core.simulation.fast_model import cell_noise_power_v2, range_responses
 from core.simulation.frame import FrameOutput, needs_elevation
-from core.simulation.gaussian import state_from
 from core.simulation.link import receiver_voltage_scale
 from core.simulation.measurement_jit import measure_frames
+from core.simulation.rng_kernels import state_from
 from core.simulation.scatterers import Scatterers
 
 #: Tabulation steps: range and Doppler in fractions of a bin, azimuth in u = sin(az).

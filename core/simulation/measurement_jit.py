@@ -1,12 +1,10 @@
 """The ``measurement`` level's compiled kernel: steps 1-4 of :mod:`core.simulation.measurement`
-for any number of frames in one call (:func:`measure_frames`), with the xoshiro256** generator
-and the draws it needs (uniform, normal, gamma, Poisson, integer).
+for any number of frames in one call (:func:`measure_frames`).
 
 The Python side (tables, constants, false-alarm pool, entry points) is
-:mod:`core.simulation.measurement`; the argument tuples the kernel reads are defined there.
-The generator and the helpers stay in this file with the kernel: numba compiles them together,
-and its on-disk cache (``cache=True``) checks only the cached function's own source file for
-staleness.
+:mod:`core.simulation.measurement`; the argument tuples the kernel reads are defined there. The
+draws (xoshiro256**: uniform, Box-Muller normal, Gamma, Poisson, integer) are
+:mod:`core.simulation.rng_kernels`.
 """
 
 from __future__ import annotations
@@ -16,80 +14,9 @@ import numpy as np
 
 from core import jit_guard  # noqa: F401  (before any kernel compiles: see core/jit_guard.py)
 from core.processing.points import angles_of
+from core.simulation.rng_kernels import ss_gamma, ss_normal, ss_poisson, ss_randint, ss_uniform
 
 __all__ = ["measure_frames"]
-
-
-# ---- the compiled generator: xoshiro256** (Blackman & Vigna) and the draws the model needs ------
-
-
-@numba.njit(inline="always")
-def _rotl(x, k):  # pragma: no cover
-    return (x << np.uint64(k)) | (x >> np.uint64(64 - k))
-
-
-@numba.njit(cache=True, nogil=True)
-def _next_u64(s):  # pragma: no cover
-    """Next 64-bit output of xoshiro256** with state ``s`` (4,) uint64 (advanced in place)."""
-    result = _rotl(s[1] * np.uint64(5), 7) * np.uint64(9)
-    t = s[1] << np.uint64(17)
-    s[2] ^= s[0]
-    s[3] ^= s[1]
-    s[1] ^= s[2]
-    s[0] ^= s[3]
-    s[2] ^= t
-    s[3] = _rotl(s[3], 45)
-    return result
-
-
-@numba.njit(cache=True, nogil=True)
-def _uniform(s):  # pragma: no cover
-    """U[0, 1) with 53 random bits."""
-    return float(_next_u64(s) >> np.uint64(11)) * (1.0 / 9007199254740992.0)
-
-
-@numba.njit(cache=True, nogil=True)
-def _normal(s):  # pragma: no cover
-    """N(0, 1) by Box-Muller: sqrt(-2 ln u1) cos(2 pi u2), u1 in (0, 1]."""
-    u1 = 1.0 - _uniform(s)
-    return np.sqrt(-2.0 * np.log(u1)) * np.cos(2.0 * np.pi * _uniform(s))
-
-
-@numba.njit(cache=True, nogil=True)
-def _gamma(s, k):  # pragma: no cover
-    """Gamma(k, 1) by Marsaglia & Tsang (2000); k < 1 via Gamma(k + 1) U^(1/k)."""
-    if k < 1.0:
-        return _gamma(s, k + 1.0) * _uniform(s) ** (1.0 / k)
-    d = k - 1.0 / 3.0
-    c = 1.0 / np.sqrt(9.0 * d)
-    while True:
-        x = _normal(s)
-        v = 1.0 + c * x
-        if v <= 0.0:
-            continue
-        v = v * v * v
-        u = 1.0 - _uniform(s)
-        # accept when ln u < x^2/2 + d - d v + d ln v
-        if np.log(u) < 0.5 * x * x + d - d * v + d * np.log(v):
-            return d * v
-
-
-@numba.njit(cache=True, nogil=True)
-def _poisson(s, lam):  # pragma: no cover
-    """Poisson(lam) by multiplying uniforms (Knuth; the rates here are well below 1)."""
-    limit = np.exp(-lam)
-    k = 0
-    p = 1.0 - _uniform(s)
-    while p > limit:
-        k += 1
-        p *= 1.0 - _uniform(s)
-    return k
-
-
-@numba.njit(cache=True, nogil=True)
-def _randint(s, n):  # pragma: no cover
-    """Uniform integer in ``0 .. n-1`` (n >= 1; the bias of the modulo is below 2^-50)."""
-    return np.int64(_next_u64(s) % np.uint64(n))
 
 
 @numba.njit(cache=True, nogil=True)
@@ -105,8 +32,8 @@ def _lerp(table, x, x0, step):  # pragma: no cover
 @numba.njit(cache=True, nogil=True)
 def _training_sum(s, method, n_train, n_eff, L, leak_l, leak_r):  # pragma: no cover
     """CFAR noise estimate: each side ``(n / n_eff) Gamma(n_eff L)`` plus the own leakage."""
-    z1 = _gamma(s, n_eff * L) * (n_train / n_eff) + leak_l
-    z2 = _gamma(s, n_eff * L) * (n_train / n_eff) + leak_r
+    z1 = ss_gamma(s, n_eff * L) * (n_train / n_eff) + leak_l
+    z2 = ss_gamma(s, n_eff * L) * (n_train / n_eff) + leak_r
     if method == 0:
         # CA: (Z1 + Z2) / 2n
         return (z1 + z2) / (2 * n_train)
@@ -202,9 +129,9 @@ def measure_frames(
             s0 = pos[i, 2] / r0
             if noise:
                 # X = |sqrt(L rho) + n|^2 + Gamma(L - 1),  n ~ CN(0, 1)
-                a = np.sqrt(L * rho) + _normal(s) / np.sqrt(2.0)
-                b = _normal(s) / np.sqrt(2.0)
-                x = a * a + b * b + _gamma(s, L - 1.0)
+                a = np.sqrt(L * rho) + ss_normal(s) / np.sqrt(2.0)
+                b = ss_normal(s) / np.sqrt(2.0)
+                x = a * a + b * b + ss_gamma(s, L - 1.0)
                 # training cells: noise plus the reflector's own leakage (units of s2)
                 leak = L * amp2 / cell_noise[dc]
                 lr = leak * doppler_gain[jd]
@@ -219,8 +146,8 @@ def measure_frames(
                 snr = 10.0 * np.log10(x / mu_r)
                 # Cramer-Rao: var(bin) = 6 / (4 pi^2 L rho)
                 sd_bin = np.sqrt(6.0 / (4.0 * np.pi**2 * L * rho))
-                r_est += sd_bin * _normal(s)
-                d_est += sd_bin * _normal(s)
+                r_est += sd_bin * ss_normal(s)
+                d_est += sd_bin * ss_normal(s)
             else:
                 det = True
                 snr = 10.0 * np.log10(L * rho)
@@ -232,7 +159,7 @@ def measure_frames(
                 ph += 2.0 * np.pi * nu_true * (v // n_rx) / (n_loops * n_tx)
                 xv[v] = amp * (np.cos(ph) + 1j * np.sin(ph))
                 if noise:
-                    xv[v] += (_normal(s) + 1j * _normal(s)) / np.sqrt(2.0)
+                    xv[v] += (ss_normal(s) + 1j * ss_normal(s)) / np.sqrt(2.0)
             a_i, e_i = angles_of(
                 xv,
                 d_est,
@@ -265,12 +192,12 @@ def measure_frames(
         if noise and fa_rate > 0.0 and fa_snr.shape[0] > 0:
             # the chain's own false alarms: Poisson count, resampled from the measured pool,
             # range uniform over the detectable bins, Doppler refinement uniform in the cell
-            k = _poisson(s, fa_rate)
+            k = ss_poisson(s, fa_rate)
             f64, i64 = _grow(f64, i64, n_out + k)
             for _ in range(k):
-                pick = _randint(s, fa_snr.shape[0])
-                rb = bin_lo + _randint(s, bin_hi - bin_lo + 1) + fa_frac[pick]
-                db = fa_doppler[pick] - n_loops // 2 + (_uniform(s) - 0.5)
+                pick = ss_randint(s, fa_snr.shape[0])
+                rb = bin_lo + ss_randint(s, bin_hi - bin_lo + 1) + fa_frac[pick]
+                db = fa_doppler[pick] - n_loops // 2 + (ss_uniform(s) - 0.5)
                 f64[n_out, 0] = rb * range_res
                 f64[n_out, 1] = fa_az[pick]
                 f64[n_out, 2] = 0.0

@@ -38,6 +38,8 @@ def allocate(
     d_alloc: float,
     v_alloc: float,
     labels: np.ndarray,
+    order: np.ndarray,
+    member: np.ndarray,
 ) -> int:
     """Groups of free points that may start tracks.
 
@@ -51,6 +53,8 @@ def allocate(
         Minimum points, minimum SNR sum (dB), group radius (m), velocity spread (m/s).
     labels
         (m,) int64 output: the group of each point, −1 for none.
+    order, member
+        Scratch, (m,) int64 each.
 
     Returns
     -------
@@ -58,27 +62,39 @@ def allocate(
         The number of groups (labels 0 … n − 1, in order of their seeds).
     """
     m = pts.shape[0]
+    n_cand = 0
     for j in range(m):
         labels[j] = -1
-    cand = np.flatnonzero(free)
-    if cand.shape[0] == 0:
+        if free[j]:
+            n_cand += 1
+    if n_cand == 0:
         return 0
-    # strongest first; a stable sort keeps ties in index order
-    order = cand[np.argsort(-pts[cand, COL_SNR], kind="mergesort")]
-    taken = np.zeros(m, dtype=np.bool_)
-    member = np.zeros(order.shape[0], dtype=np.int64)
+    # the candidates strongest first, ties in index order (a stable insertion sort: the
+    # order a stable argsort of −SNR gives, without its temporaries; frames hold few candidates)
+    n_sorted = 0
+    for j in range(m):
+        if not free[j]:
+            continue
+        key = pts[j, COL_SNR]
+        i = n_sorted
+        while i > 0 and pts[order[i - 1], COL_SNR] < key:
+            order[i] = order[i - 1]
+            i -= 1
+        order[i] = j
+        n_sorted += 1
+    # a point is taken when it has a label (only kept groups label their points)
     n_groups = 0
-    for a in range(order.shape[0]):
+    for a in range(n_cand):
         seed = order[a]
-        if taken[seed]:
+        if labels[seed] >= 0:
             continue
         n = 1
         member[0] = seed
         cx, cy, cv = pts[seed, COL_X], pts[seed, COL_Y], pts[seed, COL_VR]
         snr = max(pts[seed, COL_SNR], 0.0)
-        for b in range(a + 1, order.shape[0]):
+        for b in range(a + 1, n_cand):
             j = order[b]
-            if taken[j]:
+            if labels[j] >= 0:
                 continue
             if abs(pts[j, COL_VR] - cv) > v_alloc:
                 continue
@@ -94,7 +110,6 @@ def allocate(
             snr += max(pts[j, COL_SNR], 0.0)
         if n >= n_alloc and snr >= snr_alloc:
             for i in range(n):
-                taken[member[i]] = True
                 labels[member[i]] = n_groups
             n_groups += 1
     return n_groups

@@ -131,6 +131,9 @@ class DatasetEstimates:
         status, gated measurements and NIS (:class:`~core.tracking.results.TrackRecord`, rows
         in output-frame order), or None unless ``with_tracks=True``: the tracks file and the
         scores without positions read it.
+    height_m
+        (F_sel, max_tracks) height of every live track slot (m; the room mode: the mean z of the
+        track's latest group of points), or None (the paper mode, or without ``with_tracks``).
     """
 
     trajectories: np.ndarray
@@ -145,6 +148,7 @@ class DatasetEstimates:
     model: str = "cv"
     tracks: ConfirmedTracks | None = None
     record: TrackRecord | None = None
+    height_m: np.ndarray | None = None
 
 
 def dataset_frame_period_s(dataset: Dataset) -> float:
@@ -247,6 +251,7 @@ def track_dataset(
     z, f_off, t_off, period = _prepare(dataset)
     tracks: ConfirmedTracks | None = None
     record: TrackRecord | None = None
+    height: np.ndarray | None = None
     lengths = t_off[sel + 1] - t_off[sel]
     offsets = np.concatenate(([0], np.cumsum(lengths))).astype(np.int64)
     frame_index = (
@@ -264,6 +269,7 @@ def track_dataset(
         est_xy, has, psi, conf_xy, n_conf, n_tr = out[:6]
         if with_tracks:
             rec = record = out[8]
+            height = out[9]
             tracks = ConfirmedTracks.from_slots(
                 rec.ids, rec.state[..., :2], rec.psi, _live(rec.n_tracks, rec.confirmed)
             )
@@ -301,7 +307,7 @@ def track_dataset(
             est_xy[s], has[s], psi[s] = res.estimate_xy, res.has_estimate, res.estimate_psi
             conf_xy[s], n_conf[s], n_tr[s] = res.confirmed_xy, res.n_confirmed, res.n_tracks
             for j, ft in enumerate(res.frames or ()):
-                _record_frame(rec, offsets[i] + j, ft)
+                record_frame(rec, offsets[i] + j, ft)
         if with_tracks:
             record = rec._replace(n_tracks=n_tr.copy())
             tracks = ConfirmedTracks.from_slots(
@@ -322,10 +328,11 @@ def track_dataset(
         model=params.model,
         tracks=tracks,
         record=record,
+        height_m=height,
     )
 
 
-def _record_frame(rec: TrackRecord, row: int, ft: FrameTracks) -> None:
+def record_frame(rec: TrackRecord, row: int, ft: FrameTracks) -> None:
     """Write one frame of the readable tracker (:class:`FrameTracks`) into row ``row`` of a
     :class:`TrackRecord`, as the compiled kernel records it."""
     n = len(ft)

@@ -52,22 +52,34 @@ def safe_position(x: float, y: float) -> tuple[float, float, float]:
 
 
 @register_jitable
-def measure(state: np.ndarray) -> np.ndarray:
-    """Predicted measurement h(x) = [r (m), az (rad), vr (m/s)], shape (3,)."""
+def measure_into(state: np.ndarray, z: np.ndarray) -> None:
+    """Write the predicted measurement h(x) = [r (m), az (rad), vr (m/s)] into z (3,)."""
     x, y, r = safe_position(state[0], state[1])
     vx, vy = state[2], state[3]
     # h = [r, atan2(x, y), (x·vx + y·vy)/r]
-    return np.array([r, np.arctan2(x, y), (x * vx + y * vy) / r])
+    z[0] = r
+    z[1] = np.arctan2(x, y)
+    z[2] = (x * vx + y * vy) / r
 
 
 @register_jitable
-def jacobian(state: np.ndarray) -> np.ndarray:
-    """Jacobian H = ∂h/∂x at the state, shape (3, n) with n = len(state)."""
+def measure(state: np.ndarray) -> np.ndarray:
+    """Predicted measurement h(x) = [r (m), az (rad), vr (m/s)], shape (3,)."""
+    z = np.empty(3)
+    measure_into(state, z)
+    return z
+
+
+@register_jitable
+def jacobian_into(state: np.ndarray, H: np.ndarray) -> None:
+    """Write the Jacobian H = ∂h/∂x at the state into H (3, n), n = len(state)."""
     x, y, r = safe_position(state[0], state[1])
     vx, vy = state[2], state[3]
     r2 = r * r
     r3 = r2 * r
-    H = np.zeros((3, len(state)))
+    for i in range(3):
+        for j in range(H.shape[1]):
+            H[i, j] = 0.0
     # ∂r/∂(x, y) = (x, y)/r
     H[0, 0], H[0, 1] = x / r, y / r
     # ∂az/∂(x, y) = (y, −x)/r²
@@ -76,6 +88,13 @@ def jacobian(state: np.ndarray) -> np.ndarray:
     cross = vx * y - vy * x
     H[2, 0], H[2, 1] = y * cross / r3, -x * cross / r3
     H[2, 2], H[2, 3] = x / r, y / r
+
+
+@register_jitable
+def jacobian(state: np.ndarray) -> np.ndarray:
+    """Jacobian H = ∂h/∂x at the state, shape (3, n) with n = len(state)."""
+    H = np.zeros((3, len(state)))
+    jacobian_into(state, H)
     return H
 
 

@@ -40,6 +40,8 @@ def ghost_candidates(
     bearing: float,
     velocity: float,
     ghost: np.ndarray,
+    zm: np.ndarray,
+    order: np.ndarray,
 ) -> None:
     """Flag the ghost candidates among the first ``nt`` tracks.
 
@@ -53,25 +55,29 @@ def ghost_candidates(
         Δr_ghost (m), Δaz_ghost (rad), Δv_ghost (m/s).
     ghost
         (cap,) bool output.
+    zm, order
+        Scratch: (cap, 3) float and (cap,) int64.
     """
-    zr = np.zeros(nt)
-    za = np.zeros(nt)
-    zv = np.zeros(nt)
+    # zm: [r, az, vr] of each state; order: nearest first, ties in slot order (stable)
     for k in range(nt):
-        z = ekf.measure(X[k])
-        zr[k], za[k], zv[k] = z[0], z[1], z[2]
+        x, y, r = ekf.safe_position(X[k, 0], X[k, 1])
+        zm[k, 0], zm[k, 1], zm[k, 2] = r, math.atan2(x, y), (x * X[k, 2] + y * X[k, 3]) / r
         ghost[k] = False
-    order = np.argsort(zr, kind="mergesort")
+        i = k
+        while i > 0 and zm[order[i - 1], 0] > r:
+            order[i] = order[i - 1]
+            i -= 1
+        order[i] = k
     for ib in range(nt):
         b = order[ib]
         for ia in range(ib):
             a = order[ia]
             if not confirmed[a] or ghost[a]:
                 continue
-            if zr[b] - zr[a] < gap:
+            if zm[b, 0] - zm[a, 0] < gap:
                 continue
-            dz = ((za[b] - za[a] + math.pi) % (2.0 * math.pi)) - math.pi
-            if abs(dz) > bearing or abs(zv[b] - zv[a]) > velocity:
+            dz = ((zm[b, 1] - zm[a, 1] + math.pi) % (2.0 * math.pi)) - math.pi
+            if abs(dz) > bearing or abs(zm[b, 2] - zm[a, 2]) > velocity:
                 continue
             if strength[b] < strength[a]:
                 ghost[b] = True

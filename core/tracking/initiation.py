@@ -21,13 +21,20 @@ def unassociated(gated: np.ndarray) -> np.ndarray:
 
 
 @register_jitable
-def initial_state(z: np.ndarray, state_dim: int) -> np.ndarray:
-    """State (state_dim,) of a new track from one measurement z = [r, az, vr]."""
+def initial_state_into(z: np.ndarray, x: np.ndarray) -> None:
+    """Write the state of a new track from one measurement z = [r, az, vr] into x (n,)."""
     r, az, vr = float(z[0]), float(z[1]), float(z[2])
     s, c = np.sin(az), np.cos(az)
-    x = np.zeros(state_dim)
+    x[:] = 0.0
     # [x, y] = r [sin az, cos az]; [vx, vy] = vr [sin az, cos az]
-    x[:4] = (r * s, r * c, vr * s, vr * c)
+    x[0], x[1], x[2], x[3] = r * s, r * c, vr * s, vr * c
+
+
+@register_jitable
+def initial_state(z: np.ndarray, state_dim: int) -> np.ndarray:
+    """State (state_dim,) of a new track from one measurement z = [r, az, vr]."""
+    x = np.zeros(state_dim)
+    initial_state_into(z, x)
     return x
 
 

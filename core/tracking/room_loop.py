@@ -26,9 +26,14 @@ from core.tracking.groups import (
     COL_X,
     COL_Y,
     COL_Z,
-    body_covariance,
-    chol3,
+    body_covariance_into,
+    chol3_into,
     group_update,
+    group_work,
+    innovation_covariance_into,
+    mm,
+    mm_nt,
+    symmetrize_into,
 )
 from core.tracking.inputs import TrackerConstants
 from core.tracking.params import TrackerParams
@@ -111,15 +116,39 @@ def room_constants(params: TrackerParams, frame_period_s: float, zones: Zones) -
 
 @register_jitable
 def _gate_xy(x, S, gamma, gc, gs):
-    """The gate's projection on x–y (as :class:`FrameTracks` documents it)."""
+    """The gate's projection on x–y (as :class:`FrameTracks` documents it):
+    G = γ J S_ra Jᵀ with J = ∂(x, y)/∂(r, az), written out."""
     px, py, r = ekf.safe_position(x[0], x[1])
     az = math.atan2(px, py)
-    J = np.zeros((2, 2))
-    J[0, 0], J[0, 1] = math.sin(az), r * math.cos(az)
-    J[1, 0], J[1, 1] = math.cos(az), -r * math.sin(az)
-    G = gamma * (J @ np.ascontiguousarray(S[:2, :2]) @ J.T)
+    j00, j01 = math.sin(az), r * math.cos(az)
+    j10, j11 = math.cos(az), -r * math.sin(az)
+    # M = J S_ra, G = γ M Jᵀ
+    m00 = j00 * S[0, 0] + j01 * S[1, 0]
+    m01 = j00 * S[0, 1] + j01 * S[1, 1]
+    m10 = j10 * S[0, 0] + j11 * S[1, 0]
+    m11 = j10 * S[0, 1] + j11 * S[1, 1]
+    gs[0, 0] = gamma * (m00 * j00 + m01 * j01)
+    gs[0, 1] = gamma * (m00 * j10 + m01 * j11)
+    gs[1, 0] = gamma * (m10 * j00 + m11 * j01)
+    gs[1, 1] = gamma * (m10 * j10 + m11 * j11)
     gc[0], gc[1] = px, py
-    gs[:, :] = G
+
+
+@register_jitable
+def _predict_into(x, P, F, Q, xo, Po, FP):
+    """Kalman prediction x⁻ = F x, P⁻ = sym(F P Fᵀ + Q) into xo, Po (FP: (d, d) scratch)."""
+    d = x.shape[0]
+    for i in range(d):
+        s = 0.0
+        for k in range(d):
+            s += F[i, k] * x[k]
+        xo[i] = s
+    mm(F, P, FP)
+    mm_nt(FP, F, Po)
+    for i in range(d):
+        for j in range(d):
+            Po[i, j] += Q[i, j]
+    symmetrize_into(Po)
 
 
 @register_jitable
@@ -183,6 +212,32 @@ def room_frames(
     ZP = np.zeros((cap, 3))
     DD = np.zeros((cap, 3, 3))
     rhos = np.zeros(cap)
+    # scratch, allocated once for the run (a frame holds at most m_max points)
+    m_max = 0
+    for ti in range(trajectories.shape[0]):
+        for f in range(
+            trajectory_offsets[trajectories[ti]], trajectory_offsets[trajectories[ti] + 1]
+        ):
+            m_max = max(m_max, frame_offsets[f + 1] - frame_offsets[f])
+    used_ = np.zeros(m_max, dtype=np.bool_)
+    static_ = np.zeros(m_max, dtype=np.bool_)
+    owner_ = np.zeros(m_max, dtype=np.int64)
+    best_ = np.zeros(m_max)
+    free_ = np.zeros(m_max, dtype=np.bool_)
+    labels_ = np.zeros(m_max, dtype=np.int64)
+    rows = np.zeros(m_max, dtype=np.int64)
+    order_ = np.zeros(m_max, dtype=np.int64)
+    member_ = np.zeros(m_max, dtype=np.int64)
+    zm = np.zeros((cap + 1, 3))
+    g_order = np.zeros(cap + 1, dtype=np.int64)
+    work = group_work(d)
+    FP = np.zeros((d, d))
+    HP = np.zeros((3, d))
+    H0 = np.zeros((3, d))
+    S = np.zeros((3, 3))
+    RD = np.zeros((3, 3))
+    L = np.zeros((3, 3))
+    zc = np.zeros(3)
     for ti in range(trajectories.shape[0]):
         k_traj = trajectories[ti]
         f0 = trajectory_offsets[k_traj]
@@ -196,33 +251,35 @@ def room_frames(
             z = pts[a:b]
             m = b - a
             # 1. zones and static points
-            used = np.zeros(m, dtype=np.bool_)
-            static = np.zeros(m, dtype=np.bool_)
+            used, static = used_[:m], static_[:m]
             for j in range(m):
                 used[j] = in_box(z[j, COL_X], z[j, COL_Y], z[j, COL_Z], c.boundary)
                 static[j] = abs(z[j, COL_VR]) <= c.static_velocity
             # 2. predict and gate: each point to the track explaining it best
-            owner = np.full(m, -1, dtype=np.int64)
-            best = np.full(m, np.inf)
+            owner, best = owner_[:m], best_[:m]
+            for j in range(m):
+                owner[j] = -1
+                best[j] = np.inf
             for k in range(nt):
-                xp, Pp = ekf.predict(X[k], P[k], c.F, c.Q)
-                XP[k], PP[k] = xp, Pp
+                _predict_into(X[k], P[k], c.F, c.Q, XP[k], PP[k], FP)
                 psi[k] = ipda.predict_existence(psi[k], c.p11, c.p21)
-                zp = ekf.measure(xp)
-                H = ekf.jacobian(xp)
-                ZP[k], HH[k] = zp, H
-                D = body_covariance(zp[0], c.body_sigma, c.body_velocity_sigma)
-                DD[k] = D
-                S = H @ Pp @ H.T + c.R + D
-                S = 0.5 * (S + S.T)
-                L = chol3(S)
+                zp = ZP[k]
+                ekf.measure_into(XP[k], zp)
+                ekf.jacobian_into(XP[k], HH[k])
+                body_covariance_into(zp[0], c.body_sigma, c.body_velocity_sigma, DD[k])
+                # S_pt = H P⁻ Hᵀ + (R + D), symmetrised
+                for i in range(3):
+                    for j in range(3):
+                        RD[i, j] = c.R[i, j] + DD[k, i, j]
+                innovation_covariance_into(HH[k], PP[k], RD, HP, S)
+                chol3_into(S, L)
                 log_det = 2.0 * (math.log(L[0, 0]) + math.log(L[1, 1]) + math.log(L[2, 2]))
                 if c.nonparametric:
                     # one group in the point gate: ρ̂ = 1/V, V = (4π/3) γ^{3/2} √det S
                     rhos[k] = 1.0 / (4.0 * math.pi / 3.0 * c.gamma**1.5 * math.exp(0.5 * log_det))
                 else:
                     rhos[k] = c.rho
-                _gate_xy(xp, S, c.gamma, gc[k], gs[k])
+                _gate_xy(XP[k], S, c.gamma, gc[k], gs[k])
                 l00, l10, l11, l20, l21, l22 = L[0, 0], L[1, 0], L[1, 1], L[2, 0], L[2, 1], L[2, 2]
                 for j in range(m):
                     if not used[j]:
@@ -256,11 +313,6 @@ def room_frames(
                     and in_any_box(XP[k, 0], XP[k, 1], height[k], c.static_boxes)
                 )
                 n = 0
-                for j in range(m):
-                    if owner[j] == k and (in_static or not static[j]):
-                        n += 1
-                rows = np.zeros(n, dtype=np.int64)
-                n = 0
                 snr = 0.0
                 zsum = 0.0
                 for j in range(m):
@@ -269,27 +321,26 @@ def room_frames(
                         n += 1
                         snr += max(z[j, COL_SNR], 0.0)
                         zsum += z[j, COL_Z]
-                x_new, P_new, psi_new, nis_k = group_update(
-                    XP[k], PP[k], psi[k], HH[k], ZP[k], z, rows, c.R, DD[k], c.pdpg, c.p_g,
-                    rhos[k],
+                psi[k], nis[k] = group_update(
+                    XP[k], PP[k], psi[k], HH[k], ZP[k], z, rows, n, c.R, DD[k], c.pdpg, c.p_g,
+                    rhos[k], X[k], P[k], work,
                 )  # fmt: skip
-                X[k], P[k], psi[k], nis[k] = x_new, P_new, psi_new, nis_k
                 npts[k] = n
                 strength[k] = STRENGTH_MEMORY * strength[k] + (1.0 - STRENGTH_MEMORY) * snr
                 if n > 0:
                     height[k] = zsum / n
             # 5. groups of unexplained moving points start tentative tracks
-            free = np.zeros(m, dtype=np.bool_)
+            free, labels = free_[:m], labels_[:m]
             for j in range(m):
                 free[j] = used[j] and not static[j] and owner[j] < 0
-            labels = np.full(m, -1, dtype=np.int64)
             n_groups = allocate(
-                z, free, c.alloc_points, c.alloc_snr, c.alloc_distance, c.alloc_velocity, labels
-            )
+                z, free, c.alloc_points, c.alloc_snr, c.alloc_distance, c.alloc_velocity, labels,
+                order_[:m], member_[:m],
+            )  # fmt: skip
             for g in range(n_groups):
                 if nt >= cap:
                     break
-                zc = np.zeros(3)
+                zc[0] = zc[1] = zc[2] = 0.0
                 n = 0
                 snr = 0.0
                 zsum = 0.0
@@ -302,7 +353,7 @@ def room_frames(
                         zsum += z[j, COL_Z]
                         n += 1
                 zc /= n
-                X[nt] = initiation.initial_state(zc, d)
+                initiation.initial_state_into(zc, X[nt])
                 P[nt] = c.P0
                 psi[nt] = c.p_te
                 ids[nt] = next_id
@@ -314,13 +365,20 @@ def room_frames(
                 height[nt] = zsum / n
                 npts[nt] = 0
                 nis[nt] = math.nan
-                S0 = ekf.jacobian(X[nt]) @ P[nt] @ ekf.jacobian(X[nt]).T + c.R
-                _gate_xy(X[nt], S0, c.gamma, gc[nt], gs[nt])
+                # the newborn's gate: S₀ = H(x₀) P₀ H(x₀)ᵀ + R
+                ekf.jacobian_into(X[nt], H0)
+                mm(H0, P[nt], HP)
+                mm_nt(HP, H0, S)
+                for i in range(3):
+                    for j in range(3):
+                        S[i, j] += c.R[i, j]
+                _gate_xy(X[nt], S, c.gamma, gc[nt], gs[nt])
                 nt += 1
             # 6. ghosts, confirmation, deletion
             ghost_candidates(
-                X, conf, strength, nt, c.ghost_gap, c.ghost_bearing, c.ghost_velocity, ghost
-            )
+                X, conf, strength, nt, c.ghost_gap, c.ghost_bearing, c.ghost_velocity, ghost,
+                zm, g_order,
+            )  # fmt: skip
             for k in range(nt):
                 if not conf[k] and not ghost[k] and birth[k] < frame:
                     conf[k] = psi[k] >= c.confirm_threshold

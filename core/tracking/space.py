@@ -29,6 +29,7 @@ __all__ = [
     "MODELS",
     "GTRACK",
     "GTRACK_SPACE",
+    "GTRACK_LEGACY_NAMES",
     "MODES",
     "STATE_DIM",
     "Parameter",
@@ -205,18 +206,29 @@ GTRACK_SPACE: tuple[Parameter, ...] = (
     _g("static2free", "static to FREE misses", "", 10, 2000, 500, log=True, integer=True),
     _g("exit2free", "exit to FREE misses", "", 1, 50, 5, log=True, integer=True),
     _g("sleep2free", "sleep to FREE frames", "", 50, 10000, 6000, log=True, integer=True),
-    _g("alloc_snr", "allocation SNR sum", "", 5.0, 1000.0, 40.0, log=True),
-    _g("alloc_snr_obscured", "obscured allocation SNR sum", "", 10.0, 2000.0, 100.0, log=True),
-    _g("alloc_velocity_mps", "allocation radial velocity", "m/s", 0.0, 1.0, 0.1),
-    _g("alloc_points", "allocation points", "", 2, 50, 20, integer=True),
-    _g("alloc_distance_m2", "allocation squared distance", "m²", 0.05, 4.0, 0.5, log=True),
-    _g("alloc_velocity_spread_mps", "allocation velocity spread", "m/s", 0.2, 20.0, 20.0,
+    _g("snr_thre", "allocation SNR sum", "", 5.0, 1000.0, 40.0, log=True),
+    _g("snr_thre_obscured", "obscured allocation SNR sum", "", 10.0, 2000.0, 100.0, log=True),
+    _g("velocity_thre_mps", "allocation radial velocity", "m/s", 0.0, 1.0, 0.1),
+    _g("points_thre", "allocation points", "", 2, 50, 20, integer=True),
+    _g("max_distance_thre_m2", "allocation squared distance", "m²", 0.05, 4.0, 0.5, log=True),
+    _g("max_vel_thre_mps", "allocation velocity spread", "m/s", 0.2, 20.0, 20.0,
        log=True),
     _g("max_accel_x_mps2", "maximum acceleration x", "m/s²", 0.01, 10.0, 0.1, log=True),
     _g("max_accel_y_mps2", "maximum acceleration y", "m/s²", 0.01, 10.0, 0.1, log=True),
     _g("max_accel_z_mps2", "maximum acceleration z", "m/s²", 0.01, 10.0, 0.1, log=True),
 )
 # fmt: on
+
+#: Earlier names of the allocation fields (read from older JSON files; the fields now carry
+#: TI's allocationParam names, apart from the room tracker's own allocation rows).
+GTRACK_LEGACY_NAMES = {
+    "alloc_snr": "snr_thre",
+    "alloc_snr_obscured": "snr_thre_obscured",
+    "alloc_velocity_mps": "velocity_thre_mps",
+    "alloc_points": "points_thre",
+    "alloc_distance_m2": "max_distance_thre_m2",
+    "alloc_velocity_spread_mps": "max_vel_thre_mps",
+}
 
 _BY_NAME = {p.name: p for p in SEARCH_SPACE}
 
@@ -311,9 +323,9 @@ def flat_params(params: dict[str, Any]) -> dict[str, float]:
     """
     tracker_names = {b.name for b in SEARCH_SPACE}
     gtrack_only = [b.name for b in GTRACK_SPACE if b.name not in tracker_names]
-    # a GtrackParams JSON: no model or mode key, and a name only gtrack's table has (the room
-    # mode's allocation rows share two names with it)
+    # a GtrackParams JSON: no model or mode key, and a name only gtrack's table has
     if "model" not in params and "mode" not in params and any(n in params for n in gtrack_only):
+        params = {GTRACK_LEGACY_NAMES.get(k, k): v for k, v in params.items()}
         flat_g: dict[str, float] = {}
         for b in search_space(GTRACK):
             if b.name not in params:

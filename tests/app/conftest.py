@@ -8,6 +8,15 @@ import pytest
 
 import app  # noqa: F401  (sets the BLAS thread variables before numpy is imported)
 
+
+def pytest_configure(config) -> None:
+    """One OpenGL share group, as app.main sets it (before the QApplication exists): the 3-D
+    views of several tests share pyqtgraph's per-class shader programs."""
+    from PySide6 import QtCore
+
+    QtCore.QCoreApplication.setAttribute(QtCore.Qt.AA_ShareOpenGLContexts)
+
+
 #: A 250-frame scene (20 s of class c at 80 ms): the size the re-track budget is specified for.
 LONG_SCENE = {
     "schema_version": 1,

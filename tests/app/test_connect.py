@@ -136,3 +136,24 @@ def test_connect_again_after_stop(window, qtbot, capture) -> None:
     # the second session's frames replaced the first's, from its own frame 0
     assert window.cache.frames[0].index == 0 and len(window.cache) >= 5
     assert window.errors == []
+
+
+@pytest.mark.xcb
+def test_connect_dialog_under_xcb_fits_the_screen(qtbot, monkeypatch, tmp_path) -> None:
+    """The dialog in the real window system: shown whole on the screen, every field visible."""
+    from PySide6 import QtWidgets
+
+    if QtWidgets.QApplication.platformName() != "xcb":
+        pytest.skip("needs the real xcb platform (make test-xcb runs it under Xvfb)")
+    import app.connect_dialog as cd
+
+    monkeypatch.setattr(cd, "list_ports", lambda: [("/dev/ttyACM0", "XDS110 UART")])
+    d = cd.ConnectDialog(cfg=str(tmp_path / "a.cfg"))
+    qtbot.addWidget(d)
+    d.show()
+    qtbot.waitExposed(d)
+    screen = d.screen().availableGeometry()
+    assert screen.contains(d.frameGeometry()), (d.frameGeometry(), screen)
+    for w in (d.cli_combo, d.data_combo, d.data_baud, d.error_label.parentWidget()):
+        assert w.isVisible() and w.width() > 0 and w.height() > 0
+    d.reject()

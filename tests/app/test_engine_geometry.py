@@ -129,3 +129,19 @@ def test_sliders_and_their_defaults_are_the_search_space_table(model: str) -> No
     for p in rows:  # labels show the unit of every dimensioned parameter
         assert p.label.startswith(p.symbol) and (not p.unit or p.label.endswith(f"[{p.unit}]"))
     assert engine.default_values(model) == defaults(model)
+
+
+def test_running_rmse_of_several_people_scores_each_against_its_own_track() -> None:
+    """Two people each tracked 0.1 m off, one of them unpaired in the first frame: the running
+    RMSE is 0.1 m from the first pair on (the one scene estimate against person 0 read metres)."""
+    import numpy as np
+
+    from app.engine.tracking import running_pair_rmse
+
+    e2 = np.array([[np.nan, np.nan], [0.01, np.nan], [0.01, 0.01], [0.04, 0.01]])
+    rmse = running_pair_rmse(e2, 2.0)
+    assert np.isnan(rmse[0])
+    np.testing.assert_allclose(rmse[1:3], 0.1)
+    np.testing.assert_allclose(rmse[3], np.sqrt((0.01 * 3 + 0.04 + 0.01) / 5))
+    # GOSPA of order p = 1 gives |error|: the same RMSE
+    np.testing.assert_allclose(running_pair_rmse(np.sqrt(e2), 1.0), rmse, equal_nan=True)

@@ -194,3 +194,30 @@ def test_playback_bar_both_ways(window, long_scene_frames, long_scene_doc, fill_
     window.persistence_spin.setValue(9)
     assert window.top_view.persistence == 9
     assert QtCore.QCoreApplication.instance() is not None
+
+
+def test_users_count_from_one_and_the_counter_reads_out_of_the_scene(
+    window, long_scene_frames
+) -> None:
+    """Persons are numbered from 1 wherever a user reads them (the scene panel's list as its
+    waypoint table's rows), and the frame counter counts out of the scene's frames, saying how
+    many are simulated while the cache fills."""
+    from tests.app.conftest import LONG_SCENE
+
+    _scene, frames = long_scene_frames
+    window.scene_model.set_document(LONG_SCENE)
+    window._scene_timer.stop()
+    assert window.scene_panel.person_list.item(0).text().startswith("person 1: ")
+    info = window.engine.scene_info(window.scene_model.scene)
+    window.cache.clear(expected=info.n_frames, truth_paths=info.truth_paths)
+    for f in frames[:3]:
+        window.cache.append(f)
+    window.playback_control.update_frame_label()
+    text = window.frame_label.text()
+    assert f"frame 1 / {info.n_frames} (3 simulated so far)" in text, text
+    for f in frames[3:]:
+        window.cache.append(f)
+    window.cache.mark_complete()
+    window.playback_control.update_frame_label()
+    assert f"/ {info.n_frames} ·" in window.frame_label.text()
+    assert "simulated" not in window.frame_label.text()

@@ -81,7 +81,11 @@ def test_short_study_from_panel_keeps_event_loop_alive(
 
     # the dashboard serves this storage (the browser call is intercepted)
     opened = []
-    monkeypatch.setattr("webbrowser.open", lambda url: opened.append(url))
+    from PySide6 import QtGui
+
+    monkeypatch.setattr(
+        QtGui.QDesktopServices, "openUrl", lambda url: opened.append(url.toString())
+    )
     panel.dashboard_button.click()
     qtbot.waitUntil(lambda: bool(opened), timeout=10000)
     import json
@@ -108,10 +112,15 @@ def test_stop_ends_a_running_study_early(
     window.study_panel.start_button.click()
     qtbot.waitUntil(lambda: window.study_model.progress.n_finished >= 2, timeout=120000)
     assert window.study_panel.stop_button.isEnabled()
-    window.study_panel.stop_button.click()
     finished = []
     window.study.finished.connect(lambda: finished.append(True))
+    window.study_panel.stop_button.click()
+    # while the worker finishes its trial: the button says so and cannot be clicked again
+    stop = window.study_panel.stop_button
+    assert finished or (stop.text() == "Stopping …" and not stop.isEnabled())
     qtbot.waitUntil(lambda: bool(finished), timeout=60000)
+    qtbot.waitUntil(lambda: not window.study_model.running, timeout=10000)
+    assert stop.text() == "Stop" and not stop.isEnabled()
     p = window.study_model.progress
     assert 2 <= p.n_finished < 500
     assert p.n_running == 0  # the worker finished its trial; nothing is left RUNNING

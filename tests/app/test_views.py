@@ -176,9 +176,13 @@ def test_export_plots_and_screenshot(tracked, tmp_path) -> None:
     assert {p.name for p in out} >= {"range-azimuth.png", "micro-doppler.png", "top-view.png"}
     from PySide6 import QtGui
 
+    from app.record import EXPORT_WIDTH_PX
+
     for p in out:
         img = QtGui.QImage(str(p))
         assert not img.isNull() and img.width() >= 50
+        if p.name in ("range-azimuth.png", "micro-doppler.png", "top-view.png"):  # plots
+            assert img.width() >= EXPORT_WIDTH_PX >= 1200, (p.name, img.width())
     shot = window.record.screenshot(tmp_path / "window.png")
     assert shot is not None and QtGui.QImage(str(shot)).width() > 500
 

@@ -8,9 +8,10 @@ from collections.abc import Sequence
 import numpy as np
 
 from core.dataset import Dataset
-from core.tracking.batch import ConfirmedTracks, DatasetEstimates
+from core.tracking.batch import ConfirmedTracks, DatasetEstimates, record_frame
 from core.tracking.gtrack.params import GtrackParams
 from core.tracking.gtrack.tracker import GtrackResult, run_gtrack
+from core.tracking.results import TrackRecord
 
 __all__ = ["dataset_points", "gtrack_dataset"]
 
@@ -34,10 +35,13 @@ def gtrack_dataset(
     *,
     trajectories: Sequence[int] | None = None,
     engine: str = "numba",
+    with_tracks: bool = False,
 ) -> tuple[DatasetEstimates, list[GtrackResult]]:
     """Run gtrack on every selected trajectory; estimates as :func:`core.tracking.track_dataset`
     (ACTIVE tracks are the confirmed ones, the estimate the ACTIVE track with most points).
-    ``engine``: ``"numba"`` (compiled, default) or ``"numpy"`` (the readable form)."""
+    ``engine``: ``"numba"`` (compiled, default) or ``"numpy"`` (the readable form);
+    ``with_tracks``: keep every live track of every frame in the estimates' ``record`` (in
+    gtrack's own state layout), for the tracks file and the scores without positions."""
     from core.errors import InputError
 
     if engine == "numba":
@@ -62,7 +66,12 @@ def gtrack_dataset(
     conf_xy = np.full((n, cap, 2), np.nan)
     n_conf = np.zeros(n, dtype=np.int64)
     n_tr = np.zeros(n, dtype=np.int64)
+    # every live track of every frame (gtrack's own state layout), as the paper's tracker
+    # records it for the tracks file and the scores without positions
+    rec = TrackRecord.allocate(n if with_tracks else 0, cap, 3 * params.dims)
     for f, ft in enumerate(frames):
+        if with_tracks:
+            record_frame(rec, f, ft)
         xy = ft.state[ft.confirmed, :2]
         n_conf[f], n_tr[f] = len(xy), len(ft)
         conf_xy[f, : min(len(xy), cap)] = xy[:cap]
@@ -84,6 +93,7 @@ def gtrack_dataset(
             n_tracks=n_tr,
             model="ca",
             tracks=ConfirmedTracks.from_frames(frames),
+            record=rec._replace(n_tracks=n_tr.copy()) if with_tracks else None,
         ),
         results,
     )

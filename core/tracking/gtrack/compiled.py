@@ -32,14 +32,15 @@ def kernel_args(params: GtrackParams) -> tuple:
             p.gating_depth_m,
             p.gating_height_m,
             p.gating_velocity_mps,
-            p.alloc_snr,
-            p.alloc_snr_obscured,
-            p.alloc_velocity_mps,
-            p.alloc_distance_m2,
-            p.alloc_velocity_spread_mps,
+            p.snr_thre,
+            p.snr_thre_obscured,
+            p.velocity_thre_mps,
+            p.max_distance_thre_m2,
+            p.max_vel_thre_mps,
             p.radial_velocity_resolution_mps,
             p.sensor_height_m if d == 3 else 0.0,
             DISPERSION_WEIGHT,
+            p.max_radial_velocity_mps,
         ]  # fmt: skip
     )
     ip = np.array(
@@ -52,7 +53,7 @@ def kernel_args(params: GtrackParams) -> tuple:
             p.static2free,
             p.exit2free,
             p.sleep2free,
-            p.alloc_points,
+            p.points_thre,
         ],
         dtype=np.int64,  # fmt: skip
     )

@@ -18,7 +18,7 @@ from core.tracking.ekf import MIN_RANGE_M
 
 # indices into the float parameter vector
 (G_GAIN, G_WX, G_WY, G_WZ, G_V, A_SNR, A_SNR_OBS, A_VEL, A_DIST, A_VSPREAD, VRES, H_SENSOR,
- DISP_W) = range(13)  # fmt: skip
+ DISP_W, VMAX) = range(14)  # fmt: skip
 # indices into the integer parameter vector
 (DIMS, MAX_TRACKS, DET2ACT, DET2FREE, ACT2FREE, STAT2FREE, EXIT2FREE, SLEEP2FREE,
  ALLOC_POINTS) = range(9)  # fmt: skip
@@ -31,6 +31,12 @@ def _wrap(a):
     if w == -math.pi:
         w = math.pi
     return w
+
+
+@njit(cache=True)
+def _unroll(v, ref, vmax):
+    span = 2.0 * vmax
+    return v + span * math.floor((ref - v + vmax) / span)
 
 
 @njit(cache=True)
@@ -235,8 +241,10 @@ def gtrack_kernel(pts, off, M, F, Q, R, P0, fp, ip, boundary, static_box, presen
                 pw[j, k] = M[k, 0] * ps[0] + M[k, 1] * ps[1] + M[k, 2] * ps[2]
             if d == 3:
                 pw[j, 2] += h
-            usable[j] = _in_box(pw[j], boundary, d)
             static[j] = abs(vr) < 0.5 * fp[VRES]
+            usable[j] = _in_box(pw[j], boundary, d) and (
+                not static[j] or _in_box(pw[j], static_box, d)
+            )
         # predict
         for i in range(nt):
             xp[i] = F @ X[i]
@@ -255,22 +263,28 @@ def gtrack_kernel(pts, off, M, F, Q, R, P0, fp, ip, boundary, static_box, presen
             for j in range(k_pts):
                 if not usable[j]:
                     continue
-                for k in range(m):
-                    nu[k] = z[j, k] - zps[i, k]
-                nu[1] = _wrap(nu[1])
-                if d == 3:
-                    nu[2] = _wrap(nu[2])
-                d2 = 0.0
-                for k in range(m):
-                    for l in range(m):
-                        d2 += nu[k] * Cis[i, k, l] * nu[l]
-                if not d2 <= gain2:
-                    continue
+                # the limits first (cheap; most pairs fail them), then the distance
                 inside = True
                 for k in range(d):
                     if abs(pw[j, k] - xp[i, k]) > half[k]:
                         inside = False
                 if not inside:
+                    continue
+                for k in range(m):
+                    nu[k] = z[j, k] - zps[i, k]
+                nu[1] = _wrap(nu[1])
+                if d == 3:
+                    nu[2] = _wrap(nu[2])
+                nu[m - 1] = _unroll(z[j, m - 1], zps[i, m - 1], fp[VMAX]) - zps[i, m - 1]
+                d2 = 0.0
+                d2p = 0.0  # the gate's partial distance: position rows only
+                for k in range(m):
+                    for l in range(m):
+                        e = nu[k] * Cis[i, k, l] * nu[l]
+                        d2 += e
+                        if k < m - 1 and l < m - 1:
+                            d2p += e
+                if not d2p <= gain2:
                     continue
                 if fp[G_V] > 0 and abs(nu[m - 1]) > fp[G_V] / 2.0:
                     continue
@@ -305,6 +319,7 @@ def gtrack_kernel(pts, off, M, F, Q, R, P0, fp, ip, boundary, static_box, presen
                     nus[c, 1] = _wrap(nus[c, 1])
                     if d == 3:
                         nus[c, 2] = _wrap(nus[c, 2])
+                    nus[c, m - 1] = _unroll(z[j, m - 1], zps[i, m - 1], fp[VMAX]) - zps[i, m - 1]
                     c += 1
             nu_bar = np.zeros(m)
             for k in range(m):
@@ -330,7 +345,11 @@ def gtrack_kernel(pts, off, M, F, Q, R, P0, fp, ip, boundary, static_box, presen
         keep = np.zeros(cap, np.bool_)
         for i in range(nt):
             if st[i] == DETECT:
-                if nas[i] > 0:
+                moving = False
+                for j in range(k_pts):
+                    if owner[j] == i and not static[j]:
+                        moving = True
+                if moving:
                     hits[i] += 1
                     misses[i] = 0
                     if hits[i] >= ip[DET2ACT]:
@@ -394,14 +413,14 @@ def gtrack_kernel(pts, off, M, F, Q, R, P0, fp, ip, boundary, static_box, presen
                 dist = 0.0
                 for k in range(d):
                     dist += (pw[j, k] - cvec[k]) ** 2
-                vj = pts[a + j, 3]
-                if dist <= fp[A_DIST] and abs(vj - cv) <= fp[A_VSPREAD]:
+                vj = _unroll(pts[a + j, 3], cv, fp[VMAX])
+                if abs(vj - cv) < fp[A_VSPREAD] and dist < fp[A_DIST]:
                     members[nm] = j
                     nm += 1
                     for k in range(d):
                         cvec[k] += (pw[j, k] - cvec[k]) / nm
                     cv += (vj - cv) / nm
-            if nm < ip[ALLOC_POINTS] or abs(cv) < fp[A_VEL]:
+            if nm <= ip[ALLOC_POINTS] or not abs(cv) > fp[A_VEL]:
                 continue
             snr_sum = 0.0
             for q in range(nm):
@@ -427,7 +446,7 @@ def gtrack_kernel(pts, off, M, F, Q, R, P0, fp, ip, boundary, static_box, presen
                     obscured = True
                     break
             thr = fp[A_SNR_OBS] if obscured else fp[A_SNR]
-            if snr_sum < thr:
+            if not snr_sum > thr:
                 continue
             for q in range(nm):
                 free[members[q]] = False

@@ -22,8 +22,16 @@ from core.errors import InputError
 from core.files import read_json, write_json_atomic
 from core.formats.ti_cfg import TRACKER_COMMAND_FIELDS, TiCommand, tracker_fields
 from core.limits import FRAME_PERIOD_RANGE_S, MAX_TRACKS
+from core.tracking.space import GTRACK_LEGACY_NAMES as LEGACY_NAMES
 
-__all__ = ["GtrackParams", "CFG_MAP", "params_from_cfg", "cfg_lines", "BOX_NAMES"]
+__all__ = [
+    "GtrackParams",
+    "CFG_MAP",
+    "params_from_cfg",
+    "cfg_lines",
+    "BOX_NAMES",
+    "LEGACY_NAMES",
+]
 
 #: The three boxes: attribute prefix -> cfg line.
 BOX_NAMES = {
@@ -66,12 +74,12 @@ class GtrackParams:
         world x, y, z and radial velocity; velocity 0: no limit).
     det2act, det2free, active2free, static2free, exit2free, sleep2free
         ``stateParam``: the state counters (frames).
-    alloc_snr, alloc_snr_obscured, alloc_velocity_mps, alloc_points, alloc_distance_m2,
-    alloc_velocity_spread_mps
-        ``allocationParam``: a new track needs a set of at least ``alloc_points`` points, each
-        within ``alloc_distance_m2`` (squared distance, m²) and ``alloc_velocity_spread_mps`` of
-        the set's centroid, with centroid |vr| ≥ ``alloc_velocity_mps`` and an SNR sum ≥
-        ``alloc_snr`` (≥ ``alloc_snr_obscured`` behind another track).
+    snr_thre, snr_thre_obscured, velocity_thre_mps, points_thre, max_distance_thre_m2,
+    max_vel_thre_mps
+        ``allocationParam``: a new track needs a set of at least ``points_thre`` points, each
+        within ``max_distance_thre_m2`` (squared distance, m²) and ``max_vel_thre_mps`` of
+        the set's centroid, with centroid |vr| ≥ ``velocity_thre_mps`` and an SNR sum ≥
+        ``snr_thre`` (≥ ``snr_thre_obscured`` behind another track).
     max_accel_x_mps2, max_accel_y_mps2, max_accel_z_mps2
         ``maxAcceleration``: the process noise's acceleration-increment standard deviations.
     range_sigma_m, angle_sigma_rad, doppler_sigma_mps
@@ -118,12 +126,12 @@ class GtrackParams:
     static2free: int = 500
     exit2free: int = 5
     sleep2free: int = 6000
-    alloc_snr: float = 40.0
-    alloc_snr_obscured: float = 100.0
-    alloc_velocity_mps: float = 0.1
-    alloc_points: int = 20
-    alloc_distance_m2: float = 0.5
-    alloc_velocity_spread_mps: float = 20.0
+    snr_thre: float = 40.0
+    snr_thre_obscured: float = 100.0
+    velocity_thre_mps: float = 0.1
+    points_thre: int = 20
+    max_distance_thre_m2: float = 0.5
+    max_vel_thre_mps: float = 20.0
     max_accel_x_mps2: float = 0.1
     max_accel_y_mps2: float = 0.1
     max_accel_z_mps2: float = 0.1
@@ -153,7 +161,6 @@ class GtrackParams:
             "static2free",
             "exit2free",
             "sleep2free",
-            "alloc_points",
         ):
             if getattr(self, name) < 1:
                 raise InputError(f"{name} must be >= 1, got {name}={getattr(self, name)}")
@@ -165,8 +172,8 @@ class GtrackParams:
             "gating_width_m",
             "gating_depth_m",
             "gating_height_m",
-            "alloc_distance_m2",
-            "alloc_velocity_spread_mps",
+            "max_distance_thre_m2",
+            "max_vel_thre_mps",
             "range_sigma_m",
             "angle_sigma_rad",
             "doppler_sigma_mps",
@@ -174,10 +181,11 @@ class GtrackParams:
             if not getattr(self, name) > 0:
                 raise InputError(f"{name} must be > 0, got {name}={getattr(self, name)}")
         for name in (
+            "points_thre",  # more than pointsThre points: 0 lets one point start a track
             "gating_velocity_mps",
-            "alloc_snr",
-            "alloc_snr_obscured",
-            "alloc_velocity_mps",
+            "snr_thre",
+            "snr_thre_obscured",
+            "velocity_thre_mps",
             "max_accel_x_mps2",
             "max_accel_y_mps2",
             "max_accel_z_mps2",
@@ -190,7 +198,7 @@ class GtrackParams:
                 f"max_tracks must be <= {MAX_TRACKS}, got max_tracks={self.max_tracks}"
             )
         for name in ("max_points", "det2act", "det2free", "active2free", "static2free",
-                     "exit2free", "sleep2free", "alloc_points"):  # fmt: skip
+                     "exit2free", "sleep2free", "points_thre"):  # fmt: skip
             if getattr(self, name) > MAX_COUNT:
                 raise InputError(f"{name} must be <= {MAX_COUNT}, got {name}={getattr(self, name)}")
         lo, hi = FRAME_PERIOD_RANGE_S
@@ -198,8 +206,8 @@ class GtrackParams:
             raise InputError(f"frame_period_s must be in [{lo}, {hi}] s, got {self.frame_period_s}")
         for name in ("sensor_height_m", "gating_width_m", "gating_depth_m", "gating_height_m",
                      "gating_velocity_mps", "max_radial_velocity_mps",
-                     "radial_velocity_resolution_mps", "alloc_velocity_mps",
-                     "alloc_velocity_spread_mps", "max_accel_x_mps2", "max_accel_y_mps2",
+                     "radial_velocity_resolution_mps", "velocity_thre_mps",
+                     "max_vel_thre_mps", "max_accel_x_mps2", "max_accel_y_mps2",
                      "max_accel_z_mps2", "range_sigma_m", "doppler_sigma_mps"):  # fmt: skip
             if getattr(self, name) > MAX_SCALE:
                 raise InputError(f"{name} must be <= {MAX_SCALE:g}, got {getattr(self, name)}")
@@ -235,6 +243,7 @@ class GtrackParams:
         if not isinstance(doc, dict):
             raise InputError("gtrack parameters must be a JSON object", source)
         names = {f.name: f for f in fields(cls)}
+        doc = {LEGACY_NAMES.get(str(k), str(k)): v for k, v in doc.items()}
         unknown = sorted(set(doc) - set(names))
         if unknown:
             raise InputError(f"unknown gtrack parameter(s): {', '.join(map(str, unknown))}", source)
@@ -299,12 +308,12 @@ def _map() -> tuple[tuple[str, int, str, float], ...]:
         ("allocationParam", i, a, 1.0)
         for i, a in enumerate(
             (
-                "alloc_snr",
-                "alloc_snr_obscured",
-                "alloc_velocity_mps",
-                "alloc_points",
-                "alloc_distance_m2",
-                "alloc_velocity_spread_mps",
+                "snr_thre",
+                "snr_thre_obscured",
+                "velocity_thre_mps",
+                "points_thre",
+                "max_distance_thre_m2",
+                "max_vel_thre_mps",
             )
         )
     ]

@@ -9,15 +9,16 @@ each rule with its source and every choice made where the documents are silent).
 2. **Predict** every track: ``x⁻ = F x``, ``P⁻ = F P Fᵀ + Q`` (constant acceleration, Q from the
    maximum accelerations).
 3. **Gate and associate.** For track i, with ``C_i = H P⁻ Hᵀ + R + D_i`` (R one point's noise,
-   D_i the track's group dispersion), a point is in the gate when ``νᵀ C_i⁻¹ ν ≤ G²`` (G the
-   gating gain) and it lies within the gating limits (full extents) around the predicted
+   D_i the track's group dispersion), a point is in the gate when the partial distance over the
+   position rows, ``ν_pᵀ (C_i⁻¹)_pp ν_p ≤ G²`` (G the gating gain; Doppler left out, as TI's
+   gate), and it lies within the gating limits (full extents) around the predicted
    centroid in world x, y, z and in radial velocity. A point in several gates goes to the track
    of the smallest score ``νᵀ C_i⁻¹ ν + ln det C_i``.
 4. **Allocate** the points left (in the box, not static), in their order: a point seeds a set,
-   later points join while within ``alloc_distance_m2`` (squared distance) and
-   ``alloc_velocity_spread_mps`` of the set's running centroid; a set of at least
-   ``alloc_points`` points, centroid |vr| ≥ ``alloc_velocity_mps`` and SNR sum ≥ ``alloc_snr``
-   (``alloc_snr_obscured`` when a track is nearer the sensor at about its bearing) starts a
+   later points join while within ``max_distance_thre_m2`` (squared distance) and
+   ``max_vel_thre_mps`` of the set's running centroid; a set of at least
+   ``points_thre`` points, centroid |vr| ≥ ``velocity_thre_mps`` and SNR sum ≥ ``snr_thre``
+   (``snr_thre_obscured`` when a track is nearer the sensor at about its bearing) starts a
    track in DETECT, at the set's centroid moving radially with its mean vr.
 5. **Update** each track with the centroid of its m points: ``ν̄`` the mean innovation,
    ``S = H P⁻ Hᵀ + (R + D)/m``, Kalman gain, Joseph form; D follows the points' spread.
@@ -89,6 +90,13 @@ class GtrackResult:
     n_detect: np.ndarray = field(repr=False)
 
 
+def unroll(v: np.ndarray | float, ref: np.ndarray | float, v_max: float) -> np.ndarray:
+    """Radial velocity ``v`` moved by whole multiples of ``2 v_max`` (the unambiguous span) to
+    the alias nearest ``ref``: ``v + 2 v_max ⌊(ref − v + v_max) / (2 v_max)⌋``."""
+    span = 2.0 * v_max
+    return np.asarray(v) + span * np.floor((np.asarray(ref) - v + v_max) / span)
+
+
 def _in_box(p: np.ndarray, box: tuple[float, ...], dims: int) -> np.ndarray:
     """(n,) bool: rows of p (n, ≥dims) inside the box (x, y; and z in 3-D)."""
     inside = (p[:, 0] >= box[0]) & (p[:, 0] <= box[1]) & (p[:, 1] >= box[2]) & (p[:, 1] <= box[3])
@@ -125,6 +133,8 @@ class GtrackTracker:
         nu = z - zp
         for a in self.angles:
             nu[:, a] = ekf.wrap_angle(nu[:, a])
+        # radial velocity unrolled to the alias nearest the prediction
+        nu[:, -1] = unroll(z[:, -1], zp[-1], self.p.max_radial_velocity_mps) - zp[-1]
         return nu
 
     def _meas(self, r, az, el, vr) -> np.ndarray:
@@ -147,8 +157,9 @@ class GtrackTracker:
         # 2-D: the points in the horizontal plane (no elevation, no height)
         el_w = el if d == 3 else np.zeros_like(el)
         pw = geo.sensor_to_world(geo.spherical_to_sensor(r, az, el_w), self.M, self.h)
-        usable = _in_box(pw, p.box("boundary"), d)
         static = np.abs(vr) < 0.5 * p.radial_velocity_resolution_mps
+        # a static point counts only inside the static box (outside it: "behind the wall")
+        usable = _in_box(pw, p.box("boundary"), d) & (~static | _in_box(pw, p.box("static"), d))
         half = np.array([p.gating_width_m, p.gating_depth_m, p.gating_height_m])[:d] / 2.0
         # 2. predict
         preds = []
@@ -165,7 +176,10 @@ class GtrackTracker:
             nu = self._innovations(z, zp)
             Ci = np.linalg.inv(C)
             d2 = np.einsum("ij,jk,ik->i", nu, Ci, nu)
-            ok = usable & (d2 <= p.gating_gain**2)
+            # the gate: the partial distance over the position rows (Doppler left out)
+            q = self.m - 1
+            d2p = np.einsum("ij,jk,ik->i", nu[:, :q], Ci[:q, :q], nu[:, :q])
+            ok = usable & (d2p <= p.gating_gain**2)
             ok &= np.all(np.abs(pw[:, :d] - x_pred[:d]) <= half, axis=1)
             if p.gating_velocity_mps > 0:
                 ok &= np.abs(nu[:, -1]) <= p.gating_velocity_mps / 2.0
@@ -246,7 +260,7 @@ class GtrackTracker:
         """Count the frame's hit or miss; False when the track is freed."""
         p = self.p
         if t.state == DETECT:
-            if m > 0:
+            if m > 0 and not np.all(static_points):  # a hit needs a moving point
                 t.hits += 1
                 t.misses = 0
                 if t.hits >= p.det2act:
@@ -267,7 +281,7 @@ class GtrackTracker:
         speed = float(np.linalg.norm(t.x[self.dims : 2 * self.dims]))
         if not in_static:
             limit = p.exit2free
-        elif speed <= p.alloc_velocity_mps:
+        elif speed <= p.velocity_thre_mps:
             limit = p.static2free
         else:
             limit = p.active2free
@@ -290,19 +304,21 @@ class GtrackTracker:
             for j in idx[idx > i]:
                 if not free[j]:
                     continue
+                vj = float(unroll(vr[j], cv, p.max_radial_velocity_mps))
                 if (
-                    float(np.sum(np.square(pw[j, :d] - c))) <= p.alloc_distance_m2
-                    and abs(float(vr[j]) - cv) <= p.alloc_velocity_spread_mps
+                    abs(vj - cv) < p.max_vel_thre_mps
+                    and float(np.sum(np.square(pw[j, :d] - c))) < p.max_distance_thre_m2
                 ):
                     members.append(j)
                     k = len(members)
                     c += (pw[j, :d] - c) / k
-                    cv += (float(vr[j]) - cv) / k
-            if len(members) < p.alloc_points or abs(cv) < p.alloc_velocity_mps:
+                    cv += (vj - cv) / k
+            # TI's comparisons are strict: more than pointsThre points, |v̄| and SNR above
+            if len(members) <= p.points_thre or not abs(cv) > p.velocity_thre_mps:
                 continue
             snr_sum = float(np.sum(snr[members]))
-            threshold = p.alloc_snr_obscured if self._obscured(c) else p.alloc_snr
-            if snr_sum < threshold:
+            threshold = p.snr_thre_obscured if self._obscured(c) else p.snr_thre
+            if not snr_sum > threshold:
                 continue
             sel = np.asarray(members)
             free[sel] = False

@@ -28,3 +28,21 @@ def test_frame_stats_person_spread_and_zero_doppler_by_band():
     assert s["person_snr_db"]["median"] == 12.0
     zero = s["zero_doppler_fraction"]
     assert zero["2-4 m"] == 0.0 and zero["4-6 m"] == pytest.approx(4 / 5)
+
+
+def test_static_recurrence_tells_furniture_from_scattered_false_alarms():
+    from core.benchmarks.chain_calibration import static_recurrence
+
+    rng = np.random.default_rng(1)
+    frames = []
+    for _ in range(40):
+        # two static points that stay (a desk), two drawn anywhere in 8 x 8 m, one moving point
+        x = np.concatenate([[1.0, -2.0], rng.uniform(-4, 4, 2), [0.0]])
+        y = np.concatenate([[3.0, 5.0], rng.uniform(0, 8, 2), [2.0]])
+        v = np.array([0.0, 0.0, 0.0, 0.0, 1.0])
+        frames.append({"x": x, "y": y, "v": v})
+    r = static_recurrence(frames)
+    # the desk's two recur; a random point meets a static one within 0.2 m with probability
+    # about 4 * pi * 0.2^2 / 64 = 0.008
+    assert r == pytest.approx(0.5, abs=0.03)
+    assert static_recurrence(frames[:1]) is None

@@ -103,3 +103,26 @@ def test_cli_bad_tracks_path_is_one_line_and_writes_nothing(tmp_path, capsys) ->
     err = capsys.readouterr().err
     assert "--tracks" in err and err.count("\n") == 1
     assert sorted(p.name for p in tmp_path.iterdir()) == ["d.npz", "sub"]
+
+
+def test_room_mode_writes_each_track_height_where_points_carry_elevation() -> None:
+    """z_m is the room tracker's height (the mean z of a track's latest group): points all at
+    1.25 m give 1.2500 on every row; points without elevation (z = 0 everywhere) and the paper
+    mode leave the column empty."""
+    from dataclasses import replace
+
+    from core.tracking.synthetic import circling_paths, room_dataset
+
+    ds = room_dataset(*circling_paths(1, 60), seed=2)
+    room = TrackerParams.default("cv", mode="room")
+    raised = replace(ds, z_m=np.full_like(ds.z_m, 1.25))
+    rows = _read(
+        format_tracks_csv(track_rows(raised, track_dataset(raised, room, with_tracks=True)))
+    )
+    assert len(rows) > 0 and {r["z_m"] for r in rows} == {"1.2500"}
+    flat = replace(ds, z_m=np.zeros_like(ds.z_m))
+    rows = _read(format_tracks_csv(track_rows(flat, track_dataset(flat, room, with_tracks=True))))
+    assert len(rows) > 0 and {r["z_m"] for r in rows} == {""}
+    paper = track_dataset(raised, TrackerParams.default("cv"), with_tracks=True)
+    rows = _read(format_tracks_csv(track_rows(raised, paper)))
+    assert len(rows) > 0 and {r["z_m"] for r in rows} == {""}

@@ -149,3 +149,28 @@ def test_truth_with_heights_and_count_csv_errors(tmp_path: Path) -> None:
             read_count_csv(c)
     counts = np.array([[0.0, 0.25, 2.0], [0.3, 1.0, 0.0]])
     assert count_on_frames(counts, np.arange(5) * 0.1).tolist() == [2, 2, 2, 0, 0]
+
+
+@pytest.mark.parametrize(
+    ("body", "message"),
+    [
+        ("", "t.csv:1: the truth CSV has a header line and no samples"),
+        ("1_0,0,1,2\n", "t.csv:2: time_s must be a number, got '1_0'"),
+        ("0,\u0661,1,2\n", "t.csv:2: person must be a number"),
+        ("0,0,1,2\n0,1,1,2\n", "t.csv: all 2 samples have the same time_s 0 s"),
+        ("1,0,1,2\n0.5,0,1,2\n", "t.csv:3: time_s of person 0 must increase"),
+        ("1000000000,0,1,2\n1000000001,0,1,2\n", "overlap none of the frames"),
+        ("0,0,-1e308,2\n", "t.csv:2: x_m must be within ±1000 m"),
+    ],
+)
+def test_bad_truth_through_the_cli(tmp_path: Path, capsys, body: str, message: str) -> None:
+    """Each bad truth file of the bad-input campaign, through ``radartune import``: exit 2, one
+    line naming the file (and line and field where there is one), no data set written."""
+    rec = _walk(tmp_path)
+    truth = tmp_path / "t.csv"
+    truth.write_text("time_s,person,x_m,y_m\n" + body)
+    out = tmp_path / "ds.npz"
+    assert main(["import", str(rec), "--truth", str(truth), "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and message in err and "t.csv" in err
+    assert not out.exists()

@@ -217,3 +217,22 @@ def test_trial_carries_its_worker_from_the_first_write(tmp_path: Path) -> None:
     assert stored.state == TrialState.RUNNING and stored.user_attrs["worker"] == dead
     assert fail_stale_trials(study) == [trial.number]
     assert study.get_trials(deepcopy=False)[0].state == TrialState.FAIL
+
+
+def test_a_surplus_trial_is_neither_counted_nor_failed(tmp_path: Path) -> None:
+    """Two workers racing for the last slot leave one trial stored as FAIL with surplus=True;
+    the summaries call it SURPLUS, so "failed" counts only trials whose objective failed."""
+    from core.optimization.study import load_existing_study
+
+    s = settings(tmp_path, n_trials=3)
+    run(s, seed=0)
+    study = load_existing_study(open_storage(s.storage, create=False), s.name)
+    surplus = study.ask()
+    surplus.set_user_attr("surplus", True)
+    study.tell(surplus, state=optuna.trial.TrialState.FAIL)
+    broken = study.ask()
+    broken.set_user_attr("error", "ValueError: x")
+    study.tell(broken, state=optuna.trial.TrialState.FAIL)
+    states = [t.state for t in study_progress(s.storage, s.name)[0]]
+    assert states.count("COMPLETE") == 3
+    assert states[-2:] == ["SURPLUS", "FAIL"]

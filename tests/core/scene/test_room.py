@@ -11,7 +11,7 @@ import pytest
 
 from core.cli import main
 from core.scene import Scene
-from core.scene.room import Room, SensorPose, Wall, parse_room
+from core.scene.room import DEFAULT_REFLECTION_DB, Room, SensorPose, Wall, parse_room
 from tests.scenes import small_scene
 
 BOX = [
@@ -43,7 +43,9 @@ def test_room_round_trip():
     )
     scene = Scene.from_dict(d)
     assert scene.room is not None
-    assert [w.reflection_db for w in scene.room.walls] == [-6.0, -6.0, -3.0, -6.0]
+    # a wall without a loss gets the default, the loss fitted to a real recording (rooms-02)
+    assert [w.reflection_db for w in scene.room.walls] == [-6.0, -6.0, -3.0, DEFAULT_REFLECTION_DB]
+    assert DEFAULT_REFLECTION_DB == -33.0
     assert scene.room.sensor == SensorPose(height_m=2.0, tilt_deg=15.0)
     again = Scene.from_json_text(scene.to_json())
     assert again.room == scene.room

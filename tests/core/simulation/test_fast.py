@@ -334,8 +334,8 @@ def test_range_pruning_changes_no_bit_of_the_patches(settings) -> None:
         patches_kernel,
         slow_time_sequences,
     )
-    from core.simulation.gaussian import state_from
     from core.simulation.link import received_power_w, signal_amplitude_v
+    from core.simulation.rng_kernels import state_from
 
     rng = np.random.default_rng(5)
     n = 40

@@ -6,13 +6,12 @@ import numpy as np
 import scipy.stats
 
 from core.simulation.gaussian import (
-    ZIGGURAT_R,
     add_complex_noise,
     complex_noise,
     normals_from_stream,
     standard_normals,
-    xoshiro_next,
 )
+from core.simulation.rng_kernels import ZIGGURAT_R, xoshiro_next
 
 
 def test_xoshiro256pp_first_words_by_hand() -> None:

@@ -24,7 +24,21 @@ from core.simulation.measurement import (
     simulate_frame_measurement,
     simulate_frames_measurement,
 )
-from core.simulation.measurement_jit import _gamma, _normal, _poisson, _randint, _uniform
+from core.simulation.rng_kernels import (
+    ss_gamma as _gamma,
+)
+from core.simulation.rng_kernels import (
+    ss_normal as _normal,
+)
+from core.simulation.rng_kernels import (
+    ss_poisson as _poisson,
+)
+from core.simulation.rng_kernels import (
+    ss_randint as _randint,
+)
+from core.simulation.rng_kernels import (
+    ss_uniform as _uniform,
+)
 
 RADAR = PAPER_RADAR
 ANT = AntennaGain.ideal(RADAR)

@@ -12,7 +12,7 @@ import math
 import numpy as np
 import pytest
 
-from core.config import PAPER_RADAR
+from core.config import DEFAULT_PROCESSING, PAPER_RADAR
 from core.scene.room import Room, SensorPose, Wall
 from core.simulation.antenna import AntennaGain
 from core.simulation.multipath import (
@@ -155,3 +155,100 @@ def test_groups_cut_like_array_split_per_frame_and_person(size):
             expected = [part.tolist() for part in np.array_split(by_speed, min(3, size))]
             got = [by_speed[g[by_speed] == k].tolist() for k in dict.fromkeys(g[by_speed])]
             assert got == expected
+
+
+# ---- a ghost's two contributions share one tone (docs/rooms.md#speed) ------------------------
+
+
+def _ghost_pair():
+    """The first-order ghost of S in the wall x = 3 m (both orders) as two scatterers, and a
+    third scatterer at the same range moving across (not radial: no shared tone)."""
+    from core.simulation import Scatterers
+
+    p = image_paths(one_wall(), S, V, np.zeros(1), ANT, max_order=1)
+    across = np.cross(p.position_m[0], [0.0, 0.0, 1.0])
+    pos = np.vstack((p.position_m, p.position_m[:1] * 1.0))
+    vel = np.vstack((p.velocity_mps, 0.5 * across / np.linalg.norm(across)))
+    return Scatterers(
+        position_m=pos,
+        velocity_mps=vel,
+        rcs_dbsm=np.array([-10.0, -13.0, -10.0]),
+        source=np.zeros(3, dtype=np.int32),
+    )
+
+
+def test_a_ghost_pair_is_one_tone_and_frames_keep_theirs_apart():
+    from core.simulation.baseband import coincident_tones
+
+    sc = _ghost_pair()
+    # the two paths arrive from different directions at the same range and radial velocity
+    assert not np.allclose(sc.position_m[0], sc.position_m[1])
+    assert coincident_tones(sc.position_m, sc.velocity_mps).tolist() == [0, 0, 2]
+    # the same pair in two frames: a tone per frame
+    pos = np.vstack((sc.position_m[:2], sc.position_m[:2]))
+    vel = np.vstack((sc.velocity_mps[:2], sc.velocity_mps[:2]))
+    assert coincident_tones(pos, vel, np.array([0, 0, 1, 1])).tolist() == [0, 0, 2, 2]
+    # 1 mm apart: two tones
+    far = sc.position_m[:2] * np.array([[1.0], [1.0 + 1e-3 / np.linalg.norm(sc.position_m[1])]])
+    assert coincident_tones(far, sc.velocity_mps[:2]).tolist() == [0, 1]
+
+
+def test_merged_tone_synthesises_the_sum_of_its_contributions():
+    # the cube is linear in the scatterers: one tone with the summed channel weights equals the
+    # two contributions synthesised apart, to complex64 rounding
+    from core.simulation import Scatterers, synthesize_signal
+
+    sc = _ghost_pair()
+
+    def alone(i):
+        return Scatterers(
+            position_m=sc.position_m[i : i + 1],
+            velocity_mps=sc.velocity_mps[i : i + 1],
+            rcs_dbsm=sc.rcs_dbsm[i : i + 1],
+            source=sc.source[i : i + 1],
+        )
+
+    both = synthesize_signal(PAPER_RADAR, sc, ANT)
+    apart = sum(
+        synthesize_signal(PAPER_RADAR, alone(i), ANT).astype(np.complex128) for i in range(3)
+    )
+    scale = np.max(np.abs(apart))
+    assert np.max(np.abs(both - apart)) < 1e-6 * scale
+    # the merge is real: the two contributions differ in every channel's phase
+    a0, a1 = (synthesize_signal(PAPER_RADAR, alone(i), ANT) for i in (0, 1))
+    assert np.max(np.abs(a0 - a1)) > 0.1 * np.max(np.abs(a0))
+
+
+def test_merged_tone_gives_the_fast_level_the_summed_channels():
+    # the fast level's noise-free patch cells of the pair: the sum of each contribution's
+    # channel values where both see the cell (each contribution's slow time is computed from its
+    # own position, the merged tone's range bins follow its own bound: 1e-7 of the cell's
+    # channel vector at most, complex64's resolution)
+    from core.simulation import Scatterers
+    from core.simulation.fast import fast_spectrum, tones
+
+    sc = _ghost_pair()
+    pair = Scatterers(
+        position_m=sc.position_m[:2],
+        velocity_mps=sc.velocity_mps[:2],
+        rcs_dbsm=np.array([30.0, 27.0]),
+        source=sc.source[:2],
+    )
+    amp, _, _, _, steer, keep = tones(PAPER_RADAR, pair, ANT, DEFAULT_PROCESSING)
+    assert keep.tolist() == [0]
+    assert np.max(np.abs(steer)) == pytest.approx(1.0)  # |steer| <= 1, amp the largest channel
+
+    def cells(s):
+        spec = fast_spectrum(PAPER_RADAR, s, None, antenna=ANT, noise=False)
+        return {tuple(k): x for k, x in zip(spec.patch.tolist(), spec.signal)}
+
+    one = [cells(Scatterers(**{f: getattr(pair, f)[i : i + 1] for f in FIELDS})) for i in (0, 1)]
+    merged = cells(pair)
+    common = set(one[0]) & set(one[1]) & set(merged)
+    assert len(common) > 20
+    for c in common:
+        want = one[0][c] + one[1][c]
+        assert np.linalg.norm(merged[c] - want) <= 1e-7 * np.linalg.norm(want)
+
+
+FIELDS = ("position_m", "velocity_mps", "rcs_dbsm", "source")

@@ -140,31 +140,35 @@ def _allocated(p, pts) -> int:
     return len(ft)
 
 
+# TI's comparisons are strict: more than pointsThre points, an SNR sum and |v̄| above their
+# thresholds, each point nearer than maxDistanceThre (squared) and maxVelThre to the centroid
+
+
 def test_allocation_point_count_threshold_exact():
     p = GtrackParams()
     c, v = (0.0, 3.0, 1.0), (0.0, 0.5, 0.0)
-    assert _allocated(p, cluster(p, c, v, n=p.alloc_points)) == 1
-    assert _allocated(p, cluster(p, c, v, n=p.alloc_points - 1)) == 0
+    assert _allocated(p, cluster(p, c, v, n=p.points_thre + 1)) == 1
+    assert _allocated(p, cluster(p, c, v, n=p.points_thre)) == 0
 
 
 def test_allocation_snr_threshold_exact():
-    p = replace(GtrackParams(), alloc_points=20, alloc_snr=40.0)
+    p = replace(GtrackParams(), points_thre=19, snr_thre=40.0)
     c, v = (0.0, 3.0, 1.0), (0.0, 0.5, 0.0)
-    assert _allocated(p, cluster(p, c, v, n=20, snr=2.0)) == 1  # sum 40.0
-    assert _allocated(p, cluster(p, c, v, n=20, snr=1.999)) == 0
+    assert _allocated(p, cluster(p, c, v, n=20, snr=2.001)) == 1  # sum 40.02
+    assert _allocated(p, cluster(p, c, v, n=20, snr=2.0)) == 0  # sum 40.0: not above
 
 
 def test_allocation_velocity_threshold_exact():
-    p = replace(GtrackParams(), alloc_velocity_mps=0.1)
+    p = replace(GtrackParams(), velocity_thre_mps=0.1)
     pts = cluster(p, (0.0, 3.0, 1.0), (0.0, 0.0, 0.0), n=25)
-    pts[:, 3] = 0.1
+    pts[:, 3] = 0.1001
     assert _allocated(p, pts) == 1
-    pts[:, 3] = 0.0999
+    pts[:, 3] = 0.1
     assert _allocated(p, pts) == 0
 
 
 def test_allocation_distance_threshold_exact():
-    p = replace(GtrackParams(), alloc_points=20, alloc_distance_m2=0.5)
+    p = replace(GtrackParams(), points_thre=19, max_distance_thre_m2=0.5)
     base = cluster(p, (0.0, 3.0, 1.0), (0.0, 0.5, 0.0), n=19, spread=0.0)
     for factor, expected in ((0.999, 1), (1.001, 0)):
         # the 20th point √0.5·factor from the others along world x
@@ -174,7 +178,7 @@ def test_allocation_distance_threshold_exact():
 
 
 def test_allocation_velocity_spread_threshold():
-    p = replace(GtrackParams(), alloc_points=20, alloc_velocity_spread_mps=0.3)
+    p = replace(GtrackParams(), points_thre=19, max_vel_thre_mps=0.3)
     pts = cluster(p, (0.0, 3.0, 1.0), (0.0, 0.5, 0.0), n=20, spread=0.0)
     pts[:, 3] = 0.5
     pts[-1, 3] = 0.5 + 0.299
@@ -184,17 +188,17 @@ def test_allocation_velocity_spread_threshold():
 
 
 def test_obscured_snr_threshold_behind_a_track():
-    p = replace(GtrackParams(), alloc_points=20, alloc_snr=40.0, alloc_snr_obscured=100.0)
+    p = replace(GtrackParams(), points_thre=19, snr_thre=40.0, snr_thre_obscured=100.0)
     v = (0.0, 0.5, 0.0)
     near = cluster(p, (0.0, 2.0, 1.0), v, n=25, snr=5.0)
-    for snr, expected in ((4.0, 1), (5.0, 2)):  # sums 80 (< 100) and 100
+    for snr, expected in ((5.0, 1), (5.01, 2)):  # sums 100 (not above 100) and 100.2
         tr = GtrackTracker(p)
         step(tr, near)
         behind = cluster(p, (0.0, 4.5, 1.0), v, n=20, snr=snr)
         near2 = cluster(p, (0.0, 2.0 + 0.5 * p.frame_period_s, 1.0), v, n=25, snr=5.0)
         ft, _, _ = step(tr, np.vstack([near2, behind]))
         assert len(ft) == expected
-        # the same set beside the track (not behind it) needs only alloc_snr
+        # the same set beside the track (not behind it) needs only snr_thre
     tr = GtrackTracker(p)
     step(tr, near)
     beside = cluster(p, (2.5, 4.5, 1.0), v, n=20, snr=4.0)
@@ -206,7 +210,59 @@ def test_static_points_never_start_a_track():
     p = GtrackParams()
     pts = cluster(p, (0.0, 3.0, 1.0), (0.0, 0.0, 0.0), n=60, snr=50.0)
     assert np.all(pts[:, 3] == 0.0)
-    assert _allocated(replace(p, alloc_velocity_mps=0.0), pts) == 0
+    assert _allocated(replace(p, velocity_thre_mps=0.0), pts) == 0
+
+
+def _active_track(p, speed=0.5):
+    """A tracker with one ACTIVE track walking at (0, 3, 1) along y."""
+    tr = GtrackTracker(p)
+    v = (0.0, speed, 0.0)
+    for f in range(p.det2act):
+        step(tr, cluster(p, (0.0, 3.0 + speed * f * p.frame_period_s, 1.0), v, n=25))
+    assert tr.tracks[0].state == ACTIVE
+    return tr, (0.0, 3.0 + speed * p.det2act * p.frame_period_s, 1.0)
+
+
+@pytest.mark.parametrize(("static_y", "taken"), [((0.5, 7.5), True), ((5.0, 7.5), False)])
+def test_static_points_count_only_inside_the_static_box(static_y, taken):
+    # TI's gtrack: a zero-Doppler point in the boundary box is used only inside a static box
+    p = replace(GtrackParams(), det2act=2, static_y_min_m=static_y[0], static_y_max_m=static_y[1])
+    tr, c = _active_track(p, speed=0.15)  # slow: the still points' Doppler is in its gate
+    still = cluster(p, c, (0.0, 0.0, 0.0), n=10)
+    _, owner, _ = step(tr, still)
+    assert np.all(owner == (tr.tracks[0].id if taken else -1))
+
+
+def test_detect_track_needs_moving_points_to_go_active():
+    # static points keep no DETECT track alive: a hit needs a moving point
+    p = replace(GtrackParams(), det2act=3, det2free=2)
+    tr = GtrackTracker(p)
+    step(tr, cluster(p, (0.0, 3.0, 1.0), (0.0, 0.5, 0.0), n=25))
+    still = cluster(p, (0.0, 3.0, 1.0), (0.0, 0.0, 0.0), n=25)
+    ft, owner, _ = step(tr, still)
+    assert np.all(owner == tr.tracks[0].id) and tr.tracks[0].misses == 1
+    assert tr.tracks[0].state == DETECT
+    ft, _, _ = step(tr, still)
+    assert len(ft) == 0  # the second miss: det2free
+
+
+def test_radial_velocity_unrolled_to_the_prediction():
+    from core.tracking.gtrack.tracker import unroll
+
+    assert unroll(-4.0, 4.5, 4.6) == pytest.approx(5.2)  # -4.0 + 9.2
+    assert unroll(4.0, -4.5, 4.6) == pytest.approx(-5.2)
+    assert unroll(1.0, 0.8, 4.6) == pytest.approx(1.0)
+    # an aliased point (vr − 2 v_max) is gated and updates the track as the true one
+    p = replace(GtrackParams(), det2act=2)
+    runs = []
+    for alias in (0.0, -2 * p.max_radial_velocity_mps):
+        tr, c = _active_track(p)
+        pts = cluster(p, c, (0.0, 0.5, 0.0), n=25)
+        pts[::2, 3] += alias
+        ft, owner, _ = step(tr, pts)
+        assert np.all(owner == tr.tracks[0].id)
+        runs.append(ft.state[0])
+    np.testing.assert_allclose(runs[0], runs[1], atol=1e-9)
 
 
 # -- gating ----------------------------------------------------------------------------------
@@ -234,6 +290,17 @@ def test_gate_gain_threshold_exact(factor, taken):
     assert (owner[0] == tr.tracks[0].id) == taken
 
 
+def test_gate_leaves_doppler_out_but_the_score_keeps_it():
+    # TI's gate is the partial distance over range and angles; Doppler only scores
+    p = replace(GtrackParams(), gating_velocity_mps=0.0)
+    tr, _, zp, C = _probe_setup(p)
+    e = np.array([0.0, 0.0, 0.0, 1.0])
+    far = 3.0 * p.gating_gain / np.sqrt(e @ np.linalg.inv(C) @ e)  # 3 gates away in Doppler
+    z = zp + far * e
+    _, owner, _ = step(tr, np.array([[z[0], z[1], z[2], z[3], 5.0]]))
+    assert owner[0] == tr.tracks[0].id
+
+
 @pytest.mark.parametrize(("factor", "taken"), [(1.001, True), (0.999, False)])
 def test_gate_depth_limit_exact(factor, taken):
     p = replace(GtrackParams(), gating_gain=50.0)
@@ -243,6 +310,33 @@ def test_gate_depth_limit_exact(factor, taken):
     dy = abs(pw[1] - x_pred[1])
     assert abs(pw[0] - x_pred[0]) < 0.5 and abs(pw[2] - x_pred[2]) < 0.5
     tr.p = replace(p, gating_depth_m=2 * dy * factor)
+    _, owner, _ = step(tr, np.array([[z[0], z[1], z[2], z[3], 5.0]]))
+    assert (owner[0] == tr.tracks[0].id) == taken
+
+
+@pytest.mark.parametrize(
+    ("row", "axis", "field"), [(1, 0, "gating_width_m"), (2, 2, "gating_height_m")]
+)
+@pytest.mark.parametrize(("factor", "taken"), [(1.001, True), (0.999, False)])
+def test_gate_width_and_height_limits_exact(row, axis, field, factor, taken):
+    p = replace(GtrackParams(), gating_gain=50.0)
+    tr, x_pred, zp, _ = _probe_setup(p)
+    z = zp.copy()
+    z[row] += 0.08  # azimuth moves the point along x, elevation along z
+    pw = geo.sensor_to_world(geo.spherical_to_sensor(z[0], z[1], z[2])[None], tr.M, tr.h)[0]
+    off = abs(pw[axis] - x_pred[axis])
+    assert off > 0.1 and all(abs(pw[k] - x_pred[k]) < 0.9 for k in range(3))
+    tr.p = replace(p, **{field: 2 * off * factor})
+    _, owner, _ = step(tr, np.array([[z[0], z[1], z[2], z[3], 5.0]]))
+    assert (owner[0] == tr.tracks[0].id) == taken
+
+
+@pytest.mark.parametrize(("factor", "taken"), [(1.001, True), (0.999, False)])
+def test_gate_velocity_limit_exact(factor, taken):
+    p = replace(GtrackParams(), gating_gain=50.0)
+    tr, _, zp, _ = _probe_setup(p)
+    z = zp + np.array([0.0, 0.0, 0.0, 0.4])
+    tr.p = replace(p, gating_velocity_mps=2 * 0.4 * factor)
     _, owner, _ = step(tr, np.array([[z[0], z[1], z[2], z[3], 5.0]]))
     assert (owner[0] == tr.tracks[0].id) == taken
 
@@ -312,7 +406,7 @@ def test_resource_cfg_is_the_default_params():
 
 def test_cfg_round_trip_keeps_other_lines_and_values():
     base = "% head\nsensorStop\nchannelCfg 15 7 0\n" + RESOURCE.read_text() + "sensorStart\n"
-    p = replace(GtrackParams(), gating_gain=2.5, det2act=7, alloc_distance_m2=0.812345,
+    p = replace(GtrackParams(), gating_gain=2.5, det2act=7, max_distance_thre_m2=0.812345,
                 max_radial_velocity_mps=5.3, frame_period_s=0.1, static_y_max_m=6.25)  # fmt: skip
     text = replace_tracker_lines(base, cfg_lines(p))
     assert params_from_cfg(parse_ti_cfg(text)) == replace(p, max_radial_velocity_mps=5.3)
@@ -373,7 +467,7 @@ def test_params_json_unknown_key_is_refused():
     ("dims", "seed", "overrides"),
     [
         (3, 1, {}),
-        (3, 2, {"det2act": 1, "max_tracks": 5, "alloc_points": 8, "exit2free": 2}),
+        (3, 2, {"det2act": 1, "max_tracks": 5, "points_thre": 8, "exit2free": 2}),
         (2, 3, {"sensor_azimuth_tilt_deg": 10.0, "gating_velocity_mps": 0.0}),
     ],
 )
@@ -418,6 +512,44 @@ def test_track_cli_gtrack_runs_and_refuses_bad_cfg(tmp_path, capsys):
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "bad.cfg:1" in err and "'pointsThre'" in err
     assert main(["track", "--data", str(data), "--cfg", str(RESOURCE)]) == 2
+
+
+def test_track_cli_gtrack_tracks_csv_and_people(tmp_path, capsys):
+    import csv
+    import json
+
+    from core.formats.tracks_csv import TRACKS_HEADER
+    from core.tracking.synthetic import synthetic_dataset
+
+    ds = synthetic_dataset(0, 2, classes="a", n_frames=40)
+    data = ds.save(tmp_path / "d.npz")
+    # one point a frame: TI's pointsThre 0 and snrThre 0 let it start a track
+    params = tmp_path / "p.json"
+    params.write_text(json.dumps({"points_thre": 0, "snr_thre": 0.0, "det2act": 2}))
+    out, tracks = tmp_path / "r.json", tmp_path / "t.csv"
+    args = ["track", "--data", str(data), "--tracker", "gtrack", "--params", str(params)]
+    assert main([*args, "--out", str(out), "--tracks", str(tracks), "--people", "1"]) == 0
+    doc = json.loads(out.read_text())
+    per = doc["per_frame"]
+    assert per["frame"] == list(range(ds.n_frames))
+    assert per["confirmed"] == doc["active_per_frame"] and max(per["confirmed"]) >= 1
+    assert doc["without_positions"]["count"]["frames"] == ds.n_frames
+    assert doc["without_positions"]["nis"]["dof"] == 4  # [r, az, el, vr]
+    with tracks.open() as fh:
+        rows = list(csv.reader(fh))
+    assert tuple(rows[0]) == TRACKS_HEADER
+    body = rows[1:]
+    # one row per live track and frame; confirmed rows are the ACTIVE counts
+    assert len(body) == sum(per["confirmed"]) + sum(per["tentative"])
+    by_frame = np.bincount([int(r[0]) for r in body if r[3] == "confirmed"], minlength=ds.n_frames)
+    assert by_frame.tolist() == per["confirmed"]
+    assert all(r[9] == "" and r[6] != "" for r in body)  # no existence; gtrack's height
+    # ids unique over the file: the two trajectories' tracks do not share ids
+    runs = {}
+    for r in body:
+        runs.setdefault(int(r[2]), set()).add(int(r[0]) >= 40)
+    assert all(len(v) == 1 for v in runs.values())
+    assert main([*args, "--people", "-1"]) == 2
 
 
 def test_gtrack_search_space_rows_are_params_fields_with_ti_defaults():
@@ -488,7 +620,7 @@ def test_tune_tracker_gtrack_runs_a_study_and_gives_gtrack_params(tmp_path, caps
     assert code == 0
     out = json.loads(capsys.readouterr().out.strip().splitlines()[-1])
     got = GtrackParams.from_dict({**GtrackParams().to_dict(), **out["params"]})
-    assert isinstance(got.det2act, int) and isinstance(got.alloc_points, int)
+    assert isinstance(got.det2act, int) and isinstance(got.points_thre, int)
     assert np.isfinite(out["best_loss"]) and out["best_loss"] > 0
     # the chosen parameters track the walkers: the loss is the one gtrack gives them
     from core.dataset import Dataset

@@ -224,12 +224,26 @@ def test_no_module_restates_the_table() -> None:
 
 
 def test_a_room_file_without_model_is_not_read_as_gtrack() -> None:
-    # the room mode's allocation rows share names with gtrack's table: a room-mode parameter
-    # file without "model" is still the tracker's (CV by default), and gtrack's is gtrack's
+    # a room-mode parameter file without "model" is still the tracker's (CV by default), and
+    # gtrack's is gtrack's; gtrack's allocation rows carry TI's names (snr_thre, points_thre...)
+    # and a gtrack file with their earlier names (alloc_snr, alloc_points...) still reads
     from core.tracking.gtrack.params import GtrackParams
-    from core.tracking.space import GTRACK_SPACE, defaults, flat_params, tracker_params_dict
+    from core.tracking.space import (
+        GTRACK_LEGACY_NAMES,
+        GTRACK_SPACE,
+        defaults,
+        flat_params,
+        tracker_params_dict,
+    )
+
+    old_name = {v: k for k, v in GTRACK_LEGACY_NAMES.items()}
 
     room = tracker_params_dict(defaults("cv", "room"), "cv", "room")
     room.pop("model")
     assert set(flat_params(room)) == set(defaults("cv", "room"))
     assert set(flat_params(GtrackParams().to_dict())) == {b.name for b in GTRACK_SPACE}
+    assert not {b.name for b in GTRACK_SPACE} & set(defaults("cv", "room"))
+    legacy = {old_name.get(k, k): v for k, v in GtrackParams().to_dict().items()}
+    assert "alloc_snr" in legacy and "snr_thre" not in legacy
+    assert flat_params(legacy) == flat_params(GtrackParams().to_dict())
+    assert GtrackParams.from_dict({"alloc_points": 7}).points_thre == 7
