@@ -343,7 +343,12 @@ def reference_agreement(dataset: Dataset, estimates: Any) -> ReferenceComparison
 
 
 def trajectory_terms(
-    kind: str, estimates: Any, counts: np.ndarray | None, dataset: Dataset | None = None
+    kind: str,
+    estimates: Any,
+    counts: np.ndarray | None,
+    dataset: Dataset | None = None,
+    *,
+    nis_dof: int = NIS_DOF,
 ) -> list[tuple[float, float]]:
     """Per tracked trajectory, the value of a study objective without positions and its weight.
 
@@ -354,9 +359,11 @@ def trajectory_terms(
       complement of a positionless MOTA (missed and false tracks per frame, and every confirmed
       id beyond one per person as an identity switch); weight: the person-frames Σ_f n_f (a
       run without persons weighs 1 and scores its false tracks per frame).
-    - ``"nis"``: the fraction of the confirmed tracks' NIS samples outside the χ²₃ band (a
-      consistent filter: 5 %); weight: the samples. A trajectory without a sample scores 1
-      with weight 1 (a tracker that confirms nothing is not consistent, it is silent).
+    - ``"nis"``: the fraction of the confirmed tracks' NIS samples outside the χ² band of
+      ``nis_dof`` degrees of freedom (3, the paper tracker's [r, θ, v_r]; 4 for gtrack's 3-D
+      [r, az, el, v_r]; a consistent filter: 5 %); weight: the samples. A trajectory without
+      a sample scores 1 with weight 1 (a tracker that confirms nothing is not consistent, it
+      is silent).
     - ``"reference"``: the mean GOSPA (m; c = 1 m, p = 2) per frame between the confirmed
       tracks and the recording's reference layer (TI's own tracks); weight: the frames.
 
@@ -378,7 +385,7 @@ def trajectory_terms(
     if kind == "nis":
         from core.evaluation.consistency import chi2_band
 
-        lo, hi = chi2_band(NIS_DOF)
+        lo, hi = chi2_band(nis_dof)
         rec = estimates.record
         if rec is None:
             raise ValueError("the nis objective needs every track: with_tracks=True")

@@ -187,8 +187,6 @@ class TrackerLosses:
         )
 
     def losses(self, params: dict[str, Any], ks: Sequence[int]) -> list[TrajectoryScore]:
-        from core.evaluation import trajectory_loss_terms
-        from core.evaluation.robust import trajectory_capped_losses
         from core.tracking import TrackerParams, track_dataset
 
         if not len(ks):
@@ -198,8 +196,21 @@ class TrackerLosses:
         # person from the single-person estimate, as ever (the same numbers bit for bit); the
         # track ids and NIS of fragmentation and nis come from the kernel's record of every track
         several = self.dataset.n_persons > 1
-        record = self.without_positions in ("fragmentation", "nis", "reference")
-        est = track_dataset(self.dataset, tp, trajectories=list(ks), with_tracks=several or record)
+        est = track_dataset(
+            self.dataset, tp, trajectories=list(ks), with_tracks=several or self._record()
+        )
+        return self._scores(est)
+
+    def _record(self) -> bool:
+        """The objective needs every track of every frame (ids, NIS, the reference GOSPA)."""
+        return self.without_positions in ("fragmentation", "nis", "reference")
+
+    def _scores(self, est: Any, nis_dof: int | None = None) -> list[TrajectoryScore]:
+        """The trajectories' scores of the estimates ``est`` (``nis_dof``: the measurement's
+        dimension for the nis objective when not the paper tracker's 3)."""
+        from core.evaluation import trajectory_loss_terms
+        from core.evaluation.robust import trajectory_capped_losses
+
         n = len(est.trajectories)
         nan = [math.nan] * n
         terms = (
@@ -213,7 +224,8 @@ class TrackerLosses:
             from core.evaluation.counting import trajectory_terms
 
             counts = None if self.counts is None else self.counts[est.frame_index]
-            extra = trajectory_terms(self.without_positions, est, counts, self.dataset)
+            dof = {} if nis_dof is None else {"nis_dof": nis_dof}
+            extra = trajectory_terms(self.without_positions, est, counts, self.dataset, **dof)
         return [
             TrajectoryScore(float(value), float(mse), int(n_c), c, v, w)
             for (value, mse, n_c), c, (v, w) in zip(terms, capped, extra, strict=True)
@@ -236,23 +248,14 @@ class GtrackLosses(TrackerLosses):
         run_gtrack_compiled(np.zeros((0, 5)), np.zeros(2, dtype=np.int64), params)
 
     def losses(self, params: dict[str, Any], ks: Sequence[int]) -> list[TrajectoryScore]:
-        from core.evaluation import trajectory_loss_terms
-        from core.evaluation.robust import trajectory_capped_losses
         from core.tracking.gtrack import GtrackParams
         from core.tracking.gtrack.batch import gtrack_dataset
 
         if not len(ks):
             return []
         gp = GtrackParams.from_dict({**self.base_params, **params})
-        est, _ = gtrack_dataset(self.dataset, gp, trajectories=list(ks))
-        terms = trajectory_loss_terms(self.dataset, est)
-        capped = (
-            trajectory_capped_losses(self.dataset, est) if self.capped else [math.nan] * len(terms)
-        )
-        return [
-            TrajectoryScore(float(value), float(mse), int(n_c), c)
-            for (value, mse, n_c), c in zip(terms, capped, strict=True)
-        ]
+        est, _ = gtrack_dataset(self.dataset, gp, trajectories=list(ks), with_tracks=self._record())
+        return self._scores(est, nis_dof=gp.dims + 1)
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -417,11 +420,8 @@ def make_losses(objective: str, model: str, dataset: Any = None, **kwargs: Any) 
     if objective == "tracker":
         if dataset is None:
             raise InputError("objective 'tracker' needs a data set")
-        if model == GTRACK:
-            return GtrackLosses(
-                dataset, kwargs.get("base_params"), capped=bool(kwargs.get("capped", True))
-            )
-        return TrackerLosses(
+        cls = GtrackLosses if model == GTRACK else TrackerLosses
+        return cls(
             dataset,
             kwargs.get("base_params"),
             capped=bool(kwargs.get("capped", True)),

@@ -183,3 +183,33 @@ def test_tune_mixed_with_a_recording(tmp_path, capsys) -> None:
                  f"{rec}=1", "--people", "1", "--validation", str(val), "--storage", storage,
                  "--no-progress"])  # fmt: skip
     assert code == 2 and "mix" in capsys.readouterr().err
+
+
+def test_gtrack_objectives_without_positions_agree_with_its_scores() -> None:
+    """A gtrack study on a recording without truth scores count, fragmentation and nis (its
+    NIS against the χ² band of gtrack's 3-D measurement, 4 degrees of freedom), as `track
+    --tracker gtrack --people N` reports them."""
+    from core.optimization.objective import make_losses
+    from core.tracking.gtrack import GtrackParams
+    from core.tracking.gtrack.batch import gtrack_dataset
+    from core.tracking.space import GTRACK
+
+    ds = _no_truth(synthetic_dataset(2, 1, n_frames=120))
+    # one point a frame: allocation from a single point, so that tracks are confirmed
+    gp = dataclasses.replace(GtrackParams(), points_thre=1, snr_thre=0.0, max_distance_thre_m2=4.0)
+    est, _ = gtrack_dataset(ds, gp, with_tracks=True)
+    assert est.n_confirmed.mean() > 0.3
+    scores = recording_scores(ds, est, 0.08, people=1, nis_dof=4)
+    params = gp.to_dict()
+
+    def value(kind: str, people: int | None) -> float:
+        losses = make_losses(
+            "tracker", GTRACK, ds, capped=False, without_positions=kind, people=people
+        )
+        result = evaluate(losses, params, loss=kind)
+        assert math.isfinite(result.value), kind
+        return result.value
+
+    assert value("count", 1) == pytest.approx(scores.count.error, rel=1e-12)
+    assert value("nis", None) == pytest.approx(1.0 - scores.nis.inside, rel=1e-12)
+    assert value("fragmentation", 1) >= value("count", 1)
