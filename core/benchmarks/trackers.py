@@ -204,7 +204,12 @@ def _gtrack_study(
     import math
 
     from core.dataset import Dataset
-    from core.optimization.objective import evaluate, make_losses, uses_capped
+    from core.optimization.objective import (
+        evaluate,
+        make_losses,
+        uses_capped,
+        without_positions,
+    )
     from core.optimization.storage import load_existing_study, open_storage
     from core.optimization.study import StudySettings, prepare_study, run_worker
     from core.tracking.space import tracker_params_dict
@@ -225,7 +230,10 @@ def _gtrack_study(
     ]
     if not done:
         raise InputError(f"study {s.name}: no trial completed on {Path(train).name}")
-    losses = make_losses("tracker", "gtrack", dataset=Dataset.load(val), capped=uses_capped(loss))
+    losses = make_losses(
+        "tracker", "gtrack", dataset=Dataset.load(val), capped=uses_capped(loss),
+        without_positions=without_positions(loss), people=kw.get("people"),
+    )  # fmt: skip
     ranked = []
     for t in sorted(done, key=lambda t: (t.value, t.number))[:10]:
         params = tracker_params_dict({k: float(v) for k, v in t.params.items()}, "gtrack")
