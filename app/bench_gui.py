@@ -170,9 +170,6 @@ def run(quick: bool = False) -> dict:
         # ---- the 3-D view ----
         out["cloud3d"] = _cloud3d(qa, w, seconds=2.0 if quick else 5.0)
 
-        # ---- live sensor ----
-        out["live"] = _live(qa, w, tmp, seconds=10.0 if quick else 60.0)
-
         # ---- study ----
         n_trials = 4 if quick else 12
         w.study_model.set_form(n_trials=n_trials, n_jobs=1, storage=str(tmp / "study.db"))
@@ -192,6 +189,9 @@ def run(quick: bool = False) -> dict:
             errors=list(w.errors),
         )
         out["study"] = study
+
+        # ---- live sensor (last: its frames replace the scene's, on which the study runs) ----
+        out["live"] = _live(qa, w, tmp, seconds=10.0 if quick else 60.0)
     finally:
         w.shutdown()
         w.close()

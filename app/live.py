@@ -183,6 +183,11 @@ class LiveController(QtCore.QObject):
     def running(self) -> bool:
         return self._worker is not None and self._worker.isRunning()
 
+    @property
+    def owns_frames(self) -> bool:
+        """The window's frames are this link's (live or stopped), not the scene's simulation."""
+        return self._generation >= 0 and self._w.cache.generation == self._generation
+
     # ---- connect ----
     def connect_dialog(self) -> None:
         from app.connect_dialog import ConnectDialog

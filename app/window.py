@@ -577,6 +577,17 @@ class MainWindow(QtWidgets.QMainWindow):
         try:
             dataset = None
             if form.dataset == "scene":
+                shown = (
+                    "a recording" if self.recording.replaying
+                    else "the live sensor" if self.live.owns_frames
+                    else ""
+                )  # fmt: skip
+                if shown:
+                    raise InputError(
+                        f"the study tunes on the simulated scene, and the frames shown come from "
+                        f"{shown}: open or edit a scene to simulate it, or tune on a recording "
+                        "with radartune tune --dataset REC.npz --people N"
+                    )
                 if not self.cache.complete:
                     raise InputError("the scene is still being simulated; wait until it is done")
                 storage = Path(form.storage).expanduser().resolve()

@@ -74,9 +74,12 @@ def summary(result: dict) -> str:
             f"{platform}: first track {r['first_track_s']} s · slider→overlay median "
             f"{s['median']} ms ({s['min']}–{s['max']}, n={s['n']}) · playback 4x "
             f"{pb['4x']['redraws_per_s']} / 8x {pb['8x']['redraws_per_s']} redraws/s · study: "
-            f"longest gap {st['max_gap_ms']} ms, {st['n_gaps_over_100_ms']} over 100 ms "
+            f"{st.get('n_complete', 0) + st.get('n_pruned', 0)} of {st.get('n_trials', '?')} "
+            f"trials, longest gap {st['max_gap_ms']} ms, {st['n_gaps_over_100_ms']} over 100 ms "
             f"(idle: longest {r['idle']['max_gap_ms']} ms)"
         )
+        if st.get("errors"):  # a study that did not run measured nothing
+            lines.append(f"{platform}: the study did not run: {st['errors'][0]}")
         c3 = r.get("cloud3d")
         if c3:
             lines.append(

@@ -156,3 +156,24 @@ def test_a_study_resumed_from_an_older_storage_keeps_its_objective(tmp_path, mon
     for name in ("old-paper", "new"):
         start_study(StudyForm(storage=db, study_name=name), dataset_path=data)
     assert [s.loss for s in asked] == ["paper", DEFAULT_OBJECTIVE]
+
+
+def test_a_study_refuses_the_frames_of_a_live_link_in_one_line(
+    window, tmp_path, long_scene_frames, long_scene_doc, fill_cache
+) -> None:
+    """After a live session the window's frames are the sensor's, not the scene's: a study on
+    "the scene" would pair the sensor's frames with the scene's truth (it failed with
+    "Dataset.truth_t_s must have shape (1209,), got (116,)"); it is refused in one line, and a
+    scene simulated again is tuned on as before."""
+    scene, frames = long_scene_frames
+    fill_cache(window, long_scene_doc, frames)
+    window.cache.clear(expected=0, truth_paths=())  # what Connect does
+    window.live._generation = window.cache.generation
+    assert window.live.owns_frames
+    window.study_model.set_form(n_trials=2, n_jobs=1, storage=str(tmp_path / "live.db"))
+    window.start_study()
+    assert not window.study_model.running
+    assert len(window.errors) == 1 and "from the live sensor" in window.errors[0]
+    assert "\n" not in window.errors[0]
+    fill_cache(window, long_scene_doc, frames)  # the scene simulated again: a new generation
+    assert not window.live.owns_frames
