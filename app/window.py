@@ -88,43 +88,9 @@ class MainWindow(QtWidgets.QMainWindow):
         )
         self.study = StudyController(self.engine, self.study_model, parent=self)
 
-        # ---- views -----------------------------------------------------------------------------
-        self.top_view = TopView()
-        self.rd_view = RangeDopplerView()
-        self.psi_view = PsiView()
-        self.psi_view.has_truth = self.engine.has_truth
-        right = QtWidgets.QSplitter(QtCore.Qt.Vertical)
-        right.setObjectName("rightSplitter")
-        right.addWidget(self.rd_view)
-        right.addWidget(self.psi_view)
-        right.setSizes([350, 350])
-        central = QtWidgets.QSplitter(QtCore.Qt.Horizontal)
-        central.setObjectName("centralSplitter")
-        central.addWidget(self.top_view)
-        central.addWidget(right)
-        central.setSizes([620, 480])
-        self.central_splitter, self.right_splitter = central, right
-        self.compact = False
-        self.setCentralWidget(central)
+        self._build_central()
 
-        # ---- panels in docks -----------------------------------------------------------------
-        self.scene_panel = ScenePanel(self.scene_model, self.engine)
-        self.radar_panel = RadarPanel(self.radar_model)
-        self.tracker_panel = TrackerPanel(self.params_model)
-        self.study_panel = StudyPanel(self.study_model)
-        self.docks: dict[str, QtWidgets.QDockWidget] = {}
-        self._dock("Scene", self.scene_panel, QtCore.Qt.LeftDockWidgetArea)
-        self._dock("Radar", self.radar_panel, QtCore.Qt.LeftDockWidgetArea)
-        self._dock("Tracker", self.tracker_panel, QtCore.Qt.RightDockWidgetArea)
-        self._dock("Study", self.study_panel, QtCore.Qt.RightDockWidgetArea)
-        # fidelity level, processing settings and timing (app/panels/processing_panel)
-        self.processing_panel = ProcessingPanel(self.engine.fidelity_levels())
-        self._dock("Processing", self.processing_panel, QtCore.Qt.LeftDockWidgetArea)
-        self.tabifyDockWidget(self.docks["Radar"], self.docks["Processing"])
-        self.tabifyDockWidget(self.docks["Scene"], self.docks["Radar"])
-        self.tabifyDockWidget(self.docks["Tracker"], self.docks["Study"])
-        self.docks["Scene"].raise_()
-        self.docks["Tracker"].raise_()
+        self._build_docks()
 
         self.playback_control = PlaybackController(self.playback, self.cache, self)
         pc = self.playback_control  # the bar's widgets, as attributes of the window
@@ -159,7 +125,70 @@ class MainWindow(QtWidgets.QMainWindow):
 
         self.recording = RecordingController(self)
 
-        # ---- wiring ----------------------------------------------------------------------------
+        self._wire()
+
+        self._draw_timer = QtCore.QTimer(self)
+        self._draw_timer.setInterval(DRAW_INTERVAL_MS)
+        self._draw_timer.timeout.connect(self._draw)
+        self._draw_timer.start()
+        self._dirty = True
+        self._draw_times: deque[float] = deque(maxlen=60)
+        self._draw_costs_s: deque[float] = deque(maxlen=60)
+        self._track_ms_per_frame = float("nan")
+        self._t_timing_shown = 0.0
+        self.n_draws = 0
+
+        if restore:
+            self.restore_settings()
+        else:
+            self.fit_screen()
+        if load_scene:
+            self.scene_control.load_initial(scene_path)
+        freeze_heap()
+
+    # ---- construction helpers ----
+    def _build_central(self) -> None:
+        """The top view beside the range-Doppler and ψ views (the central splitters)."""
+        self.top_view = TopView()
+        self.rd_view = RangeDopplerView()
+        self.psi_view = PsiView()
+        self.psi_view.has_truth = self.engine.has_truth
+        right = QtWidgets.QSplitter(QtCore.Qt.Vertical)
+        right.setObjectName("rightSplitter")
+        right.addWidget(self.rd_view)
+        right.addWidget(self.psi_view)
+        right.setSizes([350, 350])
+        central = QtWidgets.QSplitter(QtCore.Qt.Horizontal)
+        central.setObjectName("centralSplitter")
+        central.addWidget(self.top_view)
+        central.addWidget(right)
+        central.setSizes([620, 480])
+        self.central_splitter, self.right_splitter = central, right
+        self.compact = False
+        self.setCentralWidget(central)
+
+    def _build_docks(self) -> None:
+        """The scene, radar, tracker, study and processing panels, each in a dock."""
+        self.scene_panel = ScenePanel(self.scene_model, self.engine)
+        self.radar_panel = RadarPanel(self.radar_model)
+        self.tracker_panel = TrackerPanel(self.params_model)
+        self.study_panel = StudyPanel(self.study_model)
+        self.docks: dict[str, QtWidgets.QDockWidget] = {}
+        self._dock("Scene", self.scene_panel, QtCore.Qt.LeftDockWidgetArea)
+        self._dock("Radar", self.radar_panel, QtCore.Qt.LeftDockWidgetArea)
+        self._dock("Tracker", self.tracker_panel, QtCore.Qt.RightDockWidgetArea)
+        self._dock("Study", self.study_panel, QtCore.Qt.RightDockWidgetArea)
+        # fidelity level, processing settings and timing (app/panels/processing_panel)
+        self.processing_panel = ProcessingPanel(self.engine.fidelity_levels())
+        self._dock("Processing", self.processing_panel, QtCore.Qt.LeftDockWidgetArea)
+        self.tabifyDockWidget(self.docks["Radar"], self.docks["Processing"])
+        self.tabifyDockWidget(self.docks["Scene"], self.docks["Radar"])
+        self.tabifyDockWidget(self.docks["Tracker"], self.docks["Study"])
+        self.docks["Scene"].raise_()
+        self.docks["Tracker"].raise_()
+
+    def _wire(self) -> None:
+        """Connect the models, controllers, panels and views."""
         self.scene_control.info_changed.connect(self._on_scene_info)
         self.processing_panel.fidelity_changed.connect(self.set_fidelity)
         self.radar_model.chain_changed.connect(self.set_chain)
@@ -198,26 +227,6 @@ class MainWindow(QtWidgets.QMainWindow):
         self.study_model.message.connect(lambda m: self.statusBar().showMessage(m, 8000))
         self.study_model.form_changed.connect(lambda _f: self.study.refresh())
 
-        self._draw_timer = QtCore.QTimer(self)
-        self._draw_timer.setInterval(DRAW_INTERVAL_MS)
-        self._draw_timer.timeout.connect(self._draw)
-        self._draw_timer.start()
-        self._dirty = True
-        self._draw_times: deque[float] = deque(maxlen=60)
-        self._draw_costs_s: deque[float] = deque(maxlen=60)
-        self._track_ms_per_frame = float("nan")
-        self._t_timing_shown = 0.0
-        self.n_draws = 0
-
-        if restore:
-            self.restore_settings()
-        else:
-            self.fit_screen()
-        if load_scene:
-            self.scene_control.load_initial(scene_path)
-        freeze_heap()
-
-    # ---- construction helpers ----
     def _dock(self, title: str, widget: QtWidgets.QWidget, area) -> None:
         scroll = QtWidgets.QScrollArea()
         scroll.setWidget(widget)

@@ -95,8 +95,16 @@ class ScenePanel(QtWidgets.QWidget):
         self.model = model
         self.engine = engine
         outer = QtWidgets.QVBoxLayout(self)
+        outer.addWidget(self._scene_box())
+        outer.addWidget(self._persons_box(engine))
+        outer.addWidget(self._reflectors_box())
+        outer.addStretch(1)
 
-        # ---- scene-wide -----------------------------------------------------------------------
+        self._wire(model)
+
+    # ---- construction ------------------------------------------------------------------------
+    def _scene_box(self) -> QtWidgets.QGroupBox:
+        """Seed, clutter density and the area of interest."""
         general = QtWidgets.QGroupBox("Scene")
         form = QtWidgets.QFormLayout(general)
         self.seed = QtWidgets.QSpinBox()
@@ -113,9 +121,10 @@ class ScenePanel(QtWidgets.QWidget):
         form.addRow("AOI min range", self.min_range)
         form.addRow("AOI max range", self.max_range)
         form.addRow("AOI max |azimuth|", self.max_az)
-        outer.addWidget(general)
+        return general
 
-        # ---- persons --------------------------------------------------------------------------
+    def _persons_box(self, engine) -> QtWidgets.QGroupBox:
+        """The person list and the selected person's trajectory, RCS and body model."""
         persons = QtWidgets.QGroupBox("Persons")
         pl = QtWidgets.QVBoxLayout(persons)
         self.person_list = QtWidgets.QListWidget()
@@ -134,7 +143,38 @@ class ScenePanel(QtWidgets.QWidget):
         pl.addLayout(row)
 
         self.stack = QtWidgets.QStackedWidget()
-        # class page
+        self.stack.addWidget(self._class_page(engine))
+        self.stack.addWidget(self._waypoint_page())
+        # explicit profile page
+        self.profile_label = QtWidgets.QLabel("explicit eq. (6) profile (edit the JSON file)")
+        self.profile_label.setWordWrap(True)
+        self.stack.addWidget(self.profile_label)
+        pl.addWidget(self.stack)
+        rcs_row = QtWidgets.QHBoxLayout()
+        self.fixed_rcs = QtWidgets.QCheckBox("fixed RCS")
+        self.fixed_rcs.setObjectName("fixedRcs")
+        self.rcs = _dspin(-40.0, 30.0, 1, "dBsm", "personRcs")
+        rcs_row.addWidget(self.fixed_rcs)
+        rcs_row.addWidget(self.rcs, 1)
+        pl.addLayout(rcs_row)
+        model_row = QtWidgets.QHBoxLayout()
+        model_row.addWidget(QtWidgets.QLabel("model"))
+        self.person_model = QtWidgets.QComboBox()
+        self.person_model.setObjectName("personModel")
+        self.person_model.addItems(list(PERSON_MODELS))
+        self.person_model.setToolTip(
+            "point: the paper's one scatterer; blob: 5 scatterers with micro-Doppler; "
+            "walking: 17 segments driven by Boulic's gait model (docs/scenes.md)"
+        )
+        self.height = _dspin(*PERSON_HEIGHT_RANGE_M, 2, "m", "personHeight")
+        self.height.setToolTip("body height of the walking model")
+        model_row.addWidget(self.person_model, 1)
+        model_row.addWidget(self.height, 1)
+        pl.addLayout(model_row)
+        return persons
+
+    def _class_page(self, engine) -> QtWidgets.QWidget:
+        """A person of a trajectory class: the class, its seed and its parameters."""
         class_page = QtWidgets.QWidget()
         cf = QtWidgets.QFormLayout(class_page)
         cf.setContentsMargins(0, 0, 0, 0)
@@ -166,8 +206,10 @@ class ScenePanel(QtWidgets.QWidget):
             spin.valueChanged.connect(self._on_class_edit)
             cf.addRow(spec.label, spin)
             self.class_params[spec.name] = spin
-        self.stack.addWidget(class_page)
-        # waypoint page
+        return class_page
+
+    def _waypoint_page(self) -> QtWidgets.QWidget:
+        """A person on waypoints: the table and drawing on the top view."""
         wp_page = QtWidgets.QWidget()
         wl = QtWidgets.QVBoxLayout(wp_page)
         wl.setContentsMargins(0, 0, 0, 0)
@@ -184,36 +226,10 @@ class ScenePanel(QtWidgets.QWidget):
         wrow.addWidget(self.draw_button)
         wrow.addWidget(self.del_wp_button)
         wl.addLayout(wrow)
-        self.stack.addWidget(wp_page)
-        # explicit profile page
-        self.profile_label = QtWidgets.QLabel("explicit eq. (6) profile (edit the JSON file)")
-        self.profile_label.setWordWrap(True)
-        self.stack.addWidget(self.profile_label)
-        pl.addWidget(self.stack)
-        rcs_row = QtWidgets.QHBoxLayout()
-        self.fixed_rcs = QtWidgets.QCheckBox("fixed RCS")
-        self.fixed_rcs.setObjectName("fixedRcs")
-        self.rcs = _dspin(-40.0, 30.0, 1, "dBsm", "personRcs")
-        rcs_row.addWidget(self.fixed_rcs)
-        rcs_row.addWidget(self.rcs, 1)
-        pl.addLayout(rcs_row)
-        model_row = QtWidgets.QHBoxLayout()
-        model_row.addWidget(QtWidgets.QLabel("model"))
-        self.person_model = QtWidgets.QComboBox()
-        self.person_model.setObjectName("personModel")
-        self.person_model.addItems(list(PERSON_MODELS))
-        self.person_model.setToolTip(
-            "point: the paper's one scatterer; blob: 5 scatterers with micro-Doppler; "
-            "walking: 17 segments driven by Boulic's gait model (docs/scenes.md)"
-        )
-        self.height = _dspin(*PERSON_HEIGHT_RANGE_M, 2, "m", "personHeight")
-        self.height.setToolTip("body height of the walking model")
-        model_row.addWidget(self.person_model, 1)
-        model_row.addWidget(self.height, 1)
-        pl.addLayout(model_row)
-        outer.addWidget(persons)
+        return wp_page
 
-        # ---- static reflectors ----------------------------------------------------------------
+    def _reflectors_box(self) -> QtWidgets.QGroupBox:
+        """The static reflectors (removed by the chain)."""
         refl = QtWidgets.QGroupBox("Static reflectors (removed by the chain)")
         rl = QtWidgets.QVBoxLayout(refl)
         self.reflectors = XYTable(["x [m]", "y [m]", "RCS [dBsm]"], "reflectorTable")
@@ -226,10 +242,10 @@ class ScenePanel(QtWidgets.QWidget):
         rrow.addWidget(self.add_refl)
         rrow.addWidget(self.del_refl)
         rl.addLayout(rrow)
-        outer.addWidget(refl)
-        outer.addStretch(1)
+        return refl
 
-        # ---- wiring ---------------------------------------------------------------------------
+    def _wire(self, model: SceneModel) -> None:
+        """Connect the fields to the scene model and back."""
         self.seed.valueChanged.connect(lambda v: self._edit(seed=int(v)))
         self.clutter.valueChanged.connect(lambda v: self._edit(clutter_density_per_m2=float(v)))
         for w in (self.min_range, self.max_range, self.max_az):
