@@ -187,6 +187,25 @@ def merge_tones(first: np.ndarray, amp: np.ndarray, steer: np.ndarray):
     return keep, amp_k, steer_k
 
 
+def merged_tones(radar, scatterers: Scatterers, antenna, group=None):
+    """The distinct tones of ``scatterers``: ``(keep, amp, steer, kept)``.
+
+    Each scatterer's received amplitude and steering vector, the scatterers that share a tone
+    (:func:`coincident_tones`, within ``group``) merged by :func:`merge_tones`; ``kept`` the
+    scatterers ``keep`` selects (``scatterers`` itself when nothing merged).
+    """
+    power = received_power_w(
+        radar, scatterers.range_m, scatterers.azimuth_rad, scatterers.rcs_dbsm, antenna
+    )
+    keep, amp, steer = merge_tones(
+        coincident_tones(scatterers.position_m, scatterers.velocity_mps, group),
+        signal_amplitude_v(radar, power),
+        steering_vectors(radar, scatterers),
+    )
+    kept = scatterers.take(keep) if len(keep) < len(scatterers) else scatterers
+    return keep, amp, steer, kept
+
+
 def visible(radar: RadarConfig, scatterers: Scatterers) -> np.ndarray:
     """``(N,)`` bool: in front of the antennas (|az| < 90 deg, the domain of eq. 1) and closer
     than the maximum range (the IF filter; beyond it complex sampling would alias the range)."""
@@ -204,30 +223,11 @@ def synthesize_signal(radar: RadarConfig, scatterers: Scatterers, antenna: Anten
         return out
     keep = visible(radar, scatterers)
     if not keep.all():
-        scatterers = Scatterers(
-            position_m=scatterers.position_m[keep],
-            velocity_mps=scatterers.velocity_mps[keep],
-            rcs_dbsm=scatterers.rcs_dbsm[keep],
-            source=scatterers.source[keep],
-        )
+        scatterers = scatterers.take(keep)
         if len(scatterers) == 0:
             return out
-    power = received_power_w(
-        radar, scatterers.range_m, scatterers.azimuth_rad, scatterers.rcs_dbsm, antenna
-    )
     # a tone shared by several scatterers (a wall ghost's two contributions) is generated once
-    keep, amp, steer = merge_tones(
-        coincident_tones(scatterers.position_m, scatterers.velocity_mps),
-        signal_amplitude_v(radar, power),
-        steering_vectors(radar, scatterers),
-    )
-    if len(keep) < len(scatterers):
-        scatterers = Scatterers(
-            position_m=scatterers.position_m[keep],
-            velocity_mps=scatterers.velocity_mps[keep],
-            rcs_dbsm=scatterers.rcs_dbsm[keep],
-            source=scatterers.source[keep],
-        )
+    keep, amp, steer, scatterers = merged_tones(radar, scatterers, antenna)
     ranges = chirp_ranges_m(radar, scatterers)
     # phase 4 pi R / lambda;  beat phase per sample 2 pi (2 S R / c) / Fs
     phase_per_m = 4 * np.pi / radar.wavelength_m

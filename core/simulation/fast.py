@@ -109,7 +109,7 @@ from core.processing.points import (
     points_kernel,
 )
 from core.simulation.antenna import AntennaGain
-from core.simulation.baseband import coincident_tones, merge_tones, steering_vectors
+from core.simulation.baseband import merged_tones
 from core.simulation.fast_cfar import cfar_arguments, cfar_range_bins
 from core.simulation.fast_model import (
     PATCH_THRESHOLD,
@@ -124,7 +124,6 @@ from core.simulation.fast_model import (
     twiddles,
 )
 from core.simulation.frame import FrameOutput
-from core.simulation.link import received_power_w, signal_amplitude_v
 from core.simulation.rng_kernels import (
     fill_normal,
     normal_l,
@@ -226,21 +225,7 @@ def tones(
     tone's first). ``amp`` ``(M,)`` V, ``theta`` ``(M,)`` beat tone rad/sample at mid-frame,
     ``slow``/``slow1`` :func:`slow_time_sequences`, ``steer`` ``(M, L)`` complex128.
     """
-    power = received_power_w(
-        radar, scatterers.range_m, scatterers.azimuth_rad, scatterers.rcs_dbsm, antenna
-    )
-    keep, amp, steer = merge_tones(
-        coincident_tones(scatterers.position_m, scatterers.velocity_mps, frame),
-        signal_amplitude_v(radar, power),
-        steering_vectors(radar, scatterers),
-    )
-    if len(keep) < len(scatterers):
-        scatterers = Scatterers(
-            position_m=scatterers.position_m[keep],
-            velocity_mps=scatterers.velocity_mps[keep],
-            rcs_dbsm=scatterers.rcs_dbsm[keep],
-            source=scatterers.source[keep],
-        )
+    keep, amp, steer, scatterers = merged_tones(radar, scatterers, antenna, frame)
     t_mid = 0.5 * radar.n_loops * radar.n_tx * radar.chirp_period_s
     r_mid = np.linalg.norm(scatterers.position_m + scatterers.velocity_mps * t_mid, axis=1)
     # theta = 2 pi (2 S R / c) / Fs   (rad per sample)

@@ -52,6 +52,15 @@ class Scatterers:
     def __len__(self) -> int:
         return len(self.rcs_dbsm)
 
+    def take(self, index: np.ndarray) -> Scatterers:
+        """The scatterers at ``index`` (a boolean mask or integer indices), in that order."""
+        return Scatterers(
+            position_m=self.position_m[index],
+            velocity_mps=self.velocity_mps[index],
+            rcs_dbsm=self.rcs_dbsm[index],
+            source=self.source[index],
+        )
+
     @classmethod
     def empty(cls) -> Scatterers:
         return cls(
