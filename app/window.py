@@ -569,8 +569,7 @@ class MainWindow(QtWidgets.QMainWindow):
             self._t_timing_shown = now
             costs = sorted(self._draw_costs_s)
             self.processing_panel.show_timing(
-                chain_ms=self.sim.ms_per_frame,
-                halves_ms=self.sim.ms_per_frame_halves,
+                frame=self.sim.frame_timing_ms,
                 track_ms=self._track_ms_per_frame,
                 draw_ms=costs[len(costs) // 2] * 1e3 if costs else float("nan"),
                 sim_fps=self.sim.rate_fps,

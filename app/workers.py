@@ -6,9 +6,12 @@ GUI thread never waits for them. Stale results (an older scene or parameter vect
 
 from __future__ import annotations
 
+import math
 import threading
 import time
 from collections import deque
+from collections.abc import Sequence
+from dataclasses import dataclass
 
 import numpy as np
 from PySide6 import QtCore
@@ -32,6 +35,43 @@ def freeze_heap() -> None:
     gc.freeze()
 
 
+@dataclass(frozen=True, slots=True, kw_only=True)
+class FrameTiming:
+    """Mean milliseconds per frame over the same frames: ``total`` = ``synthesis`` +
+    ``processing`` + ``other`` (``other``: the rest of the frame's wall time, the views' maps
+    and the hand-off). The parts are NaN where the level does not time them apart; all are NaN
+    before a frame."""
+
+    total: float = math.nan
+    synthesis: float = math.nan
+    processing: float = math.nan
+    other: float = math.nan
+    n_frames: int = 0
+
+
+def frame_timing(times_s: Sequence[tuple[float, float, float]]) -> FrameTiming:
+    """:class:`FrameTiming` of frames' (whole frame, synthesis, processing) seconds; the first
+    frame, which may compile kernels, is left out once there are others. Means, not medians,
+    so that the parts add up to the total over the same frames."""
+    rows = list(times_s)
+    if len(rows) > 1:
+        rows = rows[1:]
+    if not rows:
+        return FrameTiming()
+    a = np.array(rows, dtype=float) * 1e3
+    total = float(a[:, 0].mean())
+    if not np.isfinite(a[:, 1:]).all():
+        return FrameTiming(total=total, n_frames=len(rows))
+    synthesis, processing = float(a[:, 1].mean()), float(a[:, 2].mean())
+    return FrameTiming(
+        total=total,
+        synthesis=synthesis,
+        processing=processing,
+        other=total - synthesis - processing,
+        n_frames=len(rows),
+    )
+
+
 class SimulationWorker(QtCore.QThread):
     """Simulates a scene frame by frame; emits each frame as it is ready."""
 
@@ -48,11 +88,11 @@ class SimulationWorker(QtCore.QThread):
         self.fidelity = "exact"
         #: detection chain (core.config.ChainConfig; None: the paper's)
         self.chain = None
-        #: seconds per simulated frame (radar chain: synthesis and processing), latest last
-        self.frame_times_s: deque[float] = deque(maxlen=50)
-        #: (synthesis, processing) seconds of the same frames (NaN where the level does both in
-        #: one kernel)
-        self.half_times_s: deque[tuple[float, float]] = deque(maxlen=50)
+        #: (whole frame, synthesis, processing) seconds of each simulated frame, latest last:
+        #: the whole frame is the wall time from asking the engine for it to having it (radar
+        #: chain and the views' maps); synthesis and processing are its parts the chain timed
+        #: (NaN where the level does both in one kernel)
+        self.frame_times_s: deque[tuple[float, float, float]] = deque(maxlen=50)
 
     def stop(self) -> None:
         self._stop.set()
@@ -65,8 +105,7 @@ class SimulationWorker(QtCore.QThread):
             t0 = time.perf_counter()
             for frame in frames:
                 t1 = time.perf_counter()
-                self.frame_times_s.append(t1 - t0)  # synthesis + processing of one frame
-                self.half_times_s.append((frame.synthesis_s, frame.processing_s))
+                self.frame_times_s.append((t1 - t0, frame.synthesis_s, frame.processing_s))
                 if self._stop.is_set():
                     return
                 self.frame_ready.emit(self.generation, frame)
@@ -145,29 +184,10 @@ class SimulationController(QtCore.QObject):
         return self._worker is not None and self._worker.isRunning()
 
     @property
-    def ms_per_frame(self) -> float:
-        """Median radar-chain time per frame of the current simulation (NaN before a frame;
-        the first frame, which may compile kernels, is left out once there are others)."""
+    def frame_timing_ms(self) -> FrameTiming:
+        """Per-frame times of the current simulation's last frames (see :func:`frame_timing`)."""
         w = self._worker or (self._old[-1] if self._old else None)
-        times = list(w.frame_times_s) if w is not None else []
-        if len(times) > 1:
-            times = times[1:]
-        return float(np.median(times)) * 1e3 if times else float("nan")
-
-    @property
-    def ms_per_frame_halves(self) -> tuple[float, float]:
-        """Median synthesis and processing time per frame (ms; NaN where the level does not run
-        them apart, or before a frame), over the frames :attr:`ms_per_frame` uses."""
-        w = self._worker or (self._old[-1] if self._old else None)
-        halves = list(w.half_times_s) if w is not None else []
-        if len(halves) > 1:
-            halves = halves[1:]
-        if not halves:
-            return float("nan"), float("nan")
-        a = np.array(halves, dtype=float) * 1e3
-        if not np.isfinite(a).all():
-            return float("nan"), float("nan")
-        return float(np.median(a[:, 0])), float(np.median(a[:, 1]))
+        return frame_timing(list(w.frame_times_s) if w is not None else [])
 
     def _on_frame(self, generation: int, frame) -> None:
         if generation != self._cache.generation:

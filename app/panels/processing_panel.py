@@ -1,13 +1,18 @@
 """Processing panel: the simulator's fidelity level (editable: the scene is simulated again),
 the processing chain's settings (windows, static clutter removal, the two CFAR stages, the
-detection ranges, the angle FFT) as the chain runs them, and a timing table (radar chain, track,
-draw per frame; frames per second simulated and drawn)."""
+detection ranges, the angle FFT) as the chain runs them, and a timing table (a simulated frame
+and its parts, which add up to it; track and draw per frame; frames per second simulated and
+drawn)."""
 
 from __future__ import annotations
 
 import math
+from typing import TYPE_CHECKING
 
 from PySide6 import QtCore, QtWidgets
+
+if TYPE_CHECKING:
+    from app.workers import FrameTiming
 
 #: What each fidelity level is (docs/fidelity-models.md)
 FIDELITY_TEXT = {
@@ -75,12 +80,14 @@ class ProcessingPanel(QtWidgets.QWidget):
         time_form = QtWidgets.QFormLayout(time_box)
         self.timing_labels: dict[str, QtWidgets.QLabel] = {}
         for key, title, tip in (
-            ("chain", "simulate + process", "radar chain of one frame: baseband synthesis, FFTs, "
-             "CFAR, angle, point cloud (median of the last 50 frames)"),
+            ("chain", "simulate + process + views", "one frame from the engine, in all: the "
+             "three rows below add up to it (mean of the last 50 frames, the first left out)"),
             ("synthesis", "  simulate", "baseband synthesis and receiver noise of one frame "
              "(exact level; the fast and measurement levels do both halves in one kernel: –)"),
             ("processing", "  process", "range and Doppler FFTs, clutter removal, CFAR, angles "
              "and point cloud of one frame (exact level)"),
+            ("other", "  views, hand-off", "the rest of the frame's time: the range profile's "
+             "CFAR threshold, the micro-Doppler spectra and the frame's snapshot"),
             ("track", "track", "last re-track of the whole scene divided by its frames "
              "(tracker, ψ, gates, metrics)"),
             ("draw", "draw", "last redraw of the views (median of the last 60)"),
@@ -123,16 +130,17 @@ class ProcessingPanel(QtWidgets.QWidget):
     def show_timing(
         self,
         *,
-        chain_ms: float,
+        frame: FrameTiming,
         track_ms: float,
         draw_ms: float,
         sim_fps: float,
         draw_fps: int,
-        halves_ms: tuple[float, float] = (float("nan"), float("nan")),
     ) -> None:
-        self.timing_labels["chain"].setText(_ms(chain_ms))
-        self.timing_labels["synthesis"].setText(_ms(halves_ms[0]))
-        self.timing_labels["processing"].setText(_ms(halves_ms[1]))
+        """``frame``: the simulated frames' times (their parts add up to the total)."""
+        self.timing_labels["chain"].setText(_ms(frame.total))
+        self.timing_labels["synthesis"].setText(_ms(frame.synthesis))
+        self.timing_labels["processing"].setText(_ms(frame.processing))
+        self.timing_labels["other"].setText(_ms(frame.other))
         self.timing_labels["track"].setText(_ms(track_ms))
         self.timing_labels["draw"].setText(_ms(draw_ms))
         self.timing_labels["sim_fps"].setText("–" if sim_fps <= 0 else f"{sim_fps:.1f}")

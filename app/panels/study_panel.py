@@ -96,7 +96,7 @@ class StudyPanel(QtWidgets.QWidget):
         self.curve_plot = pg.PlotWidget()
         self.curve_plot.setObjectName("studyCurve")
         self.curve_plot.setTitle("best L_t so far")
-        self.curve_plot.setLabel("bottom", "wall-clock time", units="s")
+        self.curve_plot.setLabel("bottom", "busy time (idle gaps between runs left out)", units="s")
         self.curve_plot.setLabel("left", "loss L_t [m²]")
         self.curve_plot.setLogMode(y=True)
         left = self.curve_plot.getAxis("left")
