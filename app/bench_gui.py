@@ -1,7 +1,7 @@
 """The GUI benchmark behind ``radartune bench gui``: the real window on the paper scene, with a
 timer probe in the event loop.
 
-    python -m app.bench_gui --json OUT.json [--quick]
+    python -m app.bench_gui --json OUT.json [--quick] [--soak SECONDS]
 
 Measures (medians over repetitions, this machine is shared):
 
@@ -13,6 +13,9 @@ Measures (medians over repetitions, this machine is shared):
   frames sent against frames received;
 * **event-loop gaps while a study runs**: a 5 ms ``QTimer`` probe records its ticks; a gap is
   the time between two ticks (the longest, and how many exceed 100 ms).
+
+``--soak SECONDS``: the live link alone for that long (frames sent, received, dropped, damaged,
+latency, the process's memory before and after).
 
 Also the probe's gaps while idle (the reference of the same run). Settings go to a temporary
 file; the study to a temporary storage.
@@ -85,7 +88,16 @@ class Probe:
         }
 
 
-def run(quick: bool = False) -> dict:
+def _rss_bytes() -> int | None:
+    """The process's resident set size now (Linux ``/proc/self/statm``; None elsewhere)."""
+    try:
+        pages = int(Path("/proc/self/statm").read_text().split()[1])
+    except (OSError, ValueError, IndexError):
+        return None
+    return pages * os.sysconf("SC_PAGE_SIZE")
+
+
+def run(quick: bool = False, soak_s: float | None = None) -> dict:
     import pyqtgraph as pg
     from PySide6 import QtCore, QtWidgets
 
@@ -108,6 +120,9 @@ def run(quick: bool = False) -> dict:
         out["first_track_s"] = round(time.perf_counter() - t0, 2)
         out["scene_frames"] = len(w.cache)
         _wait(qa, lambda: False, 1.0)  # settle
+        if soak_s is not None:  # the live link alone, for as long as asked
+            out["soak"] = _live(qa, w, tmp, seconds=soak_s)
+            return out
 
         # ---- idle probe (reference) ----
         probe = Probe()
@@ -292,6 +307,7 @@ def _live(qa, w, tmp: Path, seconds: float, frame_period_s: float = 0.05) -> dic
             latencies.append(time.perf_counter() - received)
 
     w.redraw = redraw
+    rss_start = _rss_bytes()
     with SensorEmulator(capture, faults=Faults(), loop=True) as em:
         settings = LinkSettings(cli_port=em.cli_port, data_port=em.data_port, cfg=str(cfg))
         probe.start()
@@ -307,8 +323,10 @@ def _live(qa, w, tmp: Path, seconds: float, frame_period_s: float = 0.05) -> dic
         gaps = probe.stop()
         n_sent = em.n_packets_sent
     w.redraw = real_redraw
+    rss_end = _rss_bytes()
     lat = sorted(1e3 * x for x in latencies)
     record = tmp / "live.dat"
+    growth = None if rss_start is None or rss_end is None else rss_end - rss_start
     return {
         "seconds": round(elapsed, 1),
         "frame_period_ms": frame_period_s * 1e3,
@@ -326,6 +344,13 @@ def _live(qa, w, tmp: Path, seconds: float, frame_period_s: float = 0.05) -> dic
         },
         "record_bytes": record.stat().st_size if record.exists() else 0,
         "max_gap_ms": gaps["max_gap_ms"],
+        # the whole process's memory before the link and after it closed; the window keeps
+        # every frame received in its cache, so some growth a frame is expected
+        "rss_start_mb": None if rss_start is None else round(rss_start / 2**20, 1),
+        "rss_end_mb": None if rss_end is None else round(rss_end / 2**20, 1),
+        "rss_growth_kb_per_frame": (
+            None if growth is None else round(growth / 1024 / max(n_received, 1), 2)
+        ),
         "errors": list(w.errors),
     }
 
@@ -334,8 +359,9 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m app.bench_gui", description=__doc__)
     parser.add_argument("--json", required=True, help="write the figures here")
     parser.add_argument("--quick", action="store_true")
+    parser.add_argument("--soak", type=float, metavar="SECONDS", help="the live link alone")
     args = parser.parse_args(argv)
-    result = run(quick=args.quick)
+    result = run(quick=args.quick, soak_s=args.soak)
     result["qpa_platform"] = os.environ.get("QT_QPA_PLATFORM", "")
     Path(args.json).write_text(json.dumps(result, indent=1))
     return 0

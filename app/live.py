@@ -21,6 +21,7 @@ from app.data import FrameData, TrackFrame, TrackingResult
 from app.errors import log_exception, one_line
 from core.live import LinkSettings, LiveLink
 from core.pointcloud import PointCloud
+from core.tracking.history import TrackHistory
 
 
 class LiveTracks:
@@ -38,14 +39,7 @@ class LiveTracks:
     def __init__(self) -> None:
         self.frames: list[TrackFrame] = []
         self._est: list[tuple[float, float]] = []
-        # every track of every frame so far, sorted by (id, frame): ids, frame, xy, ψ, confirmed
-        self._sorted: tuple[np.ndarray, ...] = (
-            np.zeros(0, np.int64),
-            np.zeros(0, np.int64),
-            np.zeros((0, 2)),
-            np.zeros(0),
-            np.zeros(0, bool),
-        )
+        self._history = TrackHistory()
 
     def add(self, index: int, tracks) -> None:
         """The tracks (:class:`core.tracking.results.FrameTracks`) of frame ``index``; frames
@@ -59,21 +53,13 @@ class LiveTracks:
         self.frames.append(tf)
         e = tracks.estimate
         self._est.append(tuple(tf.xy_m[e]) if e >= 0 else (np.nan, np.nan))
-        if len(tf):
-            t = np.full(len(tf), index, dtype=np.int64)
-            new = (tf.track_id, t, tf.xy_m, tf.psi, tf.confirmed)
-            merged = [np.concatenate((a, b)) for a, b in zip(self._sorted, new)]
-            # the new rows are the latest frame: a stable sort by id keeps (id, frame) order
-            order = np.argsort(merged[0], kind="stable")
-            self._sorted = tuple(a[order] for a in merged)
+        self._history.add(index, tracks)
 
     def result(self, frame_period_s: float) -> TrackingResult:
+        from app.engine.tracking import curve_fields
+
         t0 = time.perf_counter()
         n_f = len(self.frames)
-        ids, t_idx, xy, psi, conf = self._sorted
-        # trails and ψ curves by track, then frame; a NaN between tracks breaks the curve
-        breaks = np.flatnonzero(np.diff(ids)) + 1
-        psi_t = np.insert(t_idx * frame_period_s, breaks, np.nan)
         est = np.array(self._est, dtype=float).reshape(n_f, 2)
         nan = np.full(n_f, np.nan)
         return TrackingResult(
@@ -83,13 +69,7 @@ class LiveTracks:
             running_loss=nan,
             running_rmse_m=nan,
             ospa_m=nan,
-            psi_t_s=psi_t,
-            psi_value=np.insert(psi, breaks, np.nan),
-            psi_confirmed_t_s=psi_t,
-            psi_confirmed_value=np.insert(np.where(conf, psi, np.nan), breaks, np.nan),
-            trail_t_index=t_idx,
-            trail_xy_m=xy,
-            trail_id=ids,
+            **curve_fields(self._history.curves(frame_period_s)),
             params_key="live",
             elapsed_s=time.perf_counter() - t0,
             engine="numpy",

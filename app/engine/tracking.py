@@ -14,6 +14,7 @@ import numpy as np
 
 from app.data import FrameData, ParamSpec, TrackFrame, TrackingResult
 from core.errors import InputError
+from core.tracking.history import TrackCurves, TrackHistory
 
 #: Non-optimised TrackerParams fields the tracker panel edits.
 EXTRA_FIELDS = ("p_g", "confirm_threshold", "delete_threshold", "clutter_density")
@@ -112,6 +113,19 @@ def load_tracker_file(path: str | os.PathLike) -> tuple[str, str, dict[str, floa
     return _tracker_params_class().load(path).mode, model, values, extra
 
 
+def curve_fields(curves: TrackCurves) -> dict[str, np.ndarray]:
+    """The trails and ψ curves as :class:`~app.data.TrackingResult` fields."""
+    return {
+        "psi_t_s": curves.psi_t_s,
+        "psi_value": curves.psi_value,
+        "psi_confirmed_t_s": curves.psi_t_s,
+        "psi_confirmed_value": curves.psi_confirmed_value,
+        "trail_t_index": curves.trail_t_index,
+        "trail_xy_m": curves.trail_xy_m,
+        "trail_id": curves.trail_id,
+    }
+
+
 def _truth0(frames: Sequence[FrameData]) -> np.ndarray:
     return np.array(
         [f.truth_xy_m[0] if len(f.truth_xy_m) else (np.nan, np.nan) for f in frames], dtype=float
@@ -188,28 +202,11 @@ def track(
     t0 = time.perf_counter()
     res, velocity_col = _run(frames, params, frame_period_s, engine)
     tfs, conf_list = [], []
-    ids_l, t_l, xy_l, psi_l, conf_l = [], [], [], [], []
-    for k, ft in enumerate(res.frames):
-        xy = np.asarray(ft.state, dtype=float)[:, :2].reshape(-1, 2)
-        confirmed = np.asarray(ft.confirmed, dtype=bool)
-        tfs.append(track_frame(ft, velocity_col=velocity_col))
-        conf_list.append(xy[confirmed])
-        ids_l.append(np.asarray(ft.ids, dtype=np.int64))
-        t_l.append(np.full(len(ft.ids), k, dtype=np.int64))
-        xy_l.append(xy)
-        psi_l.append(np.asarray(ft.psi, dtype=float))
-        conf_l.append(confirmed)
-    ids = np.concatenate(ids_l) if ids_l else np.zeros(0, dtype=np.int64)
-    t_idx = np.concatenate(t_l) if t_l else np.zeros(0, dtype=np.int64)
-    xy_all = np.concatenate(xy_l) if xy_l else np.zeros((0, 2))
-    psi = np.concatenate(psi_l) if psi_l else np.zeros(0)
-    conf = np.concatenate(conf_l) if conf_l else np.zeros(0, dtype=bool)
-    order = np.lexsort((t_idx, ids))
-    ids, t_idx, xy_all, psi, conf = ids[order], t_idx[order], xy_all[order], psi[order], conf[order]
-    breaks = np.flatnonzero(np.diff(ids)) + 1
-    psi_t = np.insert(t_idx * frame_period_s, breaks, np.nan)
-    psi_v = np.insert(psi, breaks, np.nan)
-    psi_c = np.insert(np.where(conf, psi, np.nan), breaks, np.nan)
+    for ft in res.frames:
+        tf = track_frame(ft, velocity_col=velocity_col)
+        tfs.append(tf)
+        conf_list.append(tf.xy_m[tf.confirmed])
+    curves = TrackHistory.of_frames(res.frames).curves(frame_period_s)
     has = np.asarray(res.has_estimate, dtype=bool)
     est = np.where(has[:, None], np.asarray(res.estimate_xy, dtype=float), np.nan)
     truth0 = _truth0(frames)
@@ -225,13 +222,7 @@ def track(
         running_loss=loss,
         running_rmse_m=rmse,
         ospa_m=ospa_per_frame(conf_list, [f.truth_xy_m for f in frames]),
-        psi_t_s=psi_t,
-        psi_value=psi_v,
-        psi_confirmed_t_s=psi_t,
-        psi_confirmed_value=psi_c,
-        trail_t_index=t_idx,
-        trail_xy_m=xy_all,
-        trail_id=ids,
+        **curve_fields(curves),
         params_key=key,
         elapsed_s=time.perf_counter() - t0,
         engine=engine,

@@ -14,6 +14,7 @@ OpenGL).
 from __future__ import annotations
 
 import json
+import math
 import os
 import shutil
 import subprocess
@@ -28,12 +29,14 @@ ROOT = Path(__file__).resolve().parents[2]
 XVFB_SCREEN = "1920x1080x24"
 
 
-def _run_app(platform: str, quick: bool) -> dict:
+def _run_app(platform: str, quick: bool, soak_s: float | None = None) -> dict:
     with tempfile.TemporaryDirectory(prefix="radartune-bench-gui-") as tmp:
         out = Path(tmp) / "gui.json"
         cmd = [sys.executable, "-m", "app.bench_gui", "--json", str(out)]
         if quick:
             cmd.append("--quick")
+        if soak_s is not None:
+            cmd += ["--soak", repr(float(soak_s))]
         env = dict(os.environ, QT_QPA_PLATFORM=platform)
         env["PYTHONPATH"] = os.pathsep.join(p for p in (str(ROOT), env.get("PYTHONPATH")) if p)
         if platform == "xcb":
@@ -45,7 +48,16 @@ def _run_app(platform: str, quick: bool) -> dict:
         return json.loads(out.read_text())
 
 
-def run(quick: bool = False) -> dict:
+def run(quick: bool = False, soak_s: float | None = None) -> dict:
+    """All figures; ``soak_s``: the live link alone for that many seconds (offscreen: the link
+    and the 2-D views need no OpenGL), written as ``soak``."""
+    if soak_s is not None:
+        if not (soak_s > 0 and math.isfinite(soak_s)):
+            raise InputError(f"--soak must be a positive number of seconds, got {soak_s!r}")
+        return {
+            "soak": _run_app("offscreen", quick, soak_s)["soak"],
+            "targets": {"live_latency_median_ms": 50, "live_dropped_frames": 0},
+        }
     result: dict[str, object] = {"offscreen": _run_app("offscreen", quick)}
     if shutil.which("xvfb-run"):
         result["xcb"] = _run_app("xcb", quick)
@@ -62,7 +74,28 @@ def run(quick: bool = False) -> dict:
     return result
 
 
+def _live_line(name: str, lv: dict) -> str:
+    lat = lv["latency_ms"]
+    line = (
+        f"{name} ({1e3 / lv['frame_period_ms']:g} frames/s, "
+        f"{lv['seconds']} s): last byte→drawn tracked median {lat['median']} ms "
+        f"(p90 {lat['p90']}, max {lat['max']}, "
+        f"{lv['frames_drawn_tracked']} frames drawn) · "
+        f"{lv['frames_received']} of {lv['frames_sent']} frames received, "
+        f"{lv['dropped']} dropped, {lv['damaged']} damaged · longest event-loop gap "
+        f"{lv['max_gap_ms']} ms"
+    )
+    if lv.get("rss_start_mb") is not None:
+        line += (
+            f" · RSS {lv['rss_start_mb']} → {lv['rss_end_mb']} MB "
+            f"({lv['rss_growth_kb_per_frame']} kB a frame received)"
+        )
+    return line
+
+
 def summary(result: dict) -> str:
+    if "soak" in result:
+        return _live_line("offscreen live link soak", result["soak"])
     lines = []
     for platform in ("offscreen", "xcb"):
         r = result.get(platform)
@@ -92,14 +125,5 @@ def summary(result: dict) -> str:
             )
         lv = r.get("live")
         if lv:
-            lat = lv["latency_ms"]
-            lines.append(
-                f"{platform} live link ({1e3 / lv['frame_period_ms']:g} frames/s, "
-                f"{lv['seconds']} s): last byte→drawn tracked median {lat['median']} ms "
-                f"(p90 {lat['p90']}, max {lat['max']}, "
-                f"{lv['frames_drawn_tracked']} frames drawn) · "
-                f"{lv['frames_received']} of {lv['frames_sent']} frames received, "
-                f"{lv['dropped']} dropped, {lv['damaged']} damaged · longest event-loop gap "
-                f"{lv['max_gap_ms']} ms"
-            )
+            lines.append(_live_line(f"{platform} live link", lv))
     return "\n".join(lines)

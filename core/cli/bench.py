@@ -11,6 +11,7 @@ from __future__ import annotations
 import argparse
 import datetime as dt
 import importlib
+import math
 import platform
 from pathlib import Path
 
@@ -87,6 +88,12 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--people", type=int, help="tune --recording: people in every frame (the head count)"
     )
+    p.add_argument(
+        "--soak",
+        type=float,
+        metavar="SECONDS",
+        help="gui: the live link alone at 20 frames/s for this long (written to gui-soak.json)",
+    )
     p.set_defaults(func=run)
 
 
@@ -99,6 +106,14 @@ def run(args: argparse.Namespace) -> int:
         from core.errors import InputError
 
         raise InputError(f"--recording and --people are for tune only, not {args.name!r}")
+    if getattr(args, "soak", None) is not None and args.name != "gui":
+        from core.errors import InputError
+
+        raise InputError(f"--soak is for gui only, not {args.name!r}")
+    if getattr(args, "soak", None) is not None and not (0 < args.soak < math.inf):
+        from core.errors import InputError
+
+        raise InputError(f"--soak must be a positive number of seconds, got {args.soak!r}")
     if args.render_only:
         return _render_only(args)
     if getattr(args, "lambda_only", False):
@@ -123,6 +138,9 @@ def run(args: argparse.Namespace) -> int:
                 for m, v in (("cv", args.params_cv), ("ca", args.params_ca))
                 if v
             ) + ("" if model == "point" else f" --person-model {model}")
+        if name == "gui" and getattr(args, "soak", None) is not None:
+            extra = {"soak_s": args.soak}
+            flags = f" --soak {args.soak:g}"
         result = module.run(quick=args.quick, **extra)
         result = {
             "benchmark": name,
@@ -143,6 +161,8 @@ def _result_stem(name: str, args: argparse.Namespace) -> str:
     """A benchmark result's file stem in ``--out-dir``: ``<name>[-quick]``; for fidelity
     :func:`~core.benchmarks.fidelity_report.result_name` of ``--person-model``, checked against
     the scene's person models (one-line InputError)."""
+    if name == "gui" and getattr(args, "soak", None) is not None:
+        return f"gui-soak{'-quick' if args.quick else ''}"
     if name == "tune" and getattr(args, "recording", None):
         return f"tune-recording{'-quick' if args.quick else ''}"
     if name != "fidelity":
