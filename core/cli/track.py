@@ -65,6 +65,12 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         help="room mode: boundary, static and presence boxes from a TI .cfg's boundaryBox, "
         "staticBoundaryBox and presenceBoundaryBox lines (default: none)",
     )
+    p.add_argument(
+        "--room",
+        metavar="ROOM_JSON",
+        help="room mode: the room's walls (a room file: walls/furniture/sensor, docs/rooms.md); "
+        "tentative tracks at a confirmed track's predicted wall ghosts are not confirmed",
+    )
     p.set_defaults(func=run)
 
 
@@ -86,9 +92,10 @@ def run(args: argparse.Namespace) -> int:
     if args.tracker == "gtrack":
         from core.cli.gtrack import run_track
 
-        if args.mode or args.zones:
+        if args.mode or args.zones or args.room:
             raise InputError(
-                "--mode and --zones set RadarTune's tracker; gtrack takes its boxes from --cfg"
+                "--mode, --zones and --room set RadarTune's tracker; gtrack takes its boxes "
+                "from --cfg"
             )
         return run_track(args)
     if args.cfg:
@@ -116,6 +123,13 @@ def run(args: argparse.Namespace) -> int:
         if params.mode != "room":
             raise InputError("--zones needs the room mode (--mode room)")
         zones = zones_from_cfg(args.zones)
+    if args.room:
+        from core.scene.room import Room
+        from core.tracking.zones import Zones
+
+        if params.mode != "room":
+            raise InputError("--room needs the room mode (--mode room)")
+        zones = replace(zones or Zones(), walls=Room.from_json(args.room).wall_segments())
     ds = Dataset.load(args.data)
     traj = None
     if args.trajectories:

@@ -188,6 +188,14 @@ class Room:
         """True when some wall reflects (a finite ``reflection_db``)."""
         return any(w.reflection > 0 for w in self.walls)
 
+    def wall_segments(self) -> tuple[tuple[float, float, float, float], ...]:
+        """The reflecting walls (absorbers left out) as x–y segments ``(x0, y0, x1, y1)``, m."""
+        return tuple(
+            (float(w.from_m[0]), float(w.from_m[1]), float(w.to_m[0]), float(w.to_m[1]))
+            for w in self.walls
+            if w.reflection > 0
+        )
+
     def furniture_scatterers(self) -> tuple[np.ndarray, np.ndarray]:
         """Room positions ``(5 K, 3)`` and RCS ``(5 K,)`` dBsm of the furniture's scatterers
         (each piece's RCS split evenly: ``sigma_k = sigma / 5``)."""

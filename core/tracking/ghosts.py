@@ -15,6 +15,12 @@ Tracks are visited in range order (nearest first), so a person in front is decid
 lies behind it. A candidate is neither confirmed nor counted while it is one (its existence runs
 on; it may be confirmed later if the rule no longer holds). Runs as plain Python and inside the
 compiled room kernel (``register_jitable``).
+
+Where the room's walls are known (:attr:`core.tracking.zones.Zones.walls`), the walls predict
+where each confirmed track's first-order ghosts appear (:func:`core.walls.ghost_points_xy`:
+three points per wall whose bounce is specular). A track that is not confirmed (a newborn or a
+tentative one) within ``r_ghost`` of such a point of a confirmed track that is no candidate
+itself is a ghost candidate too (:func:`wall_ghost_candidates`). Without walls nothing changes.
 """
 
 from __future__ import annotations
@@ -26,8 +32,9 @@ from numba.extending import register_jitable
 
 from core import jit_guard  # noqa: F401  (before any kernel compiles: see core/jit_guard.py)
 from core.tracking import ekf
+from core.walls import ghost_points_xy
 
-__all__ = ["ghost_candidates"]
+__all__ = ["ghost_candidates", "wall_ghost_candidates"]
 
 
 @register_jitable
@@ -82,3 +89,36 @@ def ghost_candidates(
             if strength[b] < strength[a]:
                 ghost[b] = True
                 break
+
+
+@register_jitable
+def wall_ghost_candidates(
+    X: np.ndarray,
+    confirmed: np.ndarray,
+    ghost: np.ndarray,
+    nt: int,
+    walls: np.ndarray,
+    radius: float,
+    pts: np.ndarray,
+) -> None:
+    """Flag the tracks that are not confirmed and lie within ``radius`` (m) of a predicted wall
+    ghost of a confirmed track that is no ghost candidate (among the first ``nt``).
+
+    ``walls`` (W, 7) :func:`core.walls.wall_lines`; ``pts`` scratch (≥ 3 W, 2). Without
+    walls (W = 0) nothing is touched.
+    """
+    if walls.shape[0] == 0:
+        return
+    r2 = radius * radius
+    for a in range(nt):
+        if not confirmed[a] or ghost[a]:
+            continue
+        n = ghost_points_xy(X[a, 0], X[a, 1], walls, pts)
+        for b in range(nt):
+            if confirmed[b] or ghost[b]:
+                continue
+            for i in range(n):
+                dx, dy = X[b, 0] - pts[i, 0], X[b, 1] - pts[i, 1]
+                if dx * dx + dy * dy <= r2:
+                    ghost[b] = True
+                    break

@@ -71,7 +71,7 @@ class TrackerParams:
     mode
         ``"paper"`` (the paper's one-point IPDA, :mod:`core.tracking.tracker`) or ``"room"``
         (people as groups of points, static points, ghosts: :mod:`core.tracking.room`).
-    static_velocity … ghost_velocity
+    static_velocity … ghost_radius
         The room tracker's own parameters (rows of :mod:`core.tracking.space`, units there);
         ignored by the paper mode and left out of its JSON.
     """
@@ -105,6 +105,7 @@ class TrackerParams:
     ghost_gap: float = parameter("ghost_gap").default
     ghost_bearing: float = parameter("ghost_bearing").default
     ghost_velocity: float = parameter("ghost_velocity").default
+    ghost_radius: float = parameter("ghost_radius").default
 
     def __post_init__(self) -> None:
         if self.model not in MODELS:

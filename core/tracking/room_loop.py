@@ -17,7 +17,7 @@ from numba.extending import register_jitable
 from core import jit_guard  # noqa: F401  (before any kernel compiles: see core/jit_guard.py)
 from core.tracking import ekf, initiation, ipda
 from core.tracking.allocation import allocate
-from core.tracking.ghosts import ghost_candidates
+from core.tracking.ghosts import ghost_candidates, wall_ghost_candidates
 from core.tracking.groups import (
     COL_AZ,
     COL_R,
@@ -73,9 +73,11 @@ class RoomConstants(NamedTuple):
     ghost_gap: float
     ghost_bearing: float
     ghost_velocity: float
+    ghost_radius: float
     static_frames: float
     boundary: np.ndarray
     static_boxes: np.ndarray
+    walls: np.ndarray
 
 
 def room_constants(params: TrackerParams, frame_period_s: float, zones: Zones) -> RoomConstants:
@@ -107,10 +109,12 @@ def room_constants(params: TrackerParams, frame_period_s: float, zones: Zones) -
         ghost_gap=float(params.ghost_gap),
         ghost_bearing=float(params.ghost_bearing),
         ghost_velocity=float(params.ghost_velocity),
+        ghost_radius=float(params.ghost_radius),
         # static_time in frames (T validated by TrackerConstants.build above)
         static_frames=float(params.static_time) / float(frame_period_s),
         boundary=zones.boundary_array(),
         static_boxes=zones.static_array(),
+        walls=np.ascontiguousarray(zones.wall_array()),
     )
 
 
@@ -230,6 +234,7 @@ def room_frames(
     member_ = np.zeros(m_max, dtype=np.int64)
     zm = np.zeros((cap + 1, 3))
     g_order = np.zeros(cap + 1, dtype=np.int64)
+    g_pts = np.zeros((3 * c.walls.shape[0] + 1, 2))
     work = group_work(d)
     FP = np.zeros((d, d))
     HP = np.zeros((3, d))
@@ -379,6 +384,7 @@ def room_frames(
                 X, conf, strength, nt, c.ghost_gap, c.ghost_bearing, c.ghost_velocity, ghost,
                 zm, g_order,
             )  # fmt: skip
+            wall_ghost_candidates(X, conf, ghost, nt, c.walls, c.ghost_radius, g_pts)
             for k in range(nt):
                 if not conf[k] and not ghost[k] and birth[k] < frame:
                     conf[k] = psi[k] >= c.confirm_threshold

@@ -8,8 +8,8 @@ positive-definite covariance (Cholesky succeeds), and no output may be NaN or In
 documented "no estimate" NaN.
 
 CV has 12 optimised parameters: all 2¹² = 4096 corners. CA has 14 (2¹⁴ = 16 384 corners); a
-seeded sample without replacement is run (2048 by default). The room mode adds its 11 rows
-(2²³ CV corners): a seeded sample runs on the room scenes (:func:`room_scenes`).
+seeded sample without replacement is run (2048 by default). The room mode adds its 12 rows
+(2²⁴ CV corners): a seeded sample runs on the room scenes (:func:`room_scenes`).
 """
 
 from __future__ import annotations

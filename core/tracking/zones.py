@@ -28,6 +28,7 @@ from numba.extending import register_jitable
 from core import jit_guard  # noqa: F401  (before any kernel compiles: see core/jit_guard.py)
 from core.errors import InputError
 from core.files import read_text
+from core.walls import wall_lines
 
 __all__ = ["Box", "Zones", "in_box", "in_any_box", "zones_from_cfg", "presence"]
 
@@ -68,11 +69,17 @@ class Zones:
         Static boxes (a track may live on zero-Doppler points inside one); empty: the boundary.
     presence
         Presence boxes (:func:`presence`).
+    walls
+        The room's reflecting walls, when known (``--room``), as x–y segments
+        ``(x0, y0, x1, y1)`` in m, the radar at the origin (as :mod:`core.scene.room` has them):
+        tentative tracks at their predicted ghost positions are ghost candidates
+        (:mod:`core.tracking.ghosts`).
     """
 
     boundary: Box | None = None
     static: tuple[Box, ...] = ()
     presence: tuple[Box, ...] = ()
+    walls: tuple[tuple[float, float, float, float], ...] = ()
 
     def __post_init__(self) -> None:
         if self.boundary is not None:
@@ -80,6 +87,18 @@ class Zones:
         for name in ("static", "presence"):
             boxes = tuple(_check_box(b, f"{name}[{i}]") for i, b in enumerate(getattr(self, name)))
             object.__setattr__(self, name, boxes)
+        walls = []
+        for i, w in enumerate(self.walls):
+            try:
+                seg = tuple(float(v) for v in w)
+            except (TypeError, ValueError):
+                seg = ()
+            if len(seg) != 4 or not all(math.isfinite(v) for v in seg):
+                raise InputError(f"walls[{i}] must be 4 finite numbers (x0, y0, x1, y1), got {w!r}")
+            if math.hypot(seg[2] - seg[0], seg[3] - seg[1]) <= 0.0:
+                raise InputError(f"walls[{i}] has zero length: {list(seg)}")
+            walls.append(seg)
+        object.__setattr__(self, "walls", tuple(walls))
 
     def boundary_array(self) -> np.ndarray:
         """(6,) float64 boundary box, infinite limits when none."""
@@ -90,12 +109,19 @@ class Zones:
         boxes = self.static or (self.boundary if self.boundary is not None else _ALL,)
         return np.array(boxes, dtype=np.float64).reshape(-1, 6)
 
+    def wall_array(self) -> np.ndarray:
+        """(W, 7) float64 lines of the walls (:func:`core.walls.wall_lines`)."""
+        return wall_lines(np.array(self.walls, dtype=np.float64).reshape(-1, 4))
+
     def to_dict(self) -> dict:
-        return {
+        d = {
             "boundary": list(self.boundary) if self.boundary is not None else None,
             "static": [list(b) for b in self.static],
             "presence": [list(b) for b in self.presence],
         }
+        if self.walls:
+            d["walls"] = [list(w) for w in self.walls]
+        return d
 
 
 @register_jitable

@@ -29,7 +29,7 @@ def _names(model: str, mode: str | None) -> tuple[str, ...]:
 @pytest.mark.parametrize(("model", "paper"), [("cv", PAPER_CV), ("ca", PAPER_CA)])
 def test_paper_mode_suggests_the_paper_rows_only_and_room_adds_the_eleven(model, paper):
     assert _names(model, None) == _names(model, "paper") == paper
-    assert len(ROOM_NAMES) == 11
+    assert len(ROOM_NAMES) == 12
     assert _names(model, "room") == (*paper, *ROOM_NAMES)
 
 

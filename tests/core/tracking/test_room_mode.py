@@ -259,7 +259,7 @@ def test_plain_python_and_compiled_agree(params):
 def test_room_parameters_join_the_search_space_and_stay_out_of_the_paper_mode():
     assert len(search_space("cv")) == 12 and len(search_space("ca")) == 14
     assert [p.name for p in search_space("cv", "room")][12:] == list(ROOM_NAMES)
-    assert len(ROOM_NAMES) == 11
+    assert len(ROOM_NAMES) == 12
     paper = TrackerParams.default()
     assert paper.mode == "paper" and not set(ROOM_NAMES) & set(paper.to_dict())
     d = ROOM.to_dict()

@@ -37,8 +37,8 @@ NAMES = {p.name for p in SEARCH_SPACE}
 
 
 def test_rows_are_unique_and_p0_follows_the_state() -> None:
-    # the paper's 14 rows, then the room tracker's 11
-    assert len(NAMES) == len(SEARCH_SPACE) == 25
+    # the paper's 14 rows, then the room tracker's 12
+    assert len(NAMES) == len(SEARCH_SPACE) == 26
     assert P0_NAMES == ("p0_00", "p0_11", "p0_22", "p0_33", "p0_44", "p0_55")
     for model in MODELS:
         assert len(p0_names(model)) == STATE_DIM[model]

@@ -179,14 +179,14 @@ def test_multi_person_scenes_sample_of_corners(model):
 
 
 def test_room_mode_corners_stay_healthy():
-    """A sample of the room mode's corners (its 11 rows with the paper's) on the four-people room
+    """A sample of the room mode's corners (its 12 rows with the paper's) on the four-people room
     scene: no unhealthy track, no non-finite output; the sweep notices a corrupted record."""
     from core.tracking.stability import _room_health, room_scenes
 
     ds = room_scenes(60, seed=0)["room, 4 people circling"]
     assert len(ds.frame) / ds.n_frames == 150  # four people, 25 points each, 50 clutter
     corners = all_corners("cv", 24, seed=1, mode="room")
-    assert len(corners[0]) == 23
+    assert len(corners[0]) == 24
     rep = sweep("cv", corners, ds, mode="room")
     assert rep.ok and rep.bad_track_frames == 0 and rep.nonfinite_outputs == 0
     assert rep.max_tracks_seen >= 1

@@ -1,0 +1,76 @@
+"""Where a wall makes the radar see a point a second time: the first-order ghost geometry.
+
+The one statement of it both the room tracker (predicted ghosts, :mod:`core.tracking.ghosts`)
+and the rooms of the scenes may use: walls are vertical planes given by their x–y segments, the
+radar at the origin of the x–y plane (as in :mod:`core.scene.room`). The image method's
+derivation is in :mod:`core.simulation.multipath`; docs/tracker.md "Predicted ghosts".
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba.extending import register_jitable
+
+from core import jit_guard  # noqa: F401  (before any kernel compiles: see core/jit_guard.py)
+
+__all__ = ["WALL_LINE_COLUMNS", "GHOSTS_PER_WALL", "wall_lines", "ghost_points_xy"]
+
+#: Columns of :func:`wall_lines`: a point on the wall, its unit normal, unit direction, length.
+WALL_LINE_COLUMNS = ("ax", "ay", "nx", "ny", "ex", "ey", "length")
+#: Predicted ghost points per wall (:func:`ghost_points_xy`).
+GHOSTS_PER_WALL = 3
+
+
+def wall_lines(segments: np.ndarray) -> np.ndarray:
+    """``(W, 7)`` float64 :data:`WALL_LINE_COLUMNS` of wall segments ``(W, 4)``
+    ``(x0, y0, x1, y1)`` in m (each at least a few mm long; :class:`core.scene.room.Wall`
+    checks it); ``(0, 7)`` without walls."""
+    s = np.asarray(segments, dtype=np.float64).reshape(-1, 4)
+    d = s[:, 2:4] - s[:, 0:2]
+    length = np.hypot(d[:, 0], d[:, 1])
+    e = d / length[:, None] if len(s) else d
+    return np.column_stack((s[:, 0], s[:, 1], -e[:, 1], e[:, 0], e[:, 0], e[:, 1], length))
+
+
+@register_jitable
+def ghost_points_xy(x: float, y: float, lines: np.ndarray, out: np.ndarray) -> int:
+    """Where the radar at the origin sees the first-order wall ghosts of a point S = (x, y).
+
+    With ``S' = S − 2 ((S − a)·n) n`` the image of S in wall (a, n) (horizontal plane), the
+    bounce paths are:
+
+    - radar → wall → S → radar and its reverse: length ``L = |S| + |S'|``; the radar sees a point
+      at range ``L / 2`` in the direction of the last leg, so two points: ``(L / 2) S / |S|``
+      (back from S) and ``(L / 2) S' / |S'|`` (back by the wall);
+    - radar → wall → S → wall → radar: length ``2 |S'|``, seen at S' itself.
+
+    A wall contributes only where its bounce is specular (the radar and S strictly on the same
+    side of its line, the reflection point ``t S'``, ``t = d_R / (d_R + d_S)`` with ``d`` the
+    distances to the line, inside the segment). Writes the points into ``out`` ``(≥ 3 W, 2)``
+    three per wall in wall order (back from S, back by the wall, double bounce); returns how
+    many it wrote.
+    """
+    n_out = 0
+    r = math.sqrt(x * x + y * y)
+    if r == 0.0:
+        return 0
+    for w in range(lines.shape[0]):
+        ax, ay, nx, ny = lines[w, 0], lines[w, 1], lines[w, 2], lines[w, 3]
+        d_r = -ax * nx - ay * ny  # the radar's signed distance to the wall's line
+        d_s = (x - ax) * nx + (y - ay) * ny
+        if d_r * d_s <= 0.0:
+            continue
+        ix, iy = x - 2.0 * d_s * nx, y - 2.0 * d_s * ny
+        t = d_r / (d_r + d_s)
+        u = (t * ix - ax) * lines[w, 4] + (t * iy - ay) * lines[w, 5]
+        if u < 0.0 or u > lines[w, 6]:
+            continue
+        ri = math.sqrt(ix * ix + iy * iy)
+        half = 0.5 * (r + ri)
+        out[n_out, 0], out[n_out, 1] = half * x / r, half * y / r
+        out[n_out + 1, 0], out[n_out + 1, 1] = half * ix / ri, half * iy / ri
+        out[n_out + 2, 0], out[n_out + 2, 1] = ix, iy
+        n_out += GHOSTS_PER_WALL
+    return n_out

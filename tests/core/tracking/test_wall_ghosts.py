@@ -1,0 +1,147 @@
+"""Predicted wall ghosts (the room tracker with known walls): the ghost geometry against numbers
+derived by hand, and a constructed ghost group at a confirmed track's predicted ghost is not
+confirmed while the same group away from it is; without walls nothing changes."""
+
+import math
+
+import numpy as np
+import pytest
+
+from core.errors import InputError
+from core.scene.room import Room, Wall
+from core.tracking.params import TrackerParams
+from core.tracking.room import room_points, run_room_tracker
+from core.tracking.zones import Zones
+from core.walls import ghost_points_xy, wall_lines
+
+T = 0.1
+ROOM = TrackerParams(
+    mode="room", static_velocity=0.02, body_sigma=0.3, body_velocity_sigma=0.5,
+    alloc_points=5.0, alloc_snr=60.0, alloc_distance=0.6, alloc_velocity=0.6, ghost_gap=0.5,
+    ghost_bearing=0.25, ghost_velocity=0.5, static_time=60.0, ghost_radius=0.5,
+)  # fmt: skip
+#: one wall along x = 3 m (beside the person)
+SIDE_WALL = (3.0, 0.0, 3.0, 8.0)
+
+
+def _ghosts(x, y, segments):
+    lines = wall_lines(np.array(segments, dtype=float))
+    out = np.zeros((3 * len(lines), 2))
+    return out[: ghost_points_xy(x, y, lines, out)]
+
+
+def test_ghost_points_of_one_wall_by_hand():
+    # S = (3, 4), wall y = 6: image S' = (3, 8); |S| = 5, |S'| = √73; half path (5 + √73) / 2
+    g = _ghosts(3.0, 4.0, [(-5.0, 6.0, 5.0, 6.0)])
+    half = (5.0 + math.sqrt(73.0)) / 2
+    np.testing.assert_allclose(g[0], (half * 0.6, half * 0.8), atol=1e-12)  # back from S
+    np.testing.assert_allclose(
+        g[1], (half * 3 / math.sqrt(73.0), half * 8 / math.sqrt(73.0)), atol=1e-12
+    )  # back by the wall, along S'
+    np.testing.assert_allclose(g[2], (3.0, 8.0), atol=1e-12)  # double bounce: S' itself
+    # a person straight ahead of a wall behind: all three on the boresight, at 6, 6 and 8 m
+    np.testing.assert_allclose(_ghosts(0.0, 4.0, [(-5.0, 6.0, 5.0, 6.0)]), [[0, 6], [0, 6], [0, 8]])
+    # the side wall x = 3 and S = (1, 3): S' = (5, 3), half path (√10 + √34) / 2
+    g = _ghosts(1.0, 3.0, [SIDE_WALL])
+    half = (math.sqrt(10.0) + math.sqrt(34.0)) / 2
+    np.testing.assert_allclose(g[1], np.array([5.0, 3.0]) * half / math.sqrt(34.0), atol=1e-12)
+
+
+def test_no_ghost_where_the_bounce_is_not_specular():
+    # the reflection point t S' (t = d_R / (d_R + d_S) = 6 / 8) of S = (3, 4) in y = 6 is
+    # (2.25, 6): outside a wall from x = 2.5 to 5, inside one from 2 to 5
+    assert len(_ghosts(3.0, 4.0, [(2.5, 6.0, 5.0, 6.0)])) == 0
+    assert len(_ghosts(3.0, 4.0, [(2.0, 6.0, 5.0, 6.0)])) == 3
+    # S behind the wall's line (the radar on the other side): no bounce
+    assert len(_ghosts(0.0, 7.0, [(-5.0, 6.0, 5.0, 6.0)])) == 0
+
+
+def test_room_wall_segments_leave_absorbers_out():
+    room = Room(
+        walls=(
+            Wall(from_m=(-3.0, 0.0), to_m=(-3.0, 8.0)),
+            Wall(from_m=(3.0, 0.0), to_m=(3.0, 8.0), reflection_db=-math.inf),
+        )
+    )
+    assert room.wall_segments() == ((-3.0, 0.0, -3.0, 8.0),)
+    with pytest.raises(InputError, match=r"walls\[0\]"):
+        Zones(walls=((0.0, 1.0, 2.0),))
+
+
+def cloud(cx, cy, *, n=8, vx=0.0, vy=0.0, snr=15.0, spread=0.1):
+    a = 2 * np.pi * np.arange(n) / n
+    x, y = cx + spread * np.cos(a), cy + spread * np.sin(a)
+    r = np.hypot(x, y)
+    return room_points(r, np.arctan2(x, y), (x * vx + y * vy) / r, x, y, np.ones(n),
+                       np.full(n, snr))  # fmt: skip
+
+
+def _person_and_wall_ghost(shift=(0.0, 0.0), n_f=40, start=5):
+    """A person walking along y at x = 1 and, from frame ``start``, a weaker group at the
+    person's predicted ghost back by the side wall (plus ``shift``), moving with the mirrored
+    velocity (the same here: the wall is parallel to the walk)."""
+    frames = []
+    for f in range(n_f):
+        px, py = 1.0, 2.0 + 0.5 * f * T
+        person = cloud(px, py, vy=0.5, snr=20.0)
+        if f < start:
+            frames.append(person)
+            continue
+        gx, gy = _ghosts(px, py, [SIDE_WALL])[1] + np.asarray(shift)
+        frames.append(np.vstack([person, cloud(gx, gy, n=6, vy=0.5, snr=12.0)]))
+    return frames
+
+
+@pytest.mark.parametrize("engine", ["numpy", "numba"])
+def test_a_group_at_the_predicted_ghost_is_not_confirmed(engine):
+    walls = Zones(walls=(SIDE_WALL,))
+    frames = _person_and_wall_ghost()
+    # the bearing rule alone does not catch it: ~1.0 rad from the person
+    g = _ghosts(1.0, 2.5, [SIDE_WALL])[1]
+    assert abs(math.atan2(g[0], g[1]) - math.atan2(1.0, 2.5)) > ROOM.ghost_bearing
+    res = run_room_tracker(frames, ROOM, T, walls, engine=engine)
+    assert res.n_tracks[8:].min() == 2  # both groups are tracked
+    assert res.n_confirmed[2:].max() == 1
+    last = res.frames[-1]
+    ghost = np.argmax(last.state[:, 0])  # the group by the wall (x ≈ 2.5)
+    assert last.ghost[ghost] and not last.confirmed[ghost]
+    assert last.confirmed[1 - ghost] and not last.ghost[1 - ghost]
+    # without walls it is confirmed and counted, and the run equals the one without the field
+    bare = run_room_tracker(frames, ROOM, T, Zones(), engine=engine)
+    assert bare.n_confirmed[-1] == 2
+    none = run_room_tracker(frames, ROOM, T, None, engine=engine)
+    np.testing.assert_array_equal(bare.n_confirmed, none.n_confirmed)
+    np.testing.assert_array_equal(bare.estimate_xy, none.estimate_xy)
+    # the same group 1.5 m nearer the radar (beyond r_ghost of every predicted point): counted
+    away = run_room_tracker(_person_and_wall_ghost(shift=(0.0, -1.5)), ROOM, T, walls,
+                            engine=engine)  # fmt: skip
+    assert away.n_confirmed[-1] == 2
+    # 0.3 m off the prediction: a ghost within r_ghost = 0.5 m, counted with r_ghost = 0.2 m
+    off = _person_and_wall_ghost(shift=(0.0, 0.3))
+    wide = run_room_tracker(off, ROOM, T, walls, engine=engine)
+    narrow_params = TrackerParams.from_dict(ROOM.to_dict() | {"ghost_radius": 0.2})
+    narrow = run_room_tracker(off, narrow_params, T, walls, engine=engine)
+    assert wide.n_confirmed[-1] == 1 and narrow.n_confirmed[-1] == 2
+
+
+def test_track_command_room_file(tmp_path, capsys):
+    import json
+
+    from core.cli import main
+    from core.tracking.synthetic import circling_paths, room_dataset
+
+    data = tmp_path / "room.npz"
+    room_dataset(*circling_paths(1, 30), seed=2).save(data)
+    room = tmp_path / "room.json"
+    room.write_text(json.dumps({"walls": [{"from_m": [3.0, 0.0], "to_m": [3.0, 8.0]}]}))
+    out = tmp_path / "t.json"
+    args = ["track", "--data", str(data), "--room", str(room), "--out", str(out)]
+    assert main([*args, "--mode", "room"]) == 0 and out.exists()
+    out.unlink()
+    capsys.readouterr()
+    # the walls need the room mode; a bad room file is one line naming the field, exit 2
+    assert main(args) == 2 and "--room needs the room mode" in capsys.readouterr().err
+    room.write_text(json.dumps({"walls": [{"from_m": [3.0, 0.0], "to_m": [3.0]}]}))
+    assert main([*args, "--mode", "room"]) == 2
+    err = capsys.readouterr().err
+    assert "room.json" in err and "walls[0].to_m" in err and not out.exists()
