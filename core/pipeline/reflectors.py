@@ -42,7 +42,8 @@ class Reflectors:
     extended: np.ndarray  # (n_persons,) bool: a body model (blob or walking) applies
     walking: np.ndarray  # (n_persons,) bool: the walking body (else the blob) where extended
     headings: dict[int, np.ndarray]
-    gait: dict[int, tuple[np.ndarray, np.ndarray, float]]  # walking: (phase, turn rate, height)
+    # walking: (phase, turn rate, height, seated frames or None)
+    gait: dict[int, tuple[np.ndarray, np.ndarray, float, np.ndarray | None]]
     run_rcs: bool
     run_clutter: bool
     run_static: bool
@@ -73,6 +74,7 @@ class Reflectors:
                 gait_phase(t_s[:n], q.trajectory.speed_mps, q.body_height_m, phase0),
                 heading_rates(t_s[:n], headings[i]),
                 q.body_height_m,
+                q.trajectory.seated,
             )
         fixed_rcs = np.array([np.nan if q.rcs_dbsm is None else q.rcs_dbsm for q in scene.persons])
         return cls(
@@ -285,7 +287,7 @@ class Reflectors:
         Returns positions and velocities ``(n, N_SEGMENTS, 3)`` and RCS ``(n, N_SEGMENTS)``
         (dBsm).
         """
-        phase, turn, height = self.gait[int(i)]
+        phase, turn, height, seated = self.gait[int(i)]
         pos, vel = walking_scatterers(
             xy,
             v,
@@ -294,6 +296,7 @@ class Reflectors:
             phase[frames],
             self.truth_t_s[frames],
             height,
+            None if seated is None else seated[frames],
         )
         # σ_segment = σ · share (linear power): the shares sum to 1, so the powers add up to σ
         return pos, vel, rcs[:, None] + 10 * np.log10(RCS_SHARES)[None, :]

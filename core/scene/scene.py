@@ -96,6 +96,8 @@ RCS_RANGE_DBSM = (-60.0, 60.0)
 WAYPOINT_SPEED_RANGE_MPS = (0.05, 3.0)
 #: A stop waypoint ``[x_m, y_m, 0, hold_s]`` holds for this long, s.
 WAYPOINT_HOLD_RANGE_S = (0.08, 600.0)
+#: A stop waypoint's 5th element ``[x_m, y_m, 0, hold_s, "sit"]``: the person sits for the hold.
+WAYPOINT_SIT = "sit"
 MAX_PROFILE_FRAMES = MAX_FRAMES
 MIN_SCATTERER_RANGE_M = 0.1
 #: The longest a class trajectory without ``duration_s`` lasts (classes c-e draw 6-20 s).
@@ -419,38 +421,48 @@ def _parse_class_trajectory(
         raise InputError(f"{where}: {exc.message}") from None
 
 
-def _parse_waypoint_row(row: Any, f: str, aoi: AOI) -> tuple[tuple[float, float, float], float]:
-    """One waypoint ``[x_m, y_m, speed_mps]`` or stop ``[x_m, y_m, 0, hold_s]``:
-    ``((x, y, speed), hold_s)``."""
-    if not isinstance(row, list) or len(row) not in (3, 4):
+def _parse_waypoint_row(
+    row: Any, f: str, aoi: AOI
+) -> tuple[tuple[float, float, float], float, bool]:
+    """One waypoint ``[x_m, y_m, speed_mps]``, stop ``[x_m, y_m, 0, hold_s]`` or seated stop
+    ``[x_m, y_m, 0, hold_s, "sit"]``: ``((x, y, speed), hold_s, sit)``."""
+    if not isinstance(row, list) or len(row) not in (3, 4, 5):
         raise InputError(
-            f"{f} must be [x_m, y_m, speed_mps] or a stop [x_m, y_m, 0, hold_s], got {row!r}"
+            f"{f} must be [x_m, y_m, speed_mps] or a stop [x_m, y_m, 0, hold_s] "
+            f'(+ "{WAYPOINT_SIT}" to sit), got {row!r}'
         )
     x, y = _number(row[0], f"{f}[0]"), _number(row[1], f"{f}[1]")
-    if len(row) == 4:
+    sit = False
+    if len(row) >= 4:
         _number(row[2], f"{f}[2] (speed_mps of a stop)", 0.0, 0.0)
         s, hold = 0.0, _number(row[3], f"{f}[3] (hold_s)", *WAYPOINT_HOLD_RANGE_S)
+        if len(row) == 5:
+            if row[4] != WAYPOINT_SIT:
+                raise InputError(f'{f}[4] (posture) must be "{WAYPOINT_SIT}", got {row[4]!r}')
+            sit = True
     else:
         s = _number(row[2], f"{f}[2] (speed_mps)", *WAYPOINT_SPEED_RANGE_MPS)
         hold = 0.0
     if not aoi.contains(np.array([x, y])):
         raise InputError(f"{f}: point ({x}, {y}) lies outside the AOI")
-    return (x, y, s), hold
+    return (x, y, s), hold, sit
 
 
 def _parse_waypoint_trajectory(spec: dict, where: str, aoi: AOI, dt: float) -> Trajectory:
-    """``{"waypoints": [[x, y, speed] | [x, y, 0, hold_s], ...]}``: straight legs and stops."""
+    """``{"waypoints": [[x, y, speed] | [x, y, 0, hold_s(, "sit")], ...]}``: straight legs and
+    stops (standing or seated)."""
     _check_keys(spec, ("waypoints",), where)
     w = spec["waypoints"]
     if not isinstance(w, list) or len(w) < 2:
         raise InputError(f"{where}.waypoints must list at least 2 [x_m, y_m, speed_mps]")
     if len(w) > MAX_FRAMES:
         raise InputError(f"{where}.waypoints lists {len(w)} points, more than {MAX_FRAMES}")
-    rows, holds = [], []
+    rows, holds, sits = [], [], []
     for i, row in enumerate(w):
-        point, hold = _parse_waypoint_row(row, f"{where}.waypoints[{i}]", aoi)
+        point, hold, sit = _parse_waypoint_row(row, f"{where}.waypoints[{i}]", aoi)
         rows.append(point)
         holds.append(hold)
+        sits.append(sit)
     if all(s == 0 for _, _, s in rows):
         raise InputError(f"{where}.waypoints: stops only; give some waypoint a speed")
     # the stops walked at the slowest speed given: an upper bound of the walking time
@@ -459,7 +471,12 @@ def _parse_waypoint_trajectory(spec: dict, where: str, aoi: AOI, dt: float) -> T
     _check_frames((waypoint_duration_s(np.array(walk)) + sum(holds)) / dt, where)
     try:
         if any(holds):
-            return stopping_waypoint_trajectory(np.array(rows), np.array(holds), frame_period_s=dt)
+            return stopping_waypoint_trajectory(
+                np.array(rows),
+                np.array(holds),
+                frame_period_s=dt,
+                sit=np.array(sits) if any(sits) else None,
+            )
         return waypoint_trajectory(np.array(rows), frame_period_s=dt)
     except InputError as exc:
         raise InputError(f"{where}: {exc.message}") from None

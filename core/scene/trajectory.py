@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -48,6 +48,9 @@ class Trajectory:
         Δt, s.
     trajectory_class
         ``"a"`` … ``"e"``, ``"drawn"`` (waypoints) or ``"profile"`` (explicit eq. (6) profile).
+    seated
+        ``None`` (standing or walking throughout) or shape ``(F,)`` bool: the frames where the
+        person sits (a ``sit`` stop of a drawn path; :mod:`core.scene.walking` seats the body).
     """
 
     position_m: np.ndarray
@@ -55,6 +58,7 @@ class Trajectory:
     acceleration_mps2: np.ndarray
     frame_period_s: float
     trajectory_class: str
+    seated: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         f = len(self.position_m)
@@ -66,6 +70,10 @@ class Trajectory:
                 raise InputError(f"trajectory {name} contains non-finite values")
         if f < 1:
             raise InputError("a trajectory needs at least one frame")
+        if self.seated is not None and np.shape(self.seated) != (f,):
+            raise ValueError(
+                f"Trajectory.seated must have shape ({f},), got {np.shape(self.seated)}"
+            )
 
     def __eq__(self, other: object) -> bool:
         if not isinstance(other, Trajectory):
@@ -76,6 +84,7 @@ class Trajectory:
             and np.array_equal(self.position_m, other.position_m)
             and np.array_equal(self.velocity_mps, other.velocity_mps)
             and np.array_equal(self.acceleration_mps2, other.acceleration_mps2)
+            and np.array_equal(self.seated_mask, other.seated_mask)
         )
 
     __hash__ = None  # type: ignore[assignment]
@@ -83,6 +92,13 @@ class Trajectory:
     @property
     def n_frames(self) -> int:
         return len(self.position_m)
+
+    @property
+    def seated_mask(self) -> np.ndarray:
+        """Shape ``(F,)`` bool: the frames where the person sits (all False if none)."""
+        if self.seated is None:
+            return np.zeros(self.n_frames, dtype=bool)
+        return np.asarray(self.seated, dtype=bool)
 
     @property
     def t_s(self) -> np.ndarray:
@@ -211,10 +227,16 @@ def waypoint_trajectory(waypoints: np.ndarray, *, frame_period_s: float = 0.08) 
 
 
 def stopping_waypoint_trajectory(
-    waypoints: np.ndarray, hold_s: np.ndarray, *, frame_period_s: float = 0.08
+    waypoints: np.ndarray,
+    hold_s: np.ndarray,
+    *,
+    frame_period_s: float = 0.08,
+    sit: np.ndarray | None = None,
 ) -> Trajectory:
     """A drawn path with stops: waypoints ``[x_m, y_m, speed_mps]``, where a waypoint of speed
-    0 is a stop of ``hold_s`` seconds (shape ``(W,)``; 0 elsewhere).
+    0 is a stop of ``hold_s`` seconds (shape ``(W,)``; 0 elsewhere). ``sit`` (shape ``(W,)``
+    bool, optional): the stops where the person sits for the hold (the trajectory's
+    ``seated`` frames are that hold's frames; the body sits down and stands up at once).
 
     Between stops the path is walked as :func:`waypoint_trajectory` walks it; a stop's own
     speed (0) is replaced by its walking neighbour's (the walk arrives and leaves at that
@@ -228,12 +250,15 @@ def stopping_waypoint_trajectory(
     stops = np.flatnonzero(w[:, 2] == 0)
     if not len(stops):
         return waypoint_trajectory(w, frame_period_s=dt)
+    sitting = np.zeros(len(w), dtype=bool) if sit is None else np.asarray(sit, dtype=bool)
     # pieces of the clock: ("hold", xy, duration) or ("walk", rows, duration)
     pieces: list[tuple[str, np.ndarray, float]] = []
+    sit_piece: list[bool] = []
     ends = sorted({0, len(w) - 1, *stops.tolist()})
     for a, b in zip(ends, [*ends[1:], None]):
         if w[a, 2] == 0:
             pieces.append(("hold", w[a, :2], float(hold[a])))
+            sit_piece.append(bool(sitting[a]))
         if b is None:
             break
         rows = w[a : b + 1].copy()
@@ -242,6 +267,7 @@ def stopping_waypoint_trajectory(
         if rows[-1, 2] == 0:
             rows[-1, 2] = rows[-2, 2] if rows[-2, 2] > 0 else _walking_speed(w, b)
         pieces.append(("walk", rows, float(_waypoint_segments(rows)[3][-1])))
+        sit_piece.append(False)
     t_end = np.cumsum([d for _, _, d in pieces])
     n_frames = int(math.floor(t_end[-1] / dt + 1e-9)) + 1
     if n_frames < 2:
@@ -265,7 +291,11 @@ def stopping_waypoint_trajectory(
         d = rows[1, :2] - rows[0, :2]
         if np.hypot(*d) > 0:
             vel[0] = d / np.hypot(*d) * rows[0, 2]
-    return _from_velocities(pos[0], vel, dt, "drawn")
+    traj = _from_velocities(pos[0], vel, dt, "drawn")
+    if not any(sit_piece):
+        return traj
+    seated = np.array(sit_piece)[piece]
+    return replace(traj, seated=seated)
 
 
 def _walking_speed(w: np.ndarray, i: int) -> float:

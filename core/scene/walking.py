@@ -38,6 +38,13 @@ What is approximated (docs/decisions/scene-06-walking-body.md):
   the body comes to rest continuously; a standing person sways (the body above the ankles
   ``+-1 cm`` at ``0.2 Hz``, the legs following by inverse kinematics) and breathes (chest
   ``+-3 mm`` at ``0.25 Hz``), both fading in as the speed falls below 0.3 m/s.
+- Sitting (a ``sit`` stop, the trajectory's ``seated`` frames): the body is seated at once (no
+  sitting-down or standing-up motion) on a seat at knee height: the hip joints at ``0.285 H``
+  (0.50 m for 1.75 m), the thighs horizontal forward, the shins vertical to the ankles at
+  ``0.039 H``, the feet flat; the torso, neck and head upright above the hips (the head's
+  centre at ``(0.285 - 0.530 + 0.935) H = 0.690 H``, 1.21 m; :func:`seated_joints`), the upper
+  arms hanging and the forearms forward, horizontal. The body above the seat sways as a standing one
+  does (``+-1 cm`` at ``0.2 Hz``; pelvis and legs still) and the chest breathes as standing.
 
 Segment lengths are fractions of the body height (Drillis & Contini 1966, as tabulated in D. A.
 Winter, *Biomechanics and Motor Control of Human Movement*, 4th ed., Wiley 2009, fig. 4.1):
@@ -296,7 +303,11 @@ def _knee(hip: np.ndarray, ankle: np.ndarray, height_m: float) -> tuple[np.ndarr
 
 
 def body_frame_joints(
-    phase: np.ndarray, speed_mps: np.ndarray, t_s: np.ndarray, height_m: float
+    phase: np.ndarray,
+    speed_mps: np.ndarray,
+    t_s: np.ndarray,
+    height_m: float,
+    seated: np.ndarray | None = None,
 ) -> dict[str, np.ndarray]:
     """Joint positions in the body frame ``(u, w, z)`` (z above the floor).
 
@@ -310,6 +321,8 @@ def body_frame_joints(
         Shape ``(F,)``: time, s (sway and breathing).
     height_m
         Body height, m.
+    seated
+        ``None`` or shape ``(F,)`` bool: frames where the body sits (:func:`seated_joints`).
 
     Returns
     -------
@@ -383,17 +396,73 @@ def body_frame_joints(
     sway_u = still * SWAY_AMPLITUDE_M * np.sin(two_pi * SWAY_HZ * t)
     sway_w = still * 0.5 * SWAY_AMPLITUDE_M * np.sin(two_pi * SWAY_HZ * 0.7 * t + 1.0)
 
-    return _joints(h, phi, rv, rv_w, legs, pel_u + sway_u, pel_w + sway_w, pel_z, alpha_p, alpha_t)
+    j = _joints(h, phi, rv, rv_w, legs, pel_u + sway_u, pel_w + sway_w, pel_z, alpha_p, alpha_t)
+    if seated is not None:
+        sit = np.asarray(seated, dtype=bool)
+        if sit.any():
+            # seated: full sway of the body above the seat (the person is still)
+            u = SWAY_AMPLITUDE_M * np.sin(two_pi * SWAY_HZ * t[sit])
+            w = 0.5 * SWAY_AMPLITUDE_M * np.sin(two_pi * SWAY_HZ * 0.7 * t[sit] + 1.0)
+            for name, rows in seated_joints(u, w, h).items():
+                j[name][sit] = rows
+    return j
+
+
+def seated_joints(
+    sway_u_m: np.ndarray, sway_w_m: np.ndarray, height_m: float
+) -> dict[str, np.ndarray]:
+    """Joint positions of the seated body in the body frame ``(u, w, z)``, shape ``(n, 3)``.
+
+    The hip joints on a seat at knee height ``KNEE_Z H`` (thighs horizontal forward, shins
+    vertical to the ankles at ``ANKLE_Z H``, feet flat forward), the pelvis at the origin of
+    ``(u, w)``; the trunk, neck and head upright above it, moved by the sway ``(sway_u_m,
+    sway_w_m)`` (shape ``(n,)``, m); the upper arms hanging, the forearms forward, horizontal.
+    """
+    h = float(height_m)
+    du = np.asarray(sway_u_m, dtype=np.float64)
+    dw = np.asarray(sway_w_m, dtype=np.float64)
+    n = len(du)
+    z_seat = KNEE_Z * h
+    hw, sw_half = 0.5 * HIP_WIDTH * h, 0.5 * SHOULDER_WIDTH * h
+    l_thigh = (HIP_Z - KNEE_Z) * h
+    l_ua, l_la = (SHOULDER_Z - ELBOW_Z) * h, (ELBOW_Z - WRIST_Z) * h
+
+    def at(u: float | np.ndarray, w: float | np.ndarray, z: float) -> np.ndarray:
+        out = np.empty((n, 3))
+        out[:, 0], out[:, 1], out[:, 2] = u, w, z
+        return out
+
+    z_neck = z_seat + (SHOULDER_Z - HIP_Z) * h
+    z_chin = z_neck + (CHIN_Z - SHOULDER_Z) * h
+    j = {
+        "pelvis": at(0.0, 0.0, z_seat),
+        "neck_base": at(du, dw, z_neck),
+        "chin": at(du, dw, z_chin),
+        "head_top": at(du, dw, z_chin + (1 - CHIN_Z) * h),
+    }
+    for side, sign in (("r", -1.0), ("l", 1.0)):
+        j[f"shoulder_{side}"] = at(du, dw + sign * sw_half, z_neck)
+        j[f"elbow_{side}"] = at(du, dw + sign * sw_half, z_neck - l_ua)
+        j[f"wrist_{side}"] = at(du + l_la, dw + sign * sw_half, z_neck - l_ua)
+        j[f"hip_{side}"] = at(0.0, sign * hw, z_seat)
+        j[f"knee_{side}"] = at(l_thigh, sign * hw, z_seat)
+        j[f"ankle_{side}"] = at(l_thigh, sign * hw, ANKLE_Z * h)
+        j[f"toe_{side}"] = at(l_thigh + TOE_PIVOT * h, sign * hw, 0.0)
+    return j
 
 
 def body_frame_segments(
-    phase: np.ndarray, speed_mps: np.ndarray, t_s: np.ndarray, height_m: float
+    phase: np.ndarray,
+    speed_mps: np.ndarray,
+    t_s: np.ndarray,
+    height_m: float,
+    seated: np.ndarray | None = None,
 ) -> np.ndarray:
     """Segment centres in the body frame ``(u, w, z)`` (z above the floor).
 
     Parameters
     ----------
-    phase, speed_mps, t_s, height_m
+    phase, speed_mps, t_s, height_m, seated
         As :func:`body_frame_joints`.
 
     Returns
@@ -402,7 +471,7 @@ def body_frame_segments(
         Shape ``(F, N_SEGMENTS, 3)``, m, in the order of :data:`SEGMENT_NAMES`: the midpoints
         of :data:`SEGMENT_ENDS` (the torso's moved by the breathing chest wall).
     """
-    joints = body_frame_joints(phase, speed_mps, t_s, height_m)
+    joints = body_frame_joints(phase, speed_mps, t_s, height_m, seated)
     out = np.empty((len(joints["pelvis"]), N_SEGMENTS, 3))
     for k, name in enumerate(SEGMENT_NAMES):
         a, b = SEGMENT_ENDS[name]
@@ -500,6 +569,7 @@ def walking_scatterers(
     phase: np.ndarray,
     t_s: np.ndarray,
     height_m: float,
+    seated: np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Segment centres and velocities in the radar's frame for frames of one person.
 
@@ -515,6 +585,8 @@ def walking_scatterers(
         Shape ``(F,)``: frame times (s).
     height_m
         Body height (m).
+    seated
+        ``None`` or shape ``(F,)`` bool: frames where the body sits.
 
     Returns
     -------
@@ -529,9 +601,9 @@ def walking_scatterers(
     speed = np.hypot(v[:, 0], v[:, 1])
     rate = 1.0 / cycle_duration_s(speed, height_m)  # dphi/dt
     dt = VELOCITY_STEP_S
-    local = body_frame_segments(phase, speed, t_s, height_m)
-    ahead = body_frame_segments(phase + rate * dt, speed, t_s + dt, height_m)
-    behind = body_frame_segments(phase - rate * dt, speed, t_s - dt, height_m)
+    local = body_frame_segments(phase, speed, t_s, height_m, seated)
+    ahead = body_frame_segments(phase + rate * dt, speed, t_s + dt, height_m, seated)
+    behind = body_frame_segments(phase - rate * dt, speed, t_s - dt, height_m, seated)
     d_local = (ahead - behind) / (2 * dt)
     sh, ch = np.sin(h)[:, None], np.cos(h)[:, None]
     lu, lw = local[..., 0], local[..., 1]
