@@ -21,7 +21,13 @@ from dataclasses import dataclass
 from typing import Any
 
 from core.errors import InputError
-from core.optimization.objective import evaluate, tracker_losses
+from core.optimization.objective import (
+    evaluate,
+    make_losses,
+    tracker_losses,
+    uses_capped,
+    without_positions,
+)
 from core.optimization.storage import load_existing_study, open_storage, redact
 
 #: Seed of the paper validation data set (training seeds must lie below it).
@@ -129,7 +135,7 @@ def validate_study(
         Sorted by validation objective (then trial number); empty when no trial completed.
     """
     from core.dataset import Dataset
-    from core.tracking.space import tracker_params_dict
+    from core.tracking.space import GTRACK, tracker_params_dict
 
     if top_k < 1:
         raise InputError(f"top_k must be >= 1, got {top_k}")
@@ -173,7 +179,14 @@ def validate_study(
     loss = objective_for(
         val_set, loss, str(attrs.get("recording_loss") or recording_objective(people)), people
     )
-    losses = tracker_losses(val_set, loss, people=people)
+    if model == GTRACK:  # gtrack's own loss source, with the study's fixed gtrack lines
+        losses = make_losses(
+            "tracker", model, val_set, capped=uses_capped(loss),
+            without_positions=without_positions(loss), people=people,
+            **dict(attrs.get("objective_options") or {}),
+        )  # fmt: skip
+    else:
+        losses = tracker_losses(val_set, loss, people=people)
     out = []
     for t in best:
         params = tracker_params_dict(

@@ -213,3 +213,23 @@ def test_gtrack_objectives_without_positions_agree_with_its_scores() -> None:
     assert value("count", 1) == pytest.approx(scores.count.error, rel=1e-12)
     assert value("nis", None) == pytest.approx(1.0 - scores.nis.inside, rel=1e-12)
     assert value("fragmentation", 1) >= value("count", 1)
+
+
+def test_tune_gtrack_on_a_recording_with_validation(tmp_path, capsys) -> None:
+    """`tune --tracker gtrack` on a recording without truth, chosen on a validation recording
+    (the validation tracked gtrack's trials with the paper tracker and stopped with "unknown
+    tracker parameter keys"); the chosen parameters are what `track --tracker gtrack` takes."""
+    train = _no_truth(synthetic_dataset(5, 1, n_frames=80)).save(tmp_path / "rec.npz")
+    val = _no_truth(synthetic_dataset(6, 1, n_frames=80)).save(tmp_path / "val.npz")
+    storage = f"sqlite:///{tmp_path / 'g.db'}"
+    code = main(["tune", "--tracker", "gtrack", "--trials", "3", "--dataset", str(train),
+                 "--people", "1", "--validation", str(val), "--storage", storage,
+                 "--study", "g", "--no-progress"])  # fmt: skip
+    captured = capsys.readouterr()
+    assert code == 0, captured.err
+    assert "chosen trial" in captured.err
+    out = json.loads(captured.out.strip().splitlines()[-1])
+    assert out["loss"] == "fragmentation" and 0 <= out["validation_value"]
+    p = tmp_path / "best.json"
+    p.write_text(json.dumps(out["params"]))
+    assert main(["track", "--tracker", "gtrack", "--data", str(val), "--params", str(p)]) == 0
