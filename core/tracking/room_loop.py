@@ -284,7 +284,8 @@ def room_frames(
                     rhos[k] = 1.0 / (4.0 * math.pi / 3.0 * c.gamma**1.5 * math.exp(0.5 * log_det))
                 else:
                     rhos[k] = c.rho
-                _gate_xy(XP[k], S, c.gamma, gc[k], gs[k])
+                if record:  # the gate's x–y picture is an output only
+                    _gate_xy(XP[k], S, c.gamma, gc[k], gs[k])
                 l00, l10, l11, l20, l21, l22 = L[0, 0], L[1, 0], L[1, 1], L[2, 0], L[2, 1], L[2, 2]
                 for j in range(m):
                     if not used[j]:
@@ -370,14 +371,14 @@ def room_frames(
                 height[nt] = zsum / n
                 npts[nt] = 0
                 nis[nt] = math.nan
-                # the newborn's gate: S₀ = H(x₀) P₀ H(x₀)ᵀ + R
-                ekf.jacobian_into(X[nt], H0)
-                mm(H0, P[nt], HP)
-                mm_nt(HP, H0, S)
-                for i in range(3):
-                    for j in range(3):
-                        S[i, j] += c.R[i, j]
-                _gate_xy(X[nt], S, c.gamma, gc[nt], gs[nt])
+                if record:  # the newborn's gate: S₀ = H(x₀) P₀ H(x₀)ᵀ + R
+                    ekf.jacobian_into(X[nt], H0)
+                    mm(H0, P[nt], HP)
+                    mm_nt(HP, H0, S)
+                    for i in range(3):
+                        for j in range(3):
+                            S[i, j] += c.R[i, j]
+                    _gate_xy(X[nt], S, c.gamma, gc[nt], gs[nt])
                 nt += 1
             # 6. ghosts, confirmation, deletion
             ghost_candidates(
