@@ -15,12 +15,44 @@ from numba.extending import register_jitable
 
 from core import jit_guard  # noqa: F401  (before any kernel compiles: see core/jit_guard.py)
 
-__all__ = ["WALL_LINE_COLUMNS", "GHOSTS_PER_WALL", "wall_lines", "ghost_points_xy"]
+__all__ = [
+    "WALL_LINE_COLUMNS",
+    "GHOSTS_PER_WALL",
+    "wall_lines",
+    "ghost_points_xy",
+    "scene_walls",
+]
 
 #: Columns of :func:`wall_lines`: a point on the wall, its unit normal, unit direction, length.
 WALL_LINE_COLUMNS = ("ax", "ay", "nx", "ny", "ex", "ey", "length")
 #: Predicted ghost points per wall (:func:`ghost_points_xy`).
 GHOSTS_PER_WALL = 3
+
+
+def scene_walls(scene: dict | list) -> tuple[tuple[float, float, float, float], ...]:
+    """The reflecting walls a data set's stored scene JSON carries (``Dataset.scene()``: one
+    scene or a list of them; written by :class:`core.scene.room.Room`, so already validated),
+    as x–y segments ``(x0, y0, x1, y1)``, absorbers (``reflection_db`` null) left out, as
+    :meth:`core.scene.room.Room.wall_segments` gives them. ``()`` when the scene has no walls (a
+    recording, the open field) or its scenes stand in different rooms (then only a room file
+    given to the tracker gives the walls)."""
+    scenes = scene if isinstance(scene, list) else [scene]
+    found = set()
+    for s in scenes:
+        walls = s.get("walls", []) if isinstance(s, dict) else []
+        found.add(
+            tuple(
+                (
+                    float(w["from_m"][0]),
+                    float(w["from_m"][1]),
+                    float(w["to_m"][0]),
+                    float(w["to_m"][1]),
+                )  # fmt: skip
+                for w in walls
+                if w.get("reflection_db", 0.0) is not None
+            )
+        )
+    return found.pop() if len(found) == 1 else ()
 
 
 def wall_lines(segments: np.ndarray) -> np.ndarray:

@@ -169,6 +169,7 @@ def dataset_frame_period_s(dataset: Dataset) -> float:
 
 _PREPARED: list = []  # single entry: (dataset, z, frame_offsets, trajectory_offsets, period)
 _ROOM_PREPARED: list = []  # single entry: (dataset, room points)
+_SCENE_WALLS: list = []  # single entry: (dataset, the walls of its scene)
 
 
 def _prepare(dataset: Dataset) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
@@ -207,6 +208,19 @@ def room_points_of(dataset: Dataset) -> np.ndarray:
     return pts
 
 
+def _scene_walls_of(dataset: Dataset) -> tuple:
+    """The walls of the data set's scene (:func:`core.walls.scene_walls`), read once
+    per data set (kept for the last one used)."""
+    entry = _SCENE_WALLS[0] if _SCENE_WALLS else None
+    if entry is not None and entry[0] is dataset:
+        return entry[1]
+    from core.walls import scene_walls
+
+    walls = scene_walls(dataset.scene())
+    _SCENE_WALLS[:] = [(dataset, walls)]
+    return walls
+
+
 def _selection(dataset: Dataset, trajectories: Sequence[int] | None) -> np.ndarray:
     k = dataset.n_trajectories
     if trajectories is None:
@@ -225,6 +239,7 @@ def track_dataset(
     engine: str = "numba",
     with_tracks: bool = False,
     zones: Zones | None = None,
+    walls_from_scene: bool = True,
 ) -> DatasetEstimates:
     """Track every selected trajectory of a data set from scratch.
 
@@ -241,7 +256,11 @@ def track_dataset(
     with_tracks
         Also return every confirmed track with its id (``tracks``); off on the optimiser's path.
     zones
-        The room's zones (room mode only; default: none, every point used).
+        The room's zones (room mode only; default: none, every point used). Without walls of
+        their own they take the walls of the data set's scene (a data set simulated in a room,
+        :func:`core.tracking.zones.with_scene_walls`).
+    walls_from_scene
+        False: the room mode ignores the walls of the data set's scene (only ``zones``'s).
 
     Returns
     -------
@@ -261,9 +280,11 @@ def track_dataset(
     )
     if params.mode == "room":
         from core.tracking.room import track_room_arrays
+        from core.tracking.zones import with_scene_walls
 
         out = track_room_arrays(
-            room_points_of(dataset), f_off, t_off, sel, params, period, zones,
+            room_points_of(dataset), f_off, t_off, sel, params, period,
+            with_scene_walls(zones, _scene_walls_of(dataset) if walls_from_scene else ()),
             record=with_tracks, engine=engine,
         )  # fmt: skip
         est_xy, has, psi, conf_xy, n_conf, n_tr = out[:6]

@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import math
 import os
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from numba.extending import register_jitable
@@ -30,7 +30,15 @@ from core.errors import InputError
 from core.files import read_text
 from core.walls import wall_lines
 
-__all__ = ["Box", "Zones", "in_box", "in_any_box", "zones_from_cfg", "presence"]
+__all__ = [
+    "Box",
+    "Zones",
+    "in_box",
+    "in_any_box",
+    "zones_from_cfg",
+    "presence",
+    "with_scene_walls",
+]
 
 Box = tuple[float, float, float, float, float, float]
 #: Everything: no limit on x, y, z.
@@ -122,6 +130,20 @@ class Zones:
         if self.walls:
             d["walls"] = [list(w) for w in self.walls]
         return d
+
+
+def with_scene_walls(
+    zones: Zones | None, walls: tuple[tuple[float, float, float, float], ...]
+) -> Zones | None:
+    """``zones`` with the walls of the data set's scene (:func:`core.walls.scene_walls`) when
+    it gives none itself: a data set simulated in a room carries its room, so the room mode
+    predicts its ghosts without ``--room``; walls given (``--room``) win; ``zones`` unchanged
+    without walls."""
+    if zones is not None and zones.walls:
+        return zones
+    if not walls:
+        return zones
+    return Zones(walls=walls) if zones is None else replace(zones, walls=walls)
 
 
 @register_jitable

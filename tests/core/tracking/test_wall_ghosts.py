@@ -145,3 +145,75 @@ def test_track_command_room_file(tmp_path, capsys):
     assert main([*args, "--mode", "room"]) == 2
     err = capsys.readouterr().err
     assert "room.json" in err and "walls[0].to_m" in err and not out.exists()
+
+
+def _as_dataset(frames, scene: dict):
+    """Room frames ((m, 7) :data:`core.tracking.groups.COLUMNS`) as a one-trajectory data set
+    with the given scene JSON."""
+    import json
+
+    from core.dataset import Dataset
+    from core.pointcloud import PointCloud
+
+    clouds = [
+        PointCloud(
+            range_m=z[:, 0],
+            azimuth_rad=z[:, 1],
+            elevation_rad=np.arctan2(z[:, 5], z[:, 0]),
+            radial_velocity_mps=z[:, 2],
+            snr_db=z[:, 6],
+            x_m=z[:, 3],
+            y_m=z[:, 4],
+            z_m=z[:, 5],
+            source=np.zeros(len(z), dtype=np.int32),
+        )  # fmt: skip
+        for z in frames
+    ]
+    n_f = len(frames)
+    return Dataset.from_frames(
+        clouds=clouds, trajectory=np.zeros(n_f, dtype=np.int64), truth_t_s=np.arange(n_f) * T,
+        truth_xy_m=np.zeros((n_f, 1, 2)), truth_v_mps=np.zeros((n_f, 1, 2)),
+        trajectory_class=["drawn"], scene_json=json.dumps(scene),
+        radar_json=json.dumps({"frame_period_s": T}),
+    )  # fmt: skip
+
+
+def test_a_data_set_simulated_in_a_room_gives_the_room_mode_its_walls():
+    """The walls a data set's scene carries reach the room mode without ``--room``: the
+    constructed wall ghost is not counted, as with the walls given, and is without them; walls
+    given win; a scene without walls (a recording) or scenes in different rooms give none."""
+    from core.tracking import track_dataset
+    from core.walls import scene_walls
+
+    room = Room(walls=(Wall(from_m=SIDE_WALL[:2], to_m=SIDE_WALL[2:]),))
+    # as the room reads it: absorbers left out
+    mixed = Room(walls=(*room.walls, Wall(from_m=(-3.0, 0.5), to_m=(-3.0, 9.0),
+                                          reflection_db=-math.inf)))  # fmt: skip
+    assert scene_walls(mixed.to_dict()) == mixed.wall_segments() == (SIDE_WALL,)
+    frames = _person_and_wall_ghost()
+    in_room = _as_dataset(frames, {"persons": []} | room.to_dict())
+    recording = _as_dataset(frames, {"imported": {"format": "people-csv"}})
+    assert scene_walls(in_room.scene()) == (SIDE_WALL,)
+    assert scene_walls(recording.scene()) == ()
+
+    def run(d, **kw):
+        e = track_dataset(d, ROOM, **kw)
+        return e.n_confirmed, e.estimate_xy
+
+    auto = run(in_room)
+    assert auto[0][2:].max() == 1  # the ghost group is not counted
+    for a, b in zip(auto, run(recording, zones=Zones(walls=(SIDE_WALL,))), strict=True):
+        np.testing.assert_array_equal(a, b)
+    bare = run(recording)
+    assert bare[0][-1] == 2  # a recording has no walls: the ghost group is counted
+    for a, b in zip(run(in_room, walls_from_scene=False), bare, strict=True):
+        np.testing.assert_array_equal(a, b)
+    # walls given win over the scene's: a wall far away predicts no ghost here
+    far = Zones(walls=((-6.0, 0.5, -6.0, 9.0),))
+    for a, b in zip(run(in_room, zones=far), run(recording, zones=far), strict=True):
+        np.testing.assert_array_equal(a, b)
+    assert run(in_room, zones=far)[0][-1] == 2
+    # scenes in different rooms give none; in the same room, its walls
+    other = Room(walls=(Wall(from_m=(-3.0, 0.5), to_m=(-3.0, 9.0)),))
+    assert scene_walls([room.to_dict(), other.to_dict()]) == ()
+    assert scene_walls([room.to_dict(), room.to_dict()]) == (SIDE_WALL,)
