@@ -14,6 +14,7 @@ import numpy as np
 from numba.extending import register_jitable
 
 from core import jit_guard  # noqa: F401  (before any kernel compiles: see core/jit_guard.py)
+from core.errors import InputError
 
 __all__ = [
     "WALL_LINE_COLUMNS",
@@ -31,27 +32,30 @@ GHOSTS_PER_WALL = 3
 
 def scene_walls(scene: dict | list) -> tuple[tuple[float, float, float, float], ...]:
     """The reflecting walls a data set's stored scene JSON carries (``Dataset.scene()``: one
-    scene or a list of them; written by :class:`core.scene.room.Room`, so already validated),
-    as x–y segments ``(x0, y0, x1, y1)``, absorbers (``reflection_db`` null) left out, as
-    :meth:`core.scene.room.Room.wall_segments` gives them. ``()`` when the scene has no walls (a
-    recording, the open field) or its scenes stand in different rooms (then only a room file
-    given to the tracker gives the walls)."""
+    scene or a list of them, as :class:`core.scene.room.Room` writes them), as x–y segments
+    ``(x0, y0, x1, y1)``, absorbers (``reflection_db`` null) left out, as
+    :meth:`core.scene.room.Room.wall_segments` gives them. ``()`` when the scene has no walls
+    (a recording, the open field) or its scenes stand in different rooms (then only a room file
+    given to the tracker gives the walls). A damaged wall: :class:`InputError` naming it."""
     scenes = scene if isinstance(scene, list) else [scene]
     found = set()
-    for s in scenes:
+    for k, s in enumerate(scenes):
         walls = s.get("walls", []) if isinstance(s, dict) else []
-        found.add(
-            tuple(
-                (
-                    float(w["from_m"][0]),
-                    float(w["from_m"][1]),
-                    float(w["to_m"][0]),
-                    float(w["to_m"][1]),
-                )  # fmt: skip
-                for w in walls
-                if w.get("reflection_db", 0.0) is not None
-            )
-        )
+        segments = []
+        for i, w in enumerate(walls if isinstance(walls, list) else [walls]):
+            try:
+                if w.get("reflection_db", 0.0) is None:
+                    continue
+                seg = tuple(float(v) for v in (*w["from_m"], *w["to_m"]))
+            except (AttributeError, KeyError, TypeError, ValueError):
+                seg = ()
+            if len(seg) != 4 or not all(math.isfinite(v) for v in seg):
+                raise InputError(
+                    f"data set scene {k}: walls[{i}] must have from_m and to_m [x_m, y_m], "
+                    f"got {w!r}"
+                )
+            segments.append(seg)
+        found.add(tuple(segments))
     return found.pop() if len(found) == 1 else ()
 
 

@@ -217,3 +217,7 @@ def test_a_data_set_simulated_in_a_room_gives_the_room_mode_its_walls():
     other = Room(walls=(Wall(from_m=(-3.0, 0.5), to_m=(-3.0, 9.0)),))
     assert scene_walls([room.to_dict(), other.to_dict()]) == ()
     assert scene_walls([room.to_dict(), room.to_dict()]) == (SIDE_WALL,)
+    # a damaged scene: one line naming the wall
+    for bad in ({"walls": [{"from_m": [3.0, 0.0]}]}, {"walls": [{"from_m": [3, 0], "to_m": "x"}]}):
+        with pytest.raises(InputError, match=r"scene 0: walls\[0\]"):
+            scene_walls(bad)
