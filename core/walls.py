@@ -22,6 +22,7 @@ __all__ = [
     "wall_lines",
     "ghost_points_xy",
     "scene_walls",
+    "scene_sensor_height",
 ]
 
 #: Columns of :func:`wall_lines`: a point on the wall, its unit normal, unit direction, length.
@@ -59,6 +60,18 @@ def scene_walls(scene: dict | list) -> tuple[tuple[float, float, float, float], 
     return found.pop() if len(found) == 1 else ()
 
 
+def scene_sensor_height(scene: dict | list) -> float:
+    """The sensor's mounting height (m) in a data set's stored scene JSON (``sensor.height_m``
+    of its room); 0 without one or when its scenes disagree."""
+    scenes = scene if isinstance(scene, list) else [scene]
+    found = set()
+    for s in scenes:
+        sensor = s.get("sensor", {}) if isinstance(s, dict) else {}
+        h = sensor.get("height_m", 0.0) if isinstance(sensor, dict) else 0.0
+        found.add(float(h) if isinstance(h, int | float) and math.isfinite(h) else 0.0)
+    return found.pop() if len(found) == 1 else 0.0
+
+
 def wall_lines(segments: np.ndarray) -> np.ndarray:
     """``(W, 7)`` float64 :data:`WALL_LINE_COLUMNS` of wall segments ``(W, 4)``
     ``(x0, y0, x1, y1)`` in m (each at least a few mm long; :class:`core.scene.room.Wall`
@@ -72,41 +85,62 @@ def wall_lines(segments: np.ndarray) -> np.ndarray:
 
 @register_jitable
 def ghost_points_xy(x: float, y: float, lines: np.ndarray, out: np.ndarray) -> int:
-    """Where the radar at the origin sees the first-order wall ghosts of a point S = (x, y).
+    """:func:`ghost_points` of a point at the radar's height (h = 0)."""
+    return ghost_points(x, y, 0.0, lines, out)
 
-    With ``S' = S − 2 ((S − a)·n) n`` the image of S in wall (a, n) (horizontal plane), the
-    bounce paths are:
 
-    - radar → wall → S → radar and its reverse: length ``L = |S| + |S'|``; the radar sees a point
-      at range ``L / 2`` in the direction of the last leg, so two points: ``(L / 2) S / |S|``
-      (back from S) and ``(L / 2) S' / |S'|`` (back by the wall);
-    - radar → wall → S → wall → radar: length ``2 |S'|``, seen at S' itself.
+@register_jitable
+def ghost_points(x: float, y: float, h: float, lines: np.ndarray, out: np.ndarray) -> int:
+    """Where the radar at the origin sees the first-order wall ghosts of a point S.
+
+    The tracker's position ``(x, y)`` is a range and a bearing: ``r = |(x, y)|`` is the slant
+    range from the radar to S, and S lies ``h`` (m) above (below: h < 0) the radar, as the
+    points' z gives it in the sensor's frame. S's ground position is then
+    ``S_g = (ρ / r) (x, y)`` with ``ρ = √(r² − h²)`` (h = 0: S_g = (x, y)). With
+    ``S'_g = S_g − 2 ((S_g − a)·n) n`` its image in wall (a, n) (walls are vertical, so the image
+    keeps the height) and ``r' = √(|S'_g|² + h²)`` the image's slant range, the bounce paths are:
+
+    - radar → wall → S → radar and its reverse: length ``L = r + r'``; the radar sees a point
+      at range ``L / 2`` in the bearing of the last leg, so two points: ``(L / 2) S_g / |S_g|``
+      (back from S) and ``(L / 2) S'_g / |S'_g|`` (back by the wall);
+    - radar → wall → S → wall → radar: length ``2 r'``, seen at range ``r'`` in the bearing of
+      S'_g (h = 0: S' itself).
 
     A wall contributes only where its bounce is specular (the radar and S strictly on the same
-    side of its line, the reflection point ``t S'``, ``t = d_R / (d_R + d_S)`` with ``d`` the
-    distances to the line, inside the segment). Writes the points into ``out`` ``(≥ 3 W, 2)``
-    three per wall in wall order (back from S, back by the wall, double bounce); returns how
-    many it wrote.
+    side of its line, the reflection point's ground position ``t S'_g``,
+    ``t = d_R / (d_R + d_S)`` with ``d`` the horizontal distances to the line, inside the
+    segment). Writes the points, as the tracker's ``(x, y)`` (range times the bearing's unit
+    vector), into ``out`` ``(≥ 3 W, 2)`` three per wall in wall order (back from S, back by the
+    wall, double bounce); returns how many it wrote.
     """
     n_out = 0
     r = math.sqrt(x * x + y * y)
     if r == 0.0:
         return 0
+    gx, gy = x, y
+    if h != 0.0:
+        rho = math.sqrt(max(r * r - h * h, 1e-12 * r * r))
+        gx, gy = x * rho / r, y * rho / r
     for w in range(lines.shape[0]):
         ax, ay, nx, ny = lines[w, 0], lines[w, 1], lines[w, 2], lines[w, 3]
         d_r = -ax * nx - ay * ny  # the radar's signed distance to the wall's line
-        d_s = (x - ax) * nx + (y - ay) * ny
+        d_s = (gx - ax) * nx + (gy - ay) * ny
         if d_r * d_s <= 0.0:
             continue
-        ix, iy = x - 2.0 * d_s * nx, y - 2.0 * d_s * ny
+        ix, iy = gx - 2.0 * d_s * nx, gy - 2.0 * d_s * ny
         t = d_r / (d_r + d_s)
         u = (t * ix - ax) * lines[w, 4] + (t * iy - ay) * lines[w, 5]
         if u < 0.0 or u > lines[w, 6]:
             continue
         ri = math.sqrt(ix * ix + iy * iy)
-        half = 0.5 * (r + ri)
+        if h == 0.0:
+            half = 0.5 * (r + ri)
+            out[n_out + 2, 0], out[n_out + 2, 1] = ix, iy
+        else:
+            rs = math.sqrt(ri * ri + h * h)  # the image's slant range
+            half = 0.5 * (r + rs)
+            out[n_out + 2, 0], out[n_out + 2, 1] = rs * ix / ri, rs * iy / ri
         out[n_out, 0], out[n_out, 1] = half * x / r, half * y / r
         out[n_out + 1, 0], out[n_out + 1, 1] = half * ix / ri, half * iy / ri
-        out[n_out + 2, 0], out[n_out + 2, 1] = ix, iy
         n_out += GHOSTS_PER_WALL
     return n_out

@@ -209,14 +209,16 @@ def room_points_of(dataset: Dataset) -> np.ndarray:
 
 
 def _scene_walls_of(dataset: Dataset) -> tuple:
-    """The walls of the data set's scene (:func:`core.walls.scene_walls`), read once
-    per data set (kept for the last one used)."""
+    """The walls and the sensor's height of the data set's scene (:func:`core.walls.
+    scene_walls`, :func:`core.walls.scene_sensor_height`), read once per data set (kept for the
+    last one used)."""
     entry = _SCENE_WALLS[0] if _SCENE_WALLS else None
     if entry is not None and entry[0] is dataset:
         return entry[1]
-    from core.walls import scene_walls
+    from core.walls import scene_sensor_height, scene_walls
 
-    walls = scene_walls(dataset.scene())
+    scene = dataset.scene()
+    walls = (scene_walls(scene), scene_sensor_height(scene))
     _SCENE_WALLS[:] = [(dataset, walls)]
     return walls
 
@@ -284,7 +286,7 @@ def track_dataset(
 
         out = track_room_arrays(
             room_points_of(dataset), f_off, t_off, sel, params, period,
-            with_scene_walls(zones, _scene_walls_of(dataset) if walls_from_scene else ()),
+            with_scene_walls(zones, *(_scene_walls_of(dataset) if walls_from_scene else ((), 0.0))),
             record=with_tracks, engine=engine,
         )  # fmt: skip
         est_xy, has, psi, conf_xy, n_conf, n_tr = out[:6]

@@ -17,10 +17,11 @@ on; it may be confirmed later if the rule no longer holds). Runs as plain Python
 compiled room kernel (``register_jitable``).
 
 Where the room's walls are known (:attr:`core.tracking.zones.Zones.walls`), the walls predict
-where each confirmed track's first-order ghosts appear (:func:`core.walls.ghost_points_xy`:
-three points per wall whose bounce is specular). A track that is not confirmed (a newborn or a
-tentative one) within ``r_ghost`` of such a point of a confirmed track that is no candidate
-itself is a ghost candidate too (:func:`wall_ghost_candidates`). Without walls nothing changes.
+where each confirmed track's first-order ghosts appear (:func:`core.walls.ghost_points`:
+three points per wall whose bounce is specular, from the track's range, bearing and height). A
+track that is not confirmed (a newborn or a tentative one) within ``r_ghost`` of such a point
+of a confirmed track that is no candidate itself is a ghost candidate too
+(:func:`wall_ghost_candidates`). Without walls nothing changes.
 """
 
 from __future__ import annotations
@@ -32,7 +33,7 @@ from numba.extending import register_jitable
 
 from core import jit_guard  # noqa: F401  (before any kernel compiles: see core/jit_guard.py)
 from core.tracking import ekf
-from core.walls import ghost_points_xy
+from core.walls import ghost_points
 
 __all__ = ["ghost_candidates", "wall_ghost_candidates"]
 
@@ -95,6 +96,8 @@ def ghost_candidates(
 def wall_ghost_candidates(
     X: np.ndarray,
     confirmed: np.ndarray,
+    height: np.ndarray,
+    sensor_height: float,
     ghost: np.ndarray,
     nt: int,
     walls: np.ndarray,
@@ -102,7 +105,9 @@ def wall_ghost_candidates(
     pts: np.ndarray,
 ) -> None:
     """Flag the tracks that are not confirmed and lie within ``radius`` (m) of a predicted wall
-    ghost of a confirmed track that is no ghost candidate (among the first ``nt``).
+    ghost of a confirmed track that is no ghost candidate (among the first ``nt``); ``height``
+    (m): each track's z (the mean z of its latest group), ``sensor_height`` the radar's z in
+    the same frame (:attr:`core.tracking.zones.Zones.sensor_height_m`).
 
     ``walls`` (W, 7) :func:`core.walls.wall_lines`; ``pts`` scratch (≥ 3 W, 2). Without
     walls (W = 0) nothing is touched.
@@ -113,7 +118,7 @@ def wall_ghost_candidates(
     for a in range(nt):
         if not confirmed[a] or ghost[a]:
             continue
-        n = ghost_points_xy(X[a, 0], X[a, 1], walls, pts)
+        n = ghost_points(X[a, 0], X[a, 1], height[a] - sensor_height, walls, pts)
         for b in range(nt):
             if confirmed[b] or ghost[b]:
                 continue

@@ -78,6 +78,7 @@ class RoomConstants(NamedTuple):
     boundary: np.ndarray
     static_boxes: np.ndarray
     walls: np.ndarray
+    sensor_height: float
 
 
 def room_constants(params: TrackerParams, frame_period_s: float, zones: Zones) -> RoomConstants:
@@ -115,6 +116,7 @@ def room_constants(params: TrackerParams, frame_period_s: float, zones: Zones) -
         boundary=zones.boundary_array(),
         static_boxes=zones.static_array(),
         walls=np.ascontiguousarray(zones.wall_array()),
+        sensor_height=float(zones.sensor_height_m),
     )
 
 
@@ -385,7 +387,9 @@ def room_frames(
                 X, conf, strength, nt, c.ghost_gap, c.ghost_bearing, c.ghost_velocity, ghost,
                 zm, g_order,
             )  # fmt: skip
-            wall_ghost_candidates(X, conf, ghost, nt, c.walls, c.ghost_radius, g_pts)
+            wall_ghost_candidates(
+                X, conf, height, c.sensor_height, ghost, nt, c.walls, c.ghost_radius, g_pts
+            )
             for k in range(nt):
                 if not conf[k] and not ghost[k] and birth[k] < frame:
                     conf[k] = psi[k] >= c.confirm_threshold

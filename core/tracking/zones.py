@@ -82,12 +82,17 @@ class Zones:
         ``(x0, y0, x1, y1)`` in m, the radar at the origin (as :mod:`core.scene.room` has them):
         tentative tracks at their predicted ghost positions are ghost candidates
         (:mod:`core.tracking.ghosts`).
+    sensor_height_m
+        The radar's height in the frame of the points' z (m): 0 when z is measured from the
+        sensor (a recording), the sensor's mounting height when z is the height above the floor
+        (a data set simulated in a room); the predicted ghosts use z − this.
     """
 
     boundary: Box | None = None
     static: tuple[Box, ...] = ()
     presence: tuple[Box, ...] = ()
     walls: tuple[tuple[float, float, float, float], ...] = ()
+    sensor_height_m: float = 0.0
 
     def __post_init__(self) -> None:
         if self.boundary is not None:
@@ -107,6 +112,9 @@ class Zones:
                 raise InputError(f"walls[{i}] has zero length: {list(seg)}")
             walls.append(seg)
         object.__setattr__(self, "walls", tuple(walls))
+        h = self.sensor_height_m
+        if isinstance(h, bool) or not isinstance(h, int | float) or not math.isfinite(h):
+            raise InputError(f"sensor_height_m must be a finite number (m), got {h!r}")
 
     def boundary_array(self) -> np.ndarray:
         """(6,) float64 boundary box, infinite limits when none."""
@@ -129,11 +137,15 @@ class Zones:
         }
         if self.walls:
             d["walls"] = [list(w) for w in self.walls]
+        if self.sensor_height_m:
+            d["sensor_height_m"] = self.sensor_height_m
         return d
 
 
 def with_scene_walls(
-    zones: Zones | None, walls: tuple[tuple[float, float, float, float], ...]
+    zones: Zones | None,
+    walls: tuple[tuple[float, float, float, float], ...],
+    sensor_height_m: float = 0.0,
 ) -> Zones | None:
     """``zones`` with the walls of the data set's scene (:func:`core.walls.scene_walls`) when
     it gives none itself: a data set simulated in a room carries its room, so the room mode
@@ -143,7 +155,8 @@ def with_scene_walls(
         return zones
     if not walls:
         return zones
-    return Zones(walls=walls) if zones is None else replace(zones, walls=walls)
+    kw = {"walls": walls, "sensor_height_m": sensor_height_m}
+    return Zones(**kw) if zones is None else replace(zones, **kw)
 
 
 @register_jitable

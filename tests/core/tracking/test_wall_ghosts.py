@@ -12,7 +12,7 @@ from core.scene.room import Room, Wall
 from core.tracking.params import TrackerParams
 from core.tracking.room import room_points, run_room_tracker
 from core.tracking.zones import Zones
-from core.walls import ghost_points_xy, wall_lines
+from core.walls import ghost_points, ghost_points_xy, wall_lines
 
 T = 0.1
 ROOM = TrackerParams(
@@ -45,6 +45,33 @@ def test_ghost_points_of_one_wall_by_hand():
     g = _ghosts(1.0, 3.0, [SIDE_WALL])
     half = (math.sqrt(10.0) + math.sqrt(34.0)) / 2
     np.testing.assert_allclose(g[1], np.array([5.0, 3.0]) * half / math.sqrt(34.0), atol=1e-12)
+
+
+def test_ghost_points_with_height_by_hand():
+    """A point 3 m below the radar at slant range 5 m straight ahead: ground range 4 m; in the
+    wall y = 6 its image lies at ground range 8 m, slant √(64 + 9) = √73 m; the single bounce
+    is seen at (5 + √73)/2, the double bounce at √73, all on the boresight."""
+    lines = wall_lines(np.array([(-5.0, 6.0, 5.0, 6.0)]))
+    out = np.zeros((3, 2))
+    assert ghost_points(0.0, 5.0, -3.0, lines, out) == 3
+    half = (5.0 + math.sqrt(73.0)) / 2
+    np.testing.assert_allclose(out, [[0, half], [0, half], [0, math.sqrt(73.0)]], atol=1e-12)
+    # off the boresight: S = (3, 4) in the tracker's frame at h = 1.5: S_g = (3, 4) ρ/5,
+    # ρ = √(25 − 2.25); image (S_gx, 12 − S_gy); every point keeps its leg's bearing
+    rho = math.sqrt(25.0 - 2.25)
+    gx, gy = 3.0 * rho / 5.0, 4.0 * rho / 5.0
+    ix, iy = gx, 12.0 - gy
+    rs = math.sqrt(ix * ix + iy * iy + 2.25)
+    half = (5.0 + rs) / 2
+    u = np.array([ix, iy]) / math.hypot(ix, iy)
+    assert ghost_points(3.0, 4.0, 1.5, lines, out) == 3
+    np.testing.assert_allclose(out, [[0.6 * half, 0.8 * half], half * u, rs * u], atol=1e-12)
+    # h = 0: the horizontal geometry, bit for bit
+    rng = np.random.default_rng(0)
+    a, b = np.zeros((3, 2)), np.zeros((3, 2))
+    for x, y in rng.uniform(-4.0, 5.5, (50, 2)):
+        assert ghost_points(x, y, 0.0, lines, a) == ghost_points_xy(x, y, lines, b)
+        np.testing.assert_array_equal(a, b)
 
 
 def test_no_ghost_where_the_bounce_is_not_specular():
@@ -217,6 +244,19 @@ def test_a_data_set_simulated_in_a_room_gives_the_room_mode_its_walls():
     other = Room(walls=(Wall(from_m=(-3.0, 0.5), to_m=(-3.0, 9.0)),))
     assert scene_walls([room.to_dict(), other.to_dict()]) == ()
     assert scene_walls([room.to_dict(), room.to_dict()]) == (SIDE_WALL,)
+    # a sensor mounted 2 m up: the scene's z are heights above the floor, the room mode takes
+    # the sensor's height from the scene, as when it is given with the walls
+    from core.scene.room import SensorPose
+    from core.walls import scene_sensor_height
+
+    high = Room(walls=room.walls, sensor=SensorPose(height_m=2.0))
+    assert scene_sensor_height(high.to_dict()) == 2.0 and scene_sensor_height({}) == 0.0
+    mounted = _as_dataset(frames, {"persons": []} | high.to_dict())
+    given = Zones(walls=(SIDE_WALL,), sensor_height_m=2.0)
+    for a, b in zip(run(mounted), run(recording, zones=given), strict=True):
+        np.testing.assert_array_equal(a, b)
+    with pytest.raises(InputError, match="sensor_height_m"):
+        Zones(sensor_height_m=math.nan)
     # a damaged scene: one line naming the wall
     for bad in ({"walls": [{"from_m": [3.0, 0.0]}]}, {"walls": [{"from_m": [3, 0], "to_m": "x"}]}):
         with pytest.raises(InputError, match=r"scene 0: walls\[0\]"):
