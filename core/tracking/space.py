@@ -180,9 +180,9 @@ SEARCH_SPACE: tuple[Parameter, ...] = (
     Parameter(name="ghost_velocity", symbol="Δv_ghost", meaning="ghost velocity match",
               unit="m/s", low=0.05, high=2.0, log=True, modes=("room",), default=1.5),
     # used only where the room's walls are known (Zones.walls): a tentative track this close to
-    # a confirmed track's predicted wall ghost is a ghost candidate
+    # a confirmed track's predicted wall ghost is a ghost candidate (default: tracker-09)
     Parameter(name="ghost_radius", symbol="r_ghost", meaning="predicted-ghost match radius",
-              unit="m", low=0.05, high=2.0, log=True, modes=("room",), default=0.5),
+              unit="m", low=0.05, high=2.0, log=True, modes=("room",), default=1.0),
 )
 # fmt: on
 
