@@ -17,7 +17,11 @@ over its seeds' frames:
   deviations (1.4826 x the median absolute deviation) of x, y and radial velocity.
 
 Each level's figure over the exact level's is its error; the yardstick's ratio says how much of
-it other noise alone makes. Writes ``docs/rooms/levels.md`` (the full run only).
+it other noise alone makes. Per scene also: the first-order bounce scatterers a frame and the
+share of them that lie within one merge cell (:data:`core.simulation.body_cells.MERGE_CELLS`:
+range, Doppler, azimuth beam) of a direct scatterer of the same person, a place where the exact
+chain sees one peak and the measurement level, which merges only a source's own cells, two.
+Writes ``docs/rooms/levels.md`` (the full run only).
 """
 
 from __future__ import annotations
@@ -111,6 +115,53 @@ def metrics(rows: list[dict], n_persons: int) -> dict:
     }
 
 
+def shared_cells(frames, radar) -> dict:
+    """First-order bounce scatterers per frame and the share of them closer than one merge cell
+    (:data:`~core.simulation.body_cells.MERGE_CELLS`, in all three of range, radial velocity and
+    azimuth sine, as :func:`~core.simulation.body_cells.merge_person_cells` measures) to a
+    direct scatterer of the same person; ``frames`` are the reflector stage's scatterers."""
+    from core.simulation.body_cells import MERGE_CELLS
+    from core.simulation.multipath import split_labels
+
+    k_r, k_d, k_u = MERGE_CELLS
+    scale = np.array(
+        [
+            k_r * radar.range_resolution_m,
+            k_d * radar.velocity_resolution_mps,
+            k_u * 2.0 / len(radar.azimuth_positions),
+        ]
+    )
+    ghosts = near = 0
+    for f in frames:
+        src, order = split_labels(f.source)
+        pos = np.asarray(f.position_m, dtype=np.float64)
+        rng = np.linalg.norm(pos, axis=1)
+        vr = np.einsum("ij,ij->i", np.asarray(f.velocity_mps, dtype=np.float64), pos) / rng
+        u = pos[:, 0] / np.maximum(np.hypot(pos[:, 0], pos[:, 1]), 1e-12)
+        coord = np.column_stack((rng, vr, u)) / scale
+        for i in np.flatnonzero((src >= 0) & (order == 1)):
+            direct = (src == src[i]) & (order == 0)
+            ghosts += 1
+            near += bool(np.any(np.all(np.abs(coord[direct] - coord[i]) < 1.0, axis=1)))
+    return {
+        "first_order_scatterers_per_frame": ghosts / max(1, len(frames)),
+        "share_in_a_direct_cell": near / ghosts if ghosts else None,
+    }
+
+
+def _reflector_frames(scene):
+    """The scene's scatterers of every frame from the pipeline's reflector stage (its seed; the
+    antenna drawn as ``radartune bench sim``'s room case draws it)."""
+    from core.pipeline.plan import plan, processing_settings
+    from core.pipeline.reflectors import Reflectors
+    from core.simulation import AntennaGain
+
+    antenna = AntennaGain.draw(scene.radar, np.random.default_rng(7))
+    settings = processing_settings(scene)
+    frames, _ = Reflectors.build(scene, plan(scene), scene.seed, antenna, settings).frames()
+    return frames
+
+
 def _ratio(a: float | None, b: float | None) -> float | None:
     return None if a is None or b is None or b == 0 else a / b
 
@@ -142,7 +193,11 @@ def run(quick: bool = False) -> dict:
         exact = rows_out["exact"]
         for m in rows_out.values():
             m["over_exact"] = {k: _ratio(m[k], exact[k]) for k in METRICS}
-        out["scenes"][name] = {"persons": len(scene.persons), "rows": rows_out}
+        out["scenes"][name] = {
+            "persons": len(scene.persons),
+            "rows": rows_out,
+            "ghost_scatterers": shared_cells(_reflector_frames(scene), scene.radar),
+        }
     out["load_average_1min"] = os.getloadavg()[0]
     if not quick:
         out["doc"] = str(write_doc(out).relative_to(ROOT))
@@ -195,6 +250,21 @@ def error_table(result: dict) -> list[str]:
     return lines
 
 
+def cell_lines(result: dict) -> list[str]:
+    """Markdown: first-order bounce scatterers and the share sharing a direct cell."""
+    lines = [
+        "| scene | first-order bounce scatterers / frame | within one merge cell of a direct one |",
+        "|---|---|---|",
+    ]
+    for name, sc in result["scenes"].items():
+        g = sc["ghost_scatterers"]
+        lines.append(
+            f"| `{name}` | {_f(g['first_order_scatterers_per_frame'], '.1f')} | "
+            f"{_f(g['share_in_a_direct_cell'], '.3f')} |"
+        )
+    return lines
+
+
 def write_doc(result: dict) -> Path:
     """``docs/rooms/levels.md`` from a full run's figures, replaced whole."""
     text = "\n".join(
@@ -216,6 +286,14 @@ def write_doc(result: dict) -> Path:
             "",
             *error_table(result),
             "",
+            "## Bounce paths that share a direct path's cell",
+            "",
+            "A first-order bounce scatterer closer than one merge cell (3 range bins, 2 Doppler "
+            "bins, one azimuth beam) to a direct scatterer of the same person: the exact chain "
+            "sees one peak there, the measurement level (merging a source's own cells only) two.",
+            "",
+            *cell_lines(result),
+            "",
         ]
     )
     DOC.parent.mkdir(parents=True, exist_ok=True)
@@ -229,6 +307,7 @@ def summary(result: dict) -> str:
         f"{result['seeds_per_level']} seed(s) each (load {result['load_average_1min']:.1f})",
         *path_order_table(result),
         *error_table(result),
+        *cell_lines(result),
     ]
     if "doc" in result:
         lines.append(f"written: {result['doc']}")

@@ -81,3 +81,32 @@ def test_frame_rows_without_path_order_label_direct_and_clutter():
     )
     (row,) = rl.frame_rows([pc])
     assert row["order"].tolist() == [0, -1]
+
+
+def test_shared_cells_counts_bounces_within_one_merge_cell_of_a_direct_scatterer():
+    from core.config import RadarConfig
+    from core.simulation import Scatterers
+    from core.simulation.body_cells import MERGE_CELLS
+    from core.simulation.multipath import path_labels
+
+    radar = RadarConfig()
+    dr = MERGE_CELLS[0] * radar.range_resolution_m
+    # person 0 direct at (0, 4) still; bounce A half a merge cell further along the same
+    # bearing (shares the cell); bounce B two merge cells further (does not); bounce C of
+    # person 1 at A's place (another person's: not counted as sharing); a clutter point
+    pos = np.array(
+        [[0.0, 4.0, 0.0], [0.0, 4.0 + 0.5 * dr, 0.0], [0.0, 4.0 + 2 * dr, 0.0],
+         [0.0, 4.0 + 0.5 * dr, 0.0], [1.0, 2.0, 0.0]]
+    )  # fmt: skip
+    labels = path_labels(
+        np.array([0, 0, 0, 1, -1]),
+        np.array([0, 1, 1, 1, 0]),
+        np.array([False, False, False, False, True]),
+    )
+    frame = Scatterers(
+        position_m=pos, velocity_mps=np.zeros((5, 3)), rcs_dbsm=np.zeros(5), source=labels
+    )
+    out = rl.shared_cells([frame, frame], radar)
+    assert out["first_order_scatterers_per_frame"] == 3.0
+    assert out["share_in_a_direct_cell"] == pytest.approx(1 / 3)
+    assert rl.shared_cells([], radar)["share_in_a_direct_cell"] is None
