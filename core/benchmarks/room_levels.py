@@ -19,8 +19,9 @@ over its seeds' frames:
 Each level's figure over the exact level's is its error; the yardstick's ratio says how much of
 it other noise alone makes. Per scene also: the first-order bounce scatterers a frame and the
 share of them that lie within one merge cell (:data:`core.simulation.body_cells.MERGE_CELLS`:
-range, Doppler, azimuth beam) of a direct scatterer of the same person, a place where the exact
-chain sees one peak and the measurement level, which merges only a source's own cells, two.
+range, Doppler, azimuth beam) of a direct scatterer of the same person: there the exact chain's
+tones overlap and may give one peak, while the measurement level, which merges only a source's
+own cells, detects each on its own.
 Writes ``docs/rooms/levels.md`` (the full run only).
 """
 
@@ -289,8 +290,9 @@ def write_doc(result: dict) -> Path:
             "## Bounce paths that share a direct path's cell",
             "",
             "A first-order bounce scatterer closer than one merge cell (3 range bins, 2 Doppler "
-            "bins, one azimuth beam) to a direct scatterer of the same person: the exact chain "
-            "sees one peak there, the measurement level (merging a source's own cells only) two.",
+            "bins, one azimuth beam) to a direct scatterer of the same person: there the exact "
+            "chain's tones overlap in one spectrum and may give one peak, while the measurement "
+            "level, merging a source's own cells only, detects each on its own.",
             "",
             *cell_lines(result),
             "",
