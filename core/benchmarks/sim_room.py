@@ -1,8 +1,9 @@
 """``radartune bench sim``, room case: the walking body in a four-wall room with multipath
 against the same walk in the open field, in the same run (docs/rooms.md).
 
-The scene is ``resources/scenes/room_walker.json`` (a 6 x 8 m room, -6 dB walls, the sensor
-2 m up on a wall tilted 15 deg down, one walking body) with the paper's clutter (0.02 m^-2);
+The scene is ``resources/scenes/room_walker.json`` (a 6 x 8 m room whose walls take the shipped
+default loss, :data:`core.scene.room.DEFAULT_REFLECTION_DB`, the sensor 2 m up on a wall tilted
+15 deg down, one walking body) with the paper's clutter (0.02 m^-2);
 the open field is the same scene without walls and sensor pose. The exact chain runs both
 interleaved in blocks of 10 frames (frames/s and their ratio); the fast level runs the room's
 frames in batches between the exact passes. The reflector stage (image method included) is
@@ -106,6 +107,7 @@ def run_case(quick: bool = False) -> dict:
         mp.GHOST_GROUPS = keep
     return {
         "scene": SCENE.name,
+        "wall_reflection_db": sorted({w.reflection_db for w in room.room.walls}),
         "frames": n * reps,
         "scatterers_per_frame_room": float(np.mean([len(f) for f in walls[:n]])),
         "scatterers_per_frame_open": float(np.mean([len(f) for f in field[:n]])),
@@ -132,7 +134,8 @@ def run_case(quick: bool = False) -> dict:
 def summary_line(room: dict) -> str:
     """The room case in one line of ``radartune bench sim``'s summary."""
     return (
-        f"  room ({room['scene']}, {room['scatterers_per_frame_room']:.1f} scatterers/frame "
+        f"  room ({room['scene']}, walls {room.get('wall_reflection_db', '?')} dB, "
+        f"{room['scatterers_per_frame_room']:.1f} scatterers/frame "
         f"against {room['scatterers_per_frame_open']:.1f} in the open field): exact "
         f"{room['exact_fps_room']:.0f} frames/s, open field {room['exact_fps_open']:.0f} in the "
         f"same run (room cost {room['exact_room_cost_over_open']:.2f}x; CPU "

@@ -37,7 +37,10 @@ MODULES = {"import": "import_"}
 #: (60 studies); the objective comparison and the CV-against-CA design (hours of studies)
 #: transfer: tuned parameters judged on held-out public recordings (needs them: $RADARTUNE_REAL);
 #: trackers: four trackers, tuned and not, on held-out simulated rooms and recordings
-LONG = ("cvca_seeds", "clouds", "gui", "samplers", "campaign", "transfer", "trackers")
+#: room_levels: the three fidelity levels in the shipped rooms (an error table, not a speed)
+LONG = (
+    "cvca_seeds", "clouds", "gui", "samplers", "campaign", "transfer", "trackers", "room_levels",
+)  # fmt: skip
 #: benchmarks whose tables and plots ``--render-only`` re-writes from their stored JSON
 RENDERABLE = ("fidelity", "clouds", "samplers", "campaign")
 

@@ -70,3 +70,34 @@ def test_scene_batch_path_equals_the_frame_iterator() -> None:
         len(a) != len(b) or not np.array_equal(a.range_m, b.range_m)
         for a, b in zip(run.clouds, other.clouds)
     )
+
+
+@pytest.mark.parametrize("cfg", ["oob_isk.cfg", "people_counting_isk.cfg"])
+@pytest.mark.parametrize("fidelity", ["fast", "measurement"])
+def test_ti_chains_refuse_the_cheaper_levels_in_one_line(tmp_path, capsys, cfg, fidelity):
+    """docs/decisions/simulation-16: TI's chains run on the exact level only; the CLI says so
+    in one line naming the chain, exit 2, and writes nothing."""
+    from core.cli import main
+
+    root = Path(__file__).resolve().parents[3]
+    out = tmp_path / "out.npz"
+    capsys.readouterr()
+    code = main(
+        [
+            "simulate",
+            "--scene",
+            str(root / "resources" / "scenes" / "room_walker.json"),
+            "--cfg",
+            str(root / "resources" / "radar" / cfg),
+            "--fidelity",
+            fidelity,
+            "--out",
+            str(out),
+        ]
+    )
+    # stderr may also carry the cfg's note of ignored commands; the error is one line
+    errors = [x for x in capsys.readouterr().err.splitlines() if "error:" in x]
+    assert code == 2
+    assert len(errors) == 1
+    assert "runs on the exact level only" in errors[0] and f"fidelity={fidelity!r}" in errors[0]
+    assert not out.exists()
