@@ -677,16 +677,23 @@ def _lambda_section(result: dict[str, Any]) -> str:
     )
 
 
+_COLOURS = {"cv": "tab:blue", "ca": "tab:orange"}
+
+
 def _plots(result: dict[str, Any], out: Path) -> list[Path]:
     import matplotlib
 
     matplotlib.use("Agg")
+    return [_plot_test_sets(result, out), _plot_table1(result, out), _plot_objectives(result, out)]
+
+
+def _plot_test_sets(result: dict[str, Any], out: Path) -> Path:
+    """Per test set, every study's L_t; the median over cells with its interval."""
     import matplotlib.pyplot as plt
 
     f = result["final"]
     recs = f["records"]
-    colours = {"cv": "tab:blue", "ca": "tab:orange"}
-    written = []
+    colours = _COLOURS
     # 1. per test set, every study's L_t; the median over cells with its interval
     fig, ax = plt.subplots(figsize=(9, 4.2), layout="constrained")
     tests = result["data"]["test"]
@@ -716,8 +723,17 @@ def _plots(result: dict[str, Any], out: Path) -> list[Path]:
     )
     ax.legend(fontsize=8)
     p = out / "test_sets.png"
-    written.append(save_figure(fig, p, dpi=110))
+    written = save_figure(fig, p, dpi=110)
     plt.close(fig)
+    return written
+
+
+def _plot_table1(result: dict[str, Any], out: Path) -> Path:
+    """Table I per class: medians with intervals."""
+    import matplotlib.pyplot as plt
+
+    f = result["final"]
+    colours = _COLOURS
     # 2. Table I per class: medians with intervals
     fig, ax = plt.subplots(figsize=(7, 3.8), layout="constrained")
     cols = (*CLASSES, "total")
@@ -740,8 +756,16 @@ def _plots(result: dict[str, Any], out: Path) -> list[Path]:
     )
     ax.legend(fontsize=8)
     p = out / "table1.png"
-    written.append(save_figure(fig, p, dpi=110))
+    written = save_figure(fig, p, dpi=110)
     plt.close(fig)
+    return written
+
+
+def _plot_objectives(result: dict[str, Any], out: Path) -> Path:
+    """Held-out median per objective, and against the clutter densities ρ and λ."""
+    import matplotlib.pyplot as plt
+
+    colours = _COLOURS
     # 3. objectives: held-out median per objective, and against the clutter density
     t = result["objectives"]["table"]
     objs = list(t)
@@ -800,7 +824,7 @@ def _plots(result: dict[str, Any], out: Path) -> list[Path]:
         )  # fmt: skip
         a3.legend(fontsize=6, ncol=2)
     p = out / "objectives.png"
-    written.append(save_figure(fig, p, dpi=110))
+    written = save_figure(fig, p, dpi=110)
     plt.close(fig)
     return written
 

@@ -158,25 +158,33 @@ def walker_scene(cfg: Path, frames: int, seed: int):
 def simulated(cfg_name: str, frames: int, seed: int = 5) -> dict:
     from core.formats.ti_cfg import read_ti_chain
     from core.pipeline import plan
-    from core.pipeline.frames import iter_frames
 
     cfg = ROOT / "resources" / "radar" / cfg_name
     chain = read_ti_chain(cfg) if cfg_name != "paper.cfg" else None
     scene, n = walker_scene(cfg, frames, seed)
     p = plan(scene, chain=chain) if chain is not None else plan(scene)
+    return frame_stats(cloud_frames(scene, p, n))
+
+
+def cloud_frames(scene, the_plan, n: int, *, path_order: bool = False) -> list[dict]:
+    """The first ``n`` frames of ``scene`` simulated through ``the_plan``, each a dict of the
+    point cloud's arrays x, y, z, v, snr (and ``path_order`` when asked)."""
+    from core.pipeline.frames import iter_frames
+
     out = []
-    for fr in iter_frames(scene, the_plan=p, frames=range(n)):
+    for fr in iter_frames(scene, the_plan=the_plan, frames=range(n)):
         pc = fr.point_cloud
-        out.append(
-            {
-                "x": pc.x_m,
-                "y": pc.y_m,
-                "z": pc.z_m,
-                "v": pc.radial_velocity_mps,
-                "snr": pc.snr_db,
-            }
-        )
-    return frame_stats(out)
+        frame: dict[str, Any] = {
+            "x": pc.x_m,
+            "y": pc.y_m,
+            "z": pc.z_m,
+            "v": pc.radial_velocity_mps,
+            "snr": pc.snr_db,
+        }
+        if path_order:
+            frame["path_order"] = pc.path_order
+        out.append(frame)
+    return out
 
 
 def recorded_people_counting() -> dict | None:

@@ -141,26 +141,13 @@ def fit_scene(cfg: str, reflection_db: float, seed: int):
 def simulated_frames(scene, cfg: str, frames: int | None = None) -> list[dict]:
     """The scene through the chain of ``cfg``: per frame x, y (room), z (room), v, snr and the
     path order."""
+    from core.benchmarks.chain_calibration import cloud_frames
     from core.formats.ti_cfg import read_ti_chain
     from core.pipeline import plan
-    from core.pipeline.frames import iter_frames
 
     p = plan(scene, chain=read_ti_chain(cfg))
     n = scene.n_frames if frames is None else min(frames, scene.n_frames)
-    out = []
-    for fr in iter_frames(scene, the_plan=p, frames=range(n)):
-        pc = fr.point_cloud
-        out.append(
-            {
-                "x": pc.x_m,
-                "y": pc.y_m,
-                "z": pc.z_m,
-                "v": pc.radial_velocity_mps,
-                "snr": pc.snr_db,
-                "path_order": pc.path_order,
-            }
-        )
-    return out
+    return cloud_frames(scene, p, n, path_order=True)
 
 
 def curve(cfg: str, seeds: tuple[int, ...], frames: int | None = None) -> dict:

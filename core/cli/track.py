@@ -10,7 +10,9 @@ from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
     from core.dataset import Dataset
-    from core.tracking import DatasetEstimates
+    from core.evaluation.counting import RecordingScores
+    from core.tracking import DatasetEstimates, TrackerParams
+    from core.tracking.zones import Zones
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
@@ -76,28 +78,53 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     import time
-    from dataclasses import replace
-    from pathlib import Path
 
-    import numpy as np
-
-    from core.cli.track_scores import per_frame, scores_without_positions
+    from core.cli.track_scores import scores_without_positions
     from core.dataset import Dataset
-    from core.errors import InputError
-    from core.evaluation import evaluate
-    from core.files import check_output_path, write_json_atomic
-    from core.tracking import TrackerParams, track_dataset
+    from core.formats.recording import has_truth
+    from core.tracking import track_dataset
     from core.tracking.warm import load_compiled
 
     if args.tracker == "gtrack":
-        from core.cli.gtrack import run_track
+        return _run_gtrack(args)
+    _check_args(args)
+    params = _params_from(args)
+    zones = _zones_from(args, params)
+    ds = Dataset.load(args.data)
+    traj = _trajectories_from(args, ds)
+    # loading the compiled kernels is start-up, not tracking: paid first, reported apart
+    startup = load_compiled(params) if args.engine == "numba" else 0.0
+    t0 = time.perf_counter()
+    est = track_dataset(
+        ds, params, trajectories=traj, engine=args.engine, with_tracks=True, zones=zones
+    )
+    elapsed = time.perf_counter() - t0
+    scores = scores_without_positions(ds, est, args.people)
+    if not has_truth(ds):
+        _report_without_truth(args, ds, est, params, elapsed, scores)
+    else:
+        _report_with_truth(args, ds, est, params, elapsed, startup, scores)
+    return 0
 
-        if args.mode or args.zones or args.room:
-            raise InputError(
-                "--mode, --zones and --room set RadarTune's tracker; gtrack takes its boxes "
-                "from --cfg"
-            )
-        return run_track(args)
+
+def _run_gtrack(args: argparse.Namespace) -> int:
+    """``--tracker gtrack``: TI's tracker rebuilt (:mod:`core.cli.gtrack`); refuses the options
+    that set RadarTune's tracker."""
+    from core.cli.gtrack import run_track
+    from core.errors import InputError
+
+    if args.mode or args.zones or args.room:
+        raise InputError(
+            "--mode, --zones and --room set RadarTune's tracker; gtrack takes its boxes from --cfg"
+        )
+    return run_track(args)
+
+
+def _check_args(args: argparse.Namespace) -> None:
+    """One-line refusals of option combinations and outputs before anything is read."""
+    from core.errors import InputError
+    from core.files import check_output_path
+
     if args.cfg:
         raise InputError("--cfg sets gtrack's tracker lines: use it with --tracker gtrack")
     if args.params and args.model:
@@ -107,6 +134,15 @@ def run(args: argparse.Namespace) -> int:
             check_output_path(out_path, what=f"{what} file")
     if args.people is not None and args.people < 0:
         raise InputError(f"--people must be >= 0, got {args.people}")
+
+
+def _params_from(args: argparse.Namespace) -> TrackerParams:
+    """The tracker parameters: the file or the model's defaults, with the association and mode
+    options applied."""
+    from dataclasses import replace
+
+    from core.tracking import TrackerParams
+
     params = (
         TrackerParams.load(args.params)
         if args.params
@@ -116,7 +152,16 @@ def run(args: argparse.Namespace) -> int:
         params = replace(params, association=args.association)
     if args.mode:
         params = replace(params, mode=args.mode)
-    zones = None
+    return params
+
+
+def _zones_from(args: argparse.Namespace, params: TrackerParams) -> Zones | None:
+    """The room mode's zones from ``--zones`` (a TI .cfg) and walls from ``--room``; None."""
+    from dataclasses import replace
+
+    from core.errors import InputError
+
+    zones: Zones | None = None
     if args.zones:
         from core.tracking.zones import zones_from_cfg
 
@@ -130,53 +175,82 @@ def run(args: argparse.Namespace) -> int:
         if params.mode != "room":
             raise InputError("--room needs the room mode (--mode room)")
         zones = replace(zones or Zones(), walls=Room.from_json(args.room).wall_segments())
-    ds = Dataset.load(args.data)
-    traj = None
-    if args.trajectories:
-        try:
-            traj = [int(t) for t in args.trajectories.split(",") if t.strip()]
-        except ValueError:
-            raise InputError(
-                f"--trajectories must be comma-separated integers, got {args.trajectories!r}"
-            ) from None
-        bad = [t for t in traj if not 0 <= t < ds.n_trajectories]
-        if bad:
-            raise InputError(
-                f"--trajectories must be indices in [0, {ds.n_trajectories}), got {bad}"
-            )
-    # loading the compiled kernels is start-up, not tracking: paid first, reported apart
-    startup = load_compiled(params) if args.engine == "numba" else 0.0
-    t0 = time.perf_counter()
-    est = track_dataset(
-        ds, params, trajectories=traj, engine=args.engine, with_tracks=True, zones=zones
-    )
-    elapsed = time.perf_counter() - t0
-    from core.formats.recording import has_truth
+    return zones
 
-    scores = scores_without_positions(ds, est, args.people)
-    if not has_truth(ds):
-        n_conf = int(np.sum(np.isfinite(est.confirmed_xy[..., 0]).any(axis=1)))
-        print(
-            f"{args.data}: {len(est.trajectories)} trajectories, {len(est.frame_index)} frames, "
-            f"model {params.model}, tracked in {elapsed * 1e3:.1f} ms; {n_conf} frames with a "
-            "confirmed track; no ground truth, so no loss table (import with --truth to score)"
-        )
-        print("\n".join(scores.format_lines()))
-        _write_tracks(args.tracks, ds, est)
-        if args.out:
-            doc = {
-                "data": str(args.data),
-                "params": params.to_dict(),
-                "engine": args.engine,
-                "elapsed_s": elapsed,
-                "frames_with_confirmed_track": n_conf,
-                "truth": False,
-                **per_frame(est),
-                "without_positions": scores.to_dict(),
-            }
-            write_json_atomic(Path(args.out), doc)
-            print(f"written: {args.out}")
-        return 0
+
+def _trajectories_from(args: argparse.Namespace, ds: Dataset) -> list[int] | None:
+    """``--trajectories`` as indices checked against the data set; None: all."""
+    from core.errors import InputError
+
+    if not args.trajectories:
+        return None
+    try:
+        traj = [int(t) for t in args.trajectories.split(",") if t.strip()]
+    except ValueError:
+        raise InputError(
+            f"--trajectories must be comma-separated integers, got {args.trajectories!r}"
+        ) from None
+    bad = [t for t in traj if not 0 <= t < ds.n_trajectories]
+    if bad:
+        raise InputError(f"--trajectories must be indices in [0, {ds.n_trajectories}), got {bad}")
+    return traj
+
+
+def _report_without_truth(
+    args: argparse.Namespace,
+    ds: Dataset,
+    est: DatasetEstimates,
+    params: TrackerParams,
+    elapsed: float,
+    scores: RecordingScores,
+) -> None:
+    """A recording without truth: the confirmed frames and the scores without positions."""
+    from pathlib import Path
+
+    import numpy as np
+
+    from core.cli.track_scores import per_frame
+    from core.files import write_json_atomic
+
+    n_conf = int(np.sum(np.isfinite(est.confirmed_xy[..., 0]).any(axis=1)))
+    print(
+        f"{args.data}: {len(est.trajectories)} trajectories, {len(est.frame_index)} frames, "
+        f"model {params.model}, tracked in {elapsed * 1e3:.1f} ms; {n_conf} frames with a "
+        "confirmed track; no ground truth, so no loss table (import with --truth to score)"
+    )
+    print("\n".join(scores.format_lines()))
+    _write_tracks(args.tracks, ds, est)
+    if args.out:
+        doc = {
+            "data": str(args.data),
+            "params": params.to_dict(),
+            "engine": args.engine,
+            "elapsed_s": elapsed,
+            "frames_with_confirmed_track": n_conf,
+            "truth": False,
+            **per_frame(est),
+            "without_positions": scores.to_dict(),
+        }
+        write_json_atomic(Path(args.out), doc)
+        print(f"written: {args.out}")
+
+
+def _report_with_truth(
+    args: argparse.Namespace,
+    ds: Dataset,
+    est: DatasetEstimates,
+    params: TrackerParams,
+    elapsed: float,
+    startup: float,
+    scores: RecordingScores,
+) -> None:
+    """A data set with truth: the loss table (eq. 14), its metrics and the scores."""
+    from pathlib import Path
+
+    from core.cli.track_scores import per_frame
+    from core.evaluation import evaluate
+    from core.files import write_json_atomic
+
     ev = evaluate(ds, est)
     print(
         f"{args.data}: {len(est.trajectories)} trajectories, {len(est.frame_index)} frames, "
@@ -202,7 +276,6 @@ def run(args: argparse.Namespace) -> int:
         }
         write_json_atomic(out, doc)
         print(f"written: {out}")
-    return 0
 
 
 def _write_tracks(path: str | None, ds: Dataset, est: DatasetEstimates) -> None:

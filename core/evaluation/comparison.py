@@ -203,20 +203,7 @@ def loss_breakdown(
     present = np.all(np.isfinite(truth), axis=1)
     off = estimates.offsets
     k_sel = len(estimates.trajectories)
-    n_cat = len(CATEGORIES)
-    out = {
-        "n_frames": np.zeros(k_sel, np.int64),
-        "n_c": np.zeros(k_sel, np.int64),
-        "first": np.full(k_sel, -1, np.int64),
-        "loss": np.zeros(k_sel),
-        "sse": np.zeros(k_sel),
-        "loss_cat": np.zeros((k_sel, n_cat)),
-        "sse_cat": np.zeros((k_sel, n_cat)),
-        "frames_cat": np.zeros((k_sel, n_cat), np.int64),
-        "along": np.full(k_sel, math.nan),
-        "range_rms": np.full(k_sel, math.nan),
-        "cross_rms": np.full(k_sel, math.nan),
-    }
+    out = _breakdown_arrays(k_sel)
     for i in range(k_sel):
         s = slice(off[i], off[i + 1])
         has = np.asarray(estimates.has_estimate[s], dtype=bool) & present[s]
@@ -230,21 +217,15 @@ def loss_breakdown(
         out["first"][i] = int(np.argmax(has))
         e = estimates.estimate_xy[s] - truth[s]  # (N, 2) m
         e2 = np.where(has, np.sum(np.where(has[:, None], e, 0.0) ** 2, axis=1), 0.0)
-        # frames since the estimate (re)appeared or changed track
-        start = has & ~np.concatenate(([False], has[:-1]))
-        if estimate_ids is not None:
-            ids = np.asarray(estimate_ids[s])
-            start |= has & np.concatenate(([False], ids[1:] != ids[:-1]))
-        age = np.zeros(n, np.int64)
-        for f in range(n):
-            age[f] = 0 if start[f] or not has[f] or f == 0 else age[f - 1] + 1
-        transient = has & (age < n_transient)
-        manoeuvre = (
-            has
-            & ~transient
-            & _manoeuvring(truth_v[s], period_s, manoeuvre_accel_mps2, manoeuvre_window)
+        transient, manoeuvre, steady = _frame_kinds(
+            has,
+            None if estimate_ids is None else np.asarray(estimate_ids[s]),
+            truth_v[s],
+            n_transient=n_transient,
+            manoeuvre_window=manoeuvre_window,
+            manoeuvre_accel_mps2=manoeuvre_accel_mps2,
+            period_s=period_s,
         )
-        steady = has & ~transient & ~manoeuvre
         sse = float(e2.sum())
         out["sse"][i] = sse
         # L(k) = SSE(k)/N_c(k)²  (12)–(13): additive over frames
@@ -253,19 +234,11 @@ def loss_breakdown(
             out["sse_cat"][i, c] = float(e2[mask].sum())
             out["loss_cat"][i, c] = out["sse_cat"][i, c] / n_c**2
             out["frames_cat"][i, c] = int(mask.sum())
-        # along-track error: e · v̂ (v̂ the true heading), moving, non-transient frames
-        speed = np.linalg.norm(truth_v[s], axis=1)
-        moving = has & ~transient & (speed > 0.1)
-        if moving.any():
-            v_hat = truth_v[s][moving] / speed[moving, None]
-            out["along"][i] = float(np.mean(np.sum(e[moving] * v_hat, axis=1)))
-        # range / cross-range: along and across the line of sight to the true position
-        u = truth[s][has] / np.linalg.norm(truth[s][has], axis=1, keepdims=True)
-        eh = e[has]
-        out["range_rms"][i] = float(np.sqrt(np.mean(np.sum(eh * u, axis=1) ** 2)))
-        out["cross_rms"][i] = float(
-            np.sqrt(np.mean((eh[:, 0] * u[:, 1] - eh[:, 1] * u[:, 0]) ** 2))
-        )
+        along, range_rms, cross_rms = _error_geometry(e, has, transient, truth[s], truth_v[s])
+        if along is not None:
+            out["along"][i] = along
+        out["range_rms"][i] = range_rms
+        out["cross_rms"][i] = cross_rms
     return LossBreakdown(
         trajectories=np.asarray(estimates.trajectories),
         classes=dataset.trajectory_class[estimates.trajectories].astype(str),
@@ -284,6 +257,73 @@ def loss_breakdown(
         manoeuvre_window=int(manoeuvre_window),
         manoeuvre_accel_mps2=float(manoeuvre_accel_mps2),
     )
+
+
+def _breakdown_arrays(k_sel: int) -> dict[str, np.ndarray]:
+    """The per-trajectory arrays :func:`loss_breakdown` fills (never-confirmed defaults)."""
+    n_cat = len(CATEGORIES)
+    out = {
+        "n_frames": np.zeros(k_sel, np.int64),
+        "n_c": np.zeros(k_sel, np.int64),
+        "first": np.full(k_sel, -1, np.int64),
+        "loss": np.zeros(k_sel),
+        "sse": np.zeros(k_sel),
+        "loss_cat": np.zeros((k_sel, n_cat)),
+        "sse_cat": np.zeros((k_sel, n_cat)),
+        "frames_cat": np.zeros((k_sel, n_cat), np.int64),
+        "along": np.full(k_sel, math.nan),
+        "range_rms": np.full(k_sel, math.nan),
+        "cross_rms": np.full(k_sel, math.nan),
+    }
+    return out
+
+
+def _frame_kinds(
+    has: np.ndarray,
+    ids: np.ndarray | None,
+    truth_v: np.ndarray,
+    *,
+    n_transient: int,
+    manoeuvre_window: int,
+    manoeuvre_accel_mps2: float,
+    period_s: float,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """One trajectory's scored frames (``has``) split into transient, manoeuvre and steady
+    frames (see :func:`loss_breakdown`); ``ids``: the estimate's track per frame, or None."""
+    n = len(has)
+    # frames since the estimate (re)appeared or changed track
+    start = has & ~np.concatenate(([False], has[:-1]))
+    if ids is not None:
+        start |= has & np.concatenate(([False], ids[1:] != ids[:-1]))
+    age = np.zeros(n, np.int64)
+    for f in range(n):
+        age[f] = 0 if start[f] or not has[f] or f == 0 else age[f - 1] + 1
+    transient = has & (age < n_transient)
+    manoeuvre = (
+        has & ~transient & _manoeuvring(truth_v, period_s, manoeuvre_accel_mps2, manoeuvre_window)
+    )
+    steady = has & ~transient & ~manoeuvre
+    return transient, manoeuvre, steady
+
+
+def _error_geometry(
+    e: np.ndarray, has: np.ndarray, transient: np.ndarray, truth: np.ndarray, truth_v: np.ndarray
+) -> tuple[float | None, float, float]:
+    """Mean along-track error (None when the person never moves outside transients), and the
+    RMS range and cross-range errors of one trajectory's scored frames, m."""
+    along = None
+    # along-track error: e · v̂ (v̂ the true heading), moving, non-transient frames
+    speed = np.linalg.norm(truth_v, axis=1)
+    moving = has & ~transient & (speed > 0.1)
+    if moving.any():
+        v_hat = truth_v[moving] / speed[moving, None]
+        along = float(np.mean(np.sum(e[moving] * v_hat, axis=1)))
+    # range / cross-range: along and across the line of sight to the true position
+    u = truth[has] / np.linalg.norm(truth[has], axis=1, keepdims=True)
+    eh = e[has]
+    range_rms = float(np.sqrt(np.mean(np.sum(eh * u, axis=1) ** 2)))
+    cross_rms = float(np.sqrt(np.mean((eh[:, 0] * u[:, 1] - eh[:, 1] * u[:, 0]) ** 2)))
+    return along, range_rms, cross_rms
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)

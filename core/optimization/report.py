@@ -308,7 +308,6 @@ def write_report(
     from core.dataset import Dataset
     from core.optimization.data import like_training, resolve_dataset
     from core.optimization.testsets import check_test_sets, chosen_params
-    from core.tracking import TrackerParams
 
     check_test_sets(test_sets)
     studies = load_studies(storage)
@@ -334,7 +333,37 @@ def write_report(
         else None
     )
 
-    result: dict[str, Any] = {
+    result = _report_header(command, storage, train_path, train, role)
+    if other is not None:
+        result["generalisation_dataset"] = _dataset_entry(other, generalisation_dataset)
+    estimates = {}
+    for model in mains:
+        entry, estimates[model] = _model_entry(studies, choices[model], train, other)
+        result["models"][model] = entry
+        write_json_atomic(out / f"best_{model}.json", entry["params"])
+    result["studies"] = [_study_row(s) for s in sorted(
+        studies, key=lambda s: (s.model, s.sampler, s.pruner, s.name))]  # fmt: skip
+    plots = _report_plots(studies, train, estimates, out)
+    if tests is not None:
+        result["test_sets"] = tests
+        plot_test_sets(result["test_sets"], out / "test_sets.png")
+        plots.append("test_sets.png")
+    if sensitivity:
+        add_sensitivity(result, storage, studies, out, generalisation_dataset, train_file,
+                        sensitivity_points, clutter_variants, progress)  # fmt: skip
+    result["plots"] = plots
+    if "cv" in result["models"] and "ca" in result["models"]:
+        result["conclusion"] = _conclusion(result["models"])
+    write_json_atomic(out / "report.json", result)
+    write_text_atomic(out / "report.md", render_markdown(result))
+    return result
+
+
+def _report_header(
+    command: str, storage: str, train_path: str | Path, train: Any, role: str
+) -> dict[str, Any]:
+    """The report's head: when and how it was made, the training set, the paper's Table I."""
+    return {
         "generated": dt.datetime.now(dt.UTC).isoformat(timespec="seconds"),
         "command": command,
         "storage": redact(storage),
@@ -345,51 +374,66 @@ def write_report(
         "models": {},
         "studies": [],
     }  # fmt: skip
+
+
+def _dataset_entry(other: Any, spec: str) -> dict[str, Any]:
+    """The generalisation (held-out) data set: its spec, seed and size."""
+    return {
+        "spec": spec,
+        "seed": int(other.seed),
+        "trajectories": other.n_trajectories,
+        "frames": other.n_frames,
+        "persons": other.n_persons,
+    }
+
+
+def _model_entry(
+    studies: Sequence[StudyRecord], choice: tuple, train: Any, other: Any
+) -> tuple[dict[str, Any], Any]:
+    """A model's chosen parameters (``choice``: parameters, study, trial, how chosen) scored on
+    the training set (and the generalisation set when given); also the training estimates."""
+    from core.tracking import TrackerParams
+
+    chosen, name, number, how = choice
+    study = next(s for s in studies if s.name == name)
+    trial = next(t for t in study.trials if t.number == number)
+    params = TrackerParams.from_dict(chosen).to_dict()
+    est, ev = evaluate_params(train, params)
+    entry: dict[str, Any] = {
+        "study": name,
+        "best_trial": number,
+        "chosen_by": how,
+        "best_value_in_study": trial.value,
+        "params": params,
+        "training": ev.to_dict(),
+    }
     if other is not None:
-        result["generalisation_dataset"] = {
-            "spec": generalisation_dataset,
-            "seed": int(other.seed),
-            "trajectories": other.n_trajectories,
-            "frames": other.n_frames,
-            "persons": other.n_persons,
-        }
-    estimates = {}
-    for model in mains:
-        chosen, name, number, how = choices[model]
-        study = next(s for s in studies if s.name == name)
-        trial = next(t for t in study.trials if t.number == number)
-        params = TrackerParams.from_dict(chosen).to_dict()
-        est, ev = evaluate_params(train, params)
-        estimates[model] = est
-        entry: dict[str, Any] = {
-            "study": name,
-            "best_trial": number,
-            "chosen_by": how,
-            "best_value_in_study": trial.value,
-            "params": params,
-            "training": ev.to_dict(),
-        }
-        if other is not None:
-            entry["generalisation"] = evaluate_params(other, params)[1].to_dict()
-        result["models"][model] = entry
-        write_json_atomic(out / f"best_{model}.json", params)
-    for s in sorted(studies, key=lambda s: (s.model, s.sampler, s.pruner, s.name)):
-        states = [t.state for t in s.trials]
-        b = s.best
-        result["studies"].append(
-            {
-                "name": s.name,
-                "model": s.model,
-                "sampler": s.sampler,
-                "pruner": s.pruner,
-                "complete": states.count("COMPLETE"),
-                "pruned": states.count("PRUNED"),
-                "failed": states.count("FAIL"),
-                "wall_s": _num(s.wall_s()),
-                "best": None if b is None else b.value,
-                "best_x1e3": None if b is None else b.value * 1e3,
-            }
-        )
+        entry["generalisation"] = evaluate_params(other, params)[1].to_dict()
+    return entry, est
+
+
+def _study_row(s: StudyRecord) -> dict[str, Any]:
+    """One study's line of the studies table: its set-up, trial counts, wall time and best."""
+    states = [t.state for t in s.trials]
+    b = s.best
+    return {
+        "name": s.name,
+        "model": s.model,
+        "sampler": s.sampler,
+        "pruner": s.pruner,
+        "complete": states.count("COMPLETE"),
+        "pruned": states.count("PRUNED"),
+        "failed": states.count("FAIL"),
+        "wall_s": _num(s.wall_s()),
+        "best": None if b is None else b.value,
+        "best_x1e3": None if b is None else b.value * 1e3,
+    }
+
+
+def _report_plots(
+    studies: Sequence[StudyRecord], train: Any, estimates: dict[str, Any], out: Path
+) -> list[str]:
+    """The loss-against-time plots of both models and the manoeuvring tracks; their names."""
     plots = []
     for model in ("cv", "ca"):
         if plot_loss_vs_time(studies, model, out / f"loss_vs_time_{model}.png"):
@@ -398,24 +442,17 @@ def write_report(
     if picks:
         plot_tracks(train, estimates, picks, out / "tracks.png")
         plots.append("tracks.png")
-    if tests is not None:
-        result["test_sets"] = tests
-        plot_test_sets(result["test_sets"], out / "test_sets.png")
-        plots.append("test_sets.png")
-    if sensitivity:
-        add_sensitivity(result, storage, studies, out, generalisation_dataset, train_file,
-                        sensitivity_points, clutter_variants, progress)  # fmt: skip
-    result["plots"] = plots
-    if "cv" in result["models"] and "ca" in result["models"]:
-        cv = result["models"]["cv"]["training"]["loss_total"]
-        ca = result["models"]["ca"]["training"]["loss_total"]
-        result["conclusion"] = {
-            "cv_over_ca": cv / ca,
-            "cv_not_worse_than_ca_by_more_than_5_percent": bool(cv <= (1 + CV_TOLERANCE) * ca),
-        }
-    write_json_atomic(out / "report.json", result)
-    write_text_atomic(out / "report.md", render_markdown(result))
-    return result
+    return plots
+
+
+def _conclusion(models: dict[str, Any]) -> dict[str, Any]:
+    """CV's training loss against CA's, and whether CV is within the tolerance."""
+    cv = models["cv"]["training"]["loss_total"]
+    ca = models["ca"]["training"]["loss_total"]
+    return {
+        "cv_over_ca": cv / ca,
+        "cv_not_worse_than_ca_by_more_than_5_percent": bool(cv <= (1 + CV_TOLERANCE) * ca),
+    }
 
 
 def table_dataset(
@@ -615,7 +652,20 @@ def _test_section(r: dict[str, Any]) -> list[str]:
 
 def render_markdown(r: dict[str, Any]) -> str:
     """The report as Markdown (numbers from :func:`write_report`'s dict)."""
-    models = r["models"]
+    lines = _head_lines(r)
+    lines += _table_i_lines(r)
+    lines += _decomposition_lines(r["models"])
+    lines += _metrics_lines(r)
+    lines += _people_section(r)
+    lines += _test_section(r)
+    lines += sensitivity_markdown(r)
+    lines += _chosen_lines(r["models"])
+    lines += _studies_lines(r)
+    return "\n".join(lines)
+
+
+def _head_lines(r: dict[str, Any]) -> list[str]:
+    """Title, the command that made the report and the training set."""
     lines = [
         "# Tuning report: optimal IPDA parameters (Table I)",
         "",
@@ -636,6 +686,14 @@ def render_markdown(r: dict[str, Any]) -> str:
             else "."
         ),
         "",
+    ]
+    return lines
+
+
+def _table_i_lines(r: dict[str, Any]) -> list[str]:
+    """Table I (mean loss per class, this simulation beside the paper) and the CV/CA check."""
+    models = r["models"]
+    lines = [
         "## Table I — mean loss per class, ×10⁻³",
         "",
         "| model | source | A | B | C | D | E | total |",
@@ -664,6 +722,12 @@ def render_markdown(r: dict[str, Any]) -> str:
             f"conclusion (CV not worse than CA by more than 5 %) {verdict} here "
             "(paper: 1.021 / 1.046 = 0.976).",
         ]
+    return lines
+
+
+def _decomposition_lines(models: dict[str, Any]) -> list[str]:
+    """The loss split into MSE and N_c per model and class."""
+    lines: list[str] = []
     lines += [
         "",
         "## Decomposition: L(k) = MSE(k) / N_c(k)",
@@ -691,6 +755,13 @@ def render_markdown(r: dict[str, Any]) -> str:
                 f"{_f(row['n_c'], '.1f')} | {row['n_trajectories']} | {row['n_unconfirmed']} | "
                 f"{far} | {_f(None if worst is None else worst * 1e3, '.4f')} |"
             )
+    return lines
+
+
+def _metrics_lines(r: dict[str, Any]) -> list[str]:
+    """Metrics besides the paper's loss on the training and generalisation sets."""
+    models = r["models"]
+    lines: list[str] = []
     lines += [
         "",
         "For scale: a trajectory with N_c = 170 and an RMSE of 0.1 m scores L = 0.01/170 = "
@@ -719,9 +790,12 @@ def render_markdown(r: dict[str, Any]) -> str:
                 f"{_f(e['mean_first_confirmation_s'], '.2f')} | {e['far_frames']} | "
                 f"{_f(e['ospa_mean_m'], '.3f')} |"
             )
-    lines += _people_section(r)
-    lines += _test_section(r)
-    lines += sensitivity_markdown(r)
+    return lines
+
+
+def _chosen_lines(models: dict[str, Any]) -> list[str]:
+    """The chosen parameters of each model, how they were chosen, as JSON."""
+    lines: list[str] = []
     lines += ["", "## Chosen parameters", ""]
     for model in ("cv", "ca"):
         if model not in models:
@@ -743,6 +817,12 @@ def render_markdown(r: dict[str, Any]) -> str:
             "```",
             "",
         ]
+    return lines
+
+
+def _studies_lines(r: dict[str, Any]) -> list[str]:
+    """The studies table (best loss against run time) and the plots."""
+    lines: list[str] = []
     lines += [
         "## Best loss against run time",
         "",
@@ -759,7 +839,7 @@ def render_markdown(r: dict[str, Any]) -> str:
     lines.append("")
     for p in r.get("plots", []):
         lines += [f"![{p}]({p})", ""]
-    return "\n".join(lines)
+    return lines
 
 
 def _people_section(r: dict[str, Any]) -> list[str]:

@@ -106,6 +106,25 @@ def plan(
         The detection chain; TI's chains (``oob``, ``people-counting``) need a baseband cube,
         so they run on the exact level only.
     """
+    _check_plan_args(fidelity, consumer, chain)
+    keep = keep_rd_maps or consumer == "gui"
+    study = consumer == "study"
+    needs_el = scene.radar.has_elevation and not scene.is_planar
+    stage = _stage_maker(force, study)
+    stages = _scene_stages(scene, stage) + _processing_stages(
+        scene, stage, fidelity=fidelity, keep=keep, needs_el=needs_el, study=study
+    )
+    unknown = sorted(set(force) - {s.name for s in stages})
+    if unknown:
+        raise InputError(f"force: unknown stage(s) {unknown}")
+    all_stages: tuple[Stage, ...] = stages
+    if chain.name != "paper":
+        all_stages = _chain_stages(stages, chain, study)
+    return Plan(stages=all_stages, fidelity=fidelity, consumer=consumer, chain=chain)
+
+
+def _check_plan_args(fidelity: str, consumer: str, chain: ChainConfig) -> None:
+    """InputError for an unknown level or consumer, or a TI chain off the exact level."""
     # the registry is imported here, not at load: ``import core.pipeline`` stays light
     from core.simulation.levels import fidelity_level
 
@@ -117,22 +136,12 @@ def plan(
         )
     if consumer not in CONSUMERS:
         raise InputError(f"consumer must be one of {list(CONSUMERS)}, got {consumer!r}")
-    keep = keep_rd_maps or consumer == "gui"
-    study = consumer == "study"
-    has_clutter = scene.clutter_density_per_m2 > 0
-    drawn_rcs = [i for i, p in enumerate(scene.persons) if p.rcs_dbsm is None]
-    extended = [i for i, p in enumerate(scene.persons) if p.kind != "point"]
-    walking = [i for i, p in enumerate(scene.persons) if p.kind == "walking"]
-    blob = [i for i in extended if i not in walking]
-    body_why = " and ".join(
-        (
-            [f"extended model (torso, arms, legs, micro-Doppler) for person(s) {blob}"]
-            if blob
-            else []
-        )
-        + ([f"walking body (17 segments, Boulic gait) for person(s) {walking}"] if walking else [])
-    )
-    needs_el = scene.radar.has_elevation and not scene.is_planar
+
+
+def _stage_maker(force: Sequence[str], study: bool):
+    """``stage(name, needs, produces, run, why_run, why_skip)``: a :class:`Stage` whose run
+    flag and reason follow the plan's rules (forced stages run; a study trial runs only the
+    loading of cached point clouds)."""
 
     def stage(name, needs, produces, run, why_run, why_skip):
         run = bool(run) or name in force
@@ -144,9 +153,33 @@ def plan(
                 why = "forced"
         return Stage(name=name, needs=needs, produces=produces, run=run, reason=why)
 
+    return stage
+
+
+def _body_why(scene: Scene) -> str:
+    """Why the body model runs: which persons are extended blobs and which walking bodies."""
+    extended = [i for i, p in enumerate(scene.persons) if p.kind != "point"]
+    walking = [i for i, p in enumerate(scene.persons) if p.kind == "walking"]
+    blob = [i for i in extended if i not in walking]
+    return " and ".join(
+        (
+            [f"extended model (torso, arms, legs, micro-Doppler) for person(s) {blob}"]
+            if blob
+            else []
+        )
+        + ([f"walking body (17 segments, Boulic gait) for person(s) {walking}"] if walking else [])
+    )
+
+
+def _scene_stages(scene: Scene, stage) -> tuple[Stage, ...]:
+    """The stages that build each frame's reflectors: truth to scatterers."""
+    has_clutter = scene.clutter_density_per_m2 > 0
+    drawn_rcs = [i for i, p in enumerate(scene.persons) if p.rcs_dbsm is None]
+    extended = [i for i, p in enumerate(scene.persons) if p.kind != "point"]
+    body_why = _body_why(scene)
     lam = scene.clutter_density_per_m2
     room = scene.room
-    stages = (
+    return (
         stage(
             "truth", ("trajectories",), ("truth_xy", "truth_v"), True,
             f"{scene.n_persons} person(s), {scene.n_frames} frames of eq. (6)", "",
@@ -191,6 +224,14 @@ def plan(
              "static_reflectors", "multipath_paths"),
             ("scatterers",), True, "reflectors of each frame", "",
         ),
+    )  # fmt: skip
+
+
+def _processing_stages(
+    scene: Scene, stage, *, fidelity: str, keep: bool, needs_el: bool, study: bool
+) -> tuple[Stage, ...]:
+    """The radar's stages: baseband synthesis to the point cloud, and the study's loading."""
+    return (
         stage(
             "baseband", ("scatterers", "antenna_gain"), ("cube",), True,
             f"{fidelity} synthesis [virtual, loop, sample] + receiver noise", "",
@@ -237,13 +278,6 @@ def plan(
             "point clouds are simulated here",
         ),
     )  # fmt: skip
-    unknown = sorted(set(force) - {s.name for s in stages})
-    if unknown:
-        raise InputError(f"force: unknown stage(s) {unknown}")
-    all_stages: tuple[Stage, ...] = stages
-    if chain.name != "paper":
-        all_stages = _chain_stages(stages, chain, study)
-    return Plan(stages=all_stages, fidelity=fidelity, consumer=consumer, chain=chain)
 
 
 #: What TI's chains run instead of the paper's detection stages (docs/radar-chain.md, "Chains").

@@ -1,7 +1,6 @@
 """bench trackers: ghost tracks on constructed frames, the scores of each tracker kind, the room
 the transfer bench walks the paper's trajectories in, and the quick run end to end."""
 
-import dataclasses
 import json
 from types import SimpleNamespace
 
@@ -52,17 +51,8 @@ def test_sim_scores_of_a_walker_with_truth() -> None:
 
 
 @pytest.mark.parametrize("kind", ["paper", "room", "gtrack"])
-def test_recording_scores_of_each_kind(kind) -> None:
-    base = synthetic_dataset(12, 1, classes="a", n_frames=100)
-    empty = np.zeros((base.n_frames, 0, 2))
-    walker = dataclasses.replace(base, truth_xy_m=empty, truth_v_mps=empty)
-    f = np.flatnonzero(np.isfinite(base.truth_xy_m[:, 0, 0]))
-    xy = base.truth_xy_m[f, 0]
-    reference = dataclasses.replace(
-        walker, ref_frame=f, ref_track_id=np.zeros(len(f), np.int64), ref_x_m=xy[:, 0],
-        ref_y_m=xy[:, 1], ref_z_m=np.zeros(len(f)), ref_vx_mps=np.zeros(len(f)),
-        ref_vy_mps=np.zeros(len(f)),
-    )  # fmt: skip
+def test_recording_scores_of_each_kind(kind, walker_and_reference) -> None:
+    walker, reference = walker_and_reference("a")
     s = trackers.rec_scores(walker, reference, kind, trackers.default_params(kind))
     assert set(s) == set(trackers.REC_FIGURES)
     assert 0.0 <= s["walker_right_count"] <= 1.0

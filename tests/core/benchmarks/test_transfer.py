@@ -1,14 +1,10 @@
 """bench transfer: its held-out figures and its refusal without the public recordings."""
 
-import dataclasses
-
-import numpy as np
 import pytest
 
 from core.benchmarks import transfer
 from core.errors import InputError
 from core.tracking import TrackerParams
-from core.tracking.synthetic import synthetic_dataset
 
 
 def test_without_the_recordings_one_line(tmp_path, monkeypatch) -> None:
@@ -18,17 +14,8 @@ def test_without_the_recordings_one_line(tmp_path, monkeypatch) -> None:
         transfer.real_folder()
 
 
-def test_scores_of_a_walker_and_a_reference() -> None:
-    base = synthetic_dataset(12, 1, classes="ab", n_frames=100)
-    empty = np.zeros((base.n_frames, 0, 2))
-    walker = dataclasses.replace(base, truth_xy_m=empty, truth_v_mps=empty)
-    f = np.flatnonzero(np.isfinite(base.truth_xy_m[:, 0, 0]))
-    xy = base.truth_xy_m[f, 0]
-    reference = dataclasses.replace(
-        walker, ref_frame=f, ref_track_id=np.zeros(len(f), np.int64), ref_x_m=xy[:, 0],
-        ref_y_m=xy[:, 1], ref_z_m=np.zeros(len(f)), ref_vx_mps=np.zeros(len(f)),
-        ref_vy_mps=np.zeros(len(f)),
-    )  # fmt: skip
+def test_scores_of_a_walker_and_a_reference(walker_and_reference) -> None:
+    walker, reference = walker_and_reference("ab")
     s = transfer._scores(TrackerParams.default("cv").to_dict(), walker, reference)
     assert set(transfer.FIGURES) <= set(s)
     assert 0.8 < s["walker_right_count"] <= 1.0  # one synthetic walker, mostly one track
