@@ -5,7 +5,9 @@ forth between 1.5 and 6 m in front of the radar, simulated through each chain wi
 radar (``resources/radar``), no walls (the open field); the recordings are read with the
 project's readers. The same estimator is applied to both, since the recordings have no truth:
 per frame, the *person* is the moving points (|v| > 0.05 m/s) within 1 m (x-y) of their
-median; of them the count, the spread (standard deviation) in x, y and z, the
+median; of them the count, the spread (standard deviation) in x, y and z (z also by the
+person's range band, since at a given angular spread it grows with range), the spread of the
+elevation angle ``asin(z / r)``, the person's median range, the
 Doppler spread and the median SNR; of all points, the zero-Doppler fraction by range band and
 the share of zero-Doppler points that recur in the next frame; of the moving points, the ghost
 fraction (:mod:`core.benchmarks.wall_loss`). Distributions over frames as median, p10, p90.
@@ -47,6 +49,10 @@ def frame_stats(frames: list[dict]) -> dict:
     from core.benchmarks.wall_loss import ghost_fraction
 
     n_person, sx, sy, sz, sv, snr = [], [], [], [], [], []
+    # the elevation spread (deg) and the person's range: z spread grows with range at a given
+    # angular spread, so z is compared by range band too
+    sel, rng_p = [], []
+    sz_band: dict[str, list[float]] = {f"{lo:g}-{hi:g} m": [] for lo, hi in RANGE_BANDS_M}
     zero = {f"{lo:g}-{hi:g} m": [0, 0] for lo, hi in RANGE_BANDS_M}
     for f in frames:
         x, y, z, v = f["x"], f["y"], f["z"], f["v"]
@@ -67,6 +73,13 @@ def frame_stats(frames: list[dict]) -> dict:
             sy.append(np.std(y[near]))
             sz.append(np.std(z[near]))
             sv.append(np.std(v[near]))
+            with np.errstate(invalid="ignore", divide="ignore"):
+                el = np.degrees(np.arcsin(np.clip(z[near] / r[near], -1.0, 1.0)))
+            sel.append(np.std(el))
+            rng_p.append(float(np.median(r[near])))
+            for lo, hi in RANGE_BANDS_M:
+                if lo <= rng_p[-1] < hi:
+                    sz_band[f"{lo:g}-{hi:g} m"].append(float(np.std(z[near])))
         snr.append(np.nanmedian(f["snr"][near]) if np.isfinite(f["snr"][near]).any() else np.nan)
     return {
         "frames": len(frames),
@@ -75,6 +88,9 @@ def frame_stats(frames: list[dict]) -> dict:
         "spread_x_m": _q(sx),
         "spread_y_m": _q(sy),
         "spread_z_m": _q(sz),
+        "spread_elevation_deg": _q(sel),
+        "person_range_m": _q(rng_p),
+        "spread_z_by_range_m": {k: _q(v) for k, v in sz_band.items()},
         "doppler_spread_mps": _q(sv),
         "person_snr_db": _q(snr),
         "zero_doppler_fraction": {k: (c[0] / c[1] if c[1] else None) for k, c in zero.items()},
@@ -346,6 +362,8 @@ METRICS = (
     ("spread_x_m", "spread x (m)"),
     ("spread_y_m", "spread y (m)"),
     ("spread_z_m", "spread z (m)"),
+    ("spread_elevation_deg", "elevation spread (deg)"),
+    ("person_range_m", "person's range (m)"),
     ("doppler_spread_mps", "Doppler spread (m/s)"),
 )
 
@@ -490,6 +508,11 @@ def summary(result: dict) -> str:
                 f"{k} {v:.2f}" if v is not None else f"{k} -"
                 for k, v in s["zero_doppler_fraction"].items()
             )
+            zb = ", ".join(
+                f"{k} {q['median']:.2f} (n {q['n']})"
+                for k, q in s["spread_z_by_range_m"].items()
+                if q["median"] is not None
+            )
             g = s["ghost_fraction"]
             ghost = "-" if g is None else f"{g:.3f}"
             rc = s["static_recurring_fraction"]
@@ -497,7 +520,9 @@ def summary(result: dict) -> str:
             lines.append(
                 f"  {label} ({s['frames']} frames): points/frame {f('points_per_frame', '.0f')}, "
                 f"person {f('person_points_per_frame', '.0f')}, spread x {f('spread_x_m')} "
-                f"y {f('spread_y_m')} z {f('spread_z_m')} m, Doppler {f('doppler_spread_mps')} "
+                f"y {f('spread_y_m')} z {f('spread_z_m')} m (elevation "
+                f"{f('spread_elevation_deg', '.1f')} deg; z by range: {zb}; person at "
+                f"{f('person_range_m')} m), Doppler {f('doppler_spread_mps')} "
                 f"m/s, SNR {f('person_snr_db', '.1f')} dB; zero-Doppler fraction {zero}; ghost "
                 f"fraction {ghost}"
             )
