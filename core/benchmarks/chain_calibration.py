@@ -2,7 +2,8 @@
 
 ``radartune bench chain_calibration``: a walking body (the default person model) walks back and
 forth between 1.5 and 6 m in front of the radar, simulated through each chain with its own
-radar (``resources/radar``), no walls (the open field); the recordings are read with the
+radar (``resources/radar``), no walls (the open field), and for ``people-counting`` also between
+0.6 and 2.2 m (:data:`NEAR`, where the recordings' people are); the recordings are read with the
 project's readers. The same estimator is applied to both, since the recordings have no truth:
 per frame, the *person* is the moving points (|v| > 0.05 m/s) within 1 m (x-y) of their
 median; of them the count, the spread (standard deviation) in x, y and z (z also by the
@@ -143,8 +144,14 @@ def _frames_of_cloud(pc, counts) -> list[dict]:
     return out
 
 
-def walker_scene(cfg: Path, frames: int, seed: int):
-    """A walking body back and forth between 1.5 and 6 m, 15 deg off boresight."""
+#: The walker's waypoints: between 1.5 and 6 m, 15 deg off boresight; :data:`NEAR`: between
+#: 0.6 and 2.2 m, the ranges of the people in the people-counting recordings (median 0.7 m).
+FAR = ((0.4, 1.5, 1.1), (1.5, 6.0, 1.1), (0.4, 1.5, 1.1), (1.5, 6.0, 1.1))
+NEAR = ((0.1, 0.6, 0.8), (0.5, 2.2, 0.8), (0.1, 0.6, 0.8), (0.5, 2.2, 0.8))
+
+
+def walker_scene(cfg: Path, frames: int, seed: int, waypoints: tuple = FAR):
+    """A walking body back and forth along ``waypoints`` (:data:`FAR` by default)."""
     from core.scene import Scene
 
     data = {
@@ -156,14 +163,7 @@ def walker_scene(cfg: Path, frames: int, seed: int):
         "persons": [
             {
                 "model": "walking",
-                "trajectory": {
-                    "waypoints": [
-                        [0.4, 1.5, 1.1],
-                        [1.5, 6.0, 1.1],
-                        [0.4, 1.5, 1.1],
-                        [1.5, 6.0, 1.1],
-                    ]
-                },
+                "trajectory": {"waypoints": [list(w) for w in waypoints]},
             }
         ],
     }
@@ -171,14 +171,14 @@ def walker_scene(cfg: Path, frames: int, seed: int):
     return scene, min(frames, scene.n_frames)
 
 
-def simulated(cfg_name: str, frames: int, seed: int = 5) -> dict:
+def simulated(cfg_name: str, frames: int, seed: int = 5, waypoints: tuple = FAR) -> dict:
     from core.formats.ti_cfg import read_ti_chain
     from core.pipeline import plan
     from core.pipeline.frames import iter_frames
 
     cfg = ROOT / "resources" / "radar" / cfg_name
     chain = read_ti_chain(cfg) if cfg_name != "paper.cfg" else None
-    scene, n = walker_scene(cfg, frames, seed)
+    scene, n = walker_scene(cfg, frames, seed, waypoints)
     p = plan(scene, chain=chain) if chain is not None else plan(scene)
     out = []
     for fr in iter_frames(scene, the_plan=p, frames=range(n)):
@@ -254,6 +254,11 @@ MMGAIT = tuple(f"mmgait_walkers/room2_1p_fixed_60GHz_{k}.csv" for k in ("002", "
 #: The recording the walls' loss is fitted on; the others are held out.
 TRAIN = MMGAIT[0]
 PC3 = "pc3_iwr6843/pc3_2023-06-21-12-27-01.csv"
+#: The other people-counting recordings (the 2021 ISK file, the overhead AOP one): checks.
+PC3_OTHERS = (
+    "pc3_iwr6843/pc3_2021-12-19-21-25-28.csv",
+    "pc3_iwr6843/pc3Aop2021-04-07-23-52-34.csv",
+)
 OOB_CFG = "oob_isk.cfg"
 PC_CFG = "people_counting_isk_static.cfg"
 
@@ -326,6 +331,9 @@ def run(quick: bool = False) -> dict:
         "people-counting": {
             "simulated, static chain on (people_counting_isk_static.cfg)": simulated(PC_CFG, n),
             "simulated, TI's file (static off)": simulated("people_counting_isk.cfg", n),
+            "simulated, walker at 0.6-2.2 m (the recordings' ranges)": simulated(
+                PC_CFG, n, waypoints=NEAR
+            ),
             "recorded: pc3_2023 (IWR6843ISK, TI people counting)": recorded_people_counting(),
         },
         "oob": {
@@ -345,6 +353,10 @@ def run(quick: bool = False) -> dict:
             "simulated in a room, fitted walls": fit["oob_fitted"],
             **result["oob"],
         }
+    for rel in PC3_OTHERS:
+        fr = recording_frames(rel)
+        if fr is not None:
+            result["people-counting"][f"recorded: {Path(rel).stem}"] = frame_stats(fr)
     for rel in MMGAIT:
         fr = recording_frames(rel)
         if fr is not None:
