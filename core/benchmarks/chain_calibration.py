@@ -34,6 +34,9 @@ from core.benchmarks.clouds import real_data_dir
 ROOT = Path(__file__).resolve().parents[2]
 RANGE_BANDS_M = ((0.0, 2.0), (2.0, 4.0), (4.0, 6.0), (6.0, 10.0))
 MOVING_MPS = 0.05
+#: A point is at the edge of the elevation field of view (``fovCfg`` 20 deg in TI's people
+#: counting cfgs; its search grid ends at 18-19.5 deg) from this elevation on, deg.
+EDGE_DEG = 18.0
 
 
 def _q(values: list[float] | np.ndarray) -> dict:
@@ -52,7 +55,7 @@ def frame_stats(frames: list[dict]) -> dict:
     n_person, sx, sy, sz, sv, snr = [], [], [], [], [], []
     # the elevation spread (deg) and the person's range: z spread grows with range at a given
     # angular spread, so z is compared by range band too
-    sel, rng_p = [], []
+    sel, rng_p, edge = [], [], [0, 0, 0]
     sz_band: dict[str, list[float]] = {f"{lo:g}-{hi:g} m": [] for lo, hi in RANGE_BANDS_M}
     zero = {f"{lo:g}-{hi:g} m": [0, 0] for lo, hi in RANGE_BANDS_M}
     for f in frames:
@@ -77,6 +80,9 @@ def frame_stats(frames: list[dict]) -> dict:
             with np.errstate(invalid="ignore", divide="ignore"):
                 el = np.degrees(np.arcsin(np.clip(z[near] / r[near], -1.0, 1.0)))
             sel.append(np.std(el))
+            edge[0] += int(np.sum(el >= EDGE_DEG))
+            edge[1] += int(np.sum(el <= -EDGE_DEG))
+            edge[2] += int(near.sum())
             rng_p.append(float(np.median(r[near])))
             for lo, hi in RANGE_BANDS_M:
                 if lo <= rng_p[-1] < hi:
@@ -92,6 +98,10 @@ def frame_stats(frames: list[dict]) -> dict:
         "spread_elevation_deg": _q(sel),
         "person_range_m": _q(rng_p),
         "spread_z_by_range_m": {k: _q(v) for k, v in sz_band.items()},
+        # shares of the person's points at the top / bottom edge of a +-20 deg elevation view
+        "elevation_edge_share": (
+            {"top": edge[0] / edge[2], "bottom": edge[1] / edge[2]} if edge[2] else None
+        ),
         "doppler_spread_mps": _q(sv),
         "person_snr_db": _q(snr),
         "zero_doppler_fraction": {k: (c[0] / c[1] if c[1] else None) for k, c in zero.items()},
@@ -525,6 +535,9 @@ def summary(result: dict) -> str:
                 for k, q in s["spread_z_by_range_m"].items()
                 if q["median"] is not None
             )
+            e = s["elevation_edge_share"]
+            if e is not None:
+                zb += f"; at the elevation edge: top {e['top']:.2f}, bottom {e['bottom']:.2f}"
             g = s["ghost_fraction"]
             ghost = "-" if g is None else f"{g:.3f}"
             rc = s["static_recurring_fraction"]

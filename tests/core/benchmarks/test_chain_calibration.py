@@ -35,6 +35,13 @@ def test_frame_stats_person_spread_and_zero_doppler_by_band():
     band = s["spread_z_by_range_m"]
     assert band["2-4 m"]["n"] == 50 and band["0-2 m"]["n"] == 0 and band["4-6 m"]["n"] == 0
     assert band["2-4 m"]["median"] == s["spread_z_m"]["median"]
+    # no point near 18 deg (z ~ 1 m at 3.16 m would be 20 sigma away)
+    assert s["elevation_edge_share"] == {"top": 0.0, "bottom": 0.0}
+    # a frame whose person's points all sit at +19 deg: all at the top edge
+    el = np.radians(19.0)
+    top = {k: np.full(3, val) for k, val in (("x", 0.0), ("v", 1.0), ("snr", 10.0))}
+    top["y"], top["z"] = np.full(3, np.cos(el)), np.full(3, np.sin(el))
+    assert frame_stats([top])["elevation_edge_share"] == {"top": 1.0, "bottom": 0.0}
 
 
 def test_static_recurrence_tells_furniture_from_scattered_false_alarms():
