@@ -319,7 +319,8 @@ class TopView(pg.PlotWidget):
 
     def set_waypoints(self, rows) -> None:
         """Show the selected person's waypoints (``None``: not a drawn trajectory)."""
-        rows = [list(map(float, r)) for r in (rows or [])]
+        # x, y as numbers; the rest (speed, hold, a seated stop's "sit") kept as given
+        rows = [[float(r[0]), float(r[1]), *r[2:]] for r in (rows or [])]
         self._waypoint_rows = rows
         while len(self._waypoint_items) > len(rows):
             self.removeItem(self._waypoint_items.pop())

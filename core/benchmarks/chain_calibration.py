@@ -2,10 +2,13 @@
 
 ``radartune bench chain_calibration``: a walking body (the default person model) walks back and
 forth between 1.5 and 6 m in front of the radar, simulated through each chain with its own
-radar (``resources/radar``), no walls (the open field); the recordings are read with the
+radar (``resources/radar``), no walls (the open field), and for ``people-counting`` also between
+0.6 and 2.2 m (:data:`NEAR`, where the recordings' people are); the recordings are read with the
 project's readers. The same estimator is applied to both, since the recordings have no truth:
 per frame, the *person* is the moving points (|v| > 0.05 m/s) within 1 m (x-y) of their
-median; of them the count, the spread (standard deviation) in x, y and z, the
+median; of them the count, the spread (standard deviation) in x, y and z (z also by the
+person's range band, since at a given angular spread it grows with range), the spread of the
+elevation angle ``asin(z / r)``, the person's median range, the
 Doppler spread and the median SNR; of all points, the zero-Doppler fraction by range band and
 the share of zero-Doppler points that recur in the next frame; of the moving points, the ghost
 fraction (:mod:`core.benchmarks.wall_loss`). Distributions over frames as median, p10, p90.
@@ -31,6 +34,9 @@ from core.benchmarks.clouds import real_data_dir
 ROOT = Path(__file__).resolve().parents[2]
 RANGE_BANDS_M = ((0.0, 2.0), (2.0, 4.0), (4.0, 6.0), (6.0, 10.0))
 MOVING_MPS = 0.05
+#: A point is at the edge of the elevation field of view (``fovCfg`` 20 deg in TI's people
+#: counting cfgs; its search grid ends at 18-19.5 deg) from this elevation on, deg.
+EDGE_DEG = 18.0
 
 
 def _q(values: list[float] | np.ndarray) -> dict:
@@ -47,6 +53,10 @@ def frame_stats(frames: list[dict]) -> dict:
     from core.benchmarks.wall_loss import ghost_fraction
 
     n_person, sx, sy, sz, sv, snr = [], [], [], [], [], []
+    # the elevation spread (deg) and the person's range: z spread grows with range at a given
+    # angular spread, so z is compared by range band too
+    sel, rng_p, edge = [], [], [0, 0, 0]
+    sz_band: dict[str, list[float]] = {f"{lo:g}-{hi:g} m": [] for lo, hi in RANGE_BANDS_M}
     zero = {f"{lo:g}-{hi:g} m": [0, 0] for lo, hi in RANGE_BANDS_M}
     for f in frames:
         x, y, z, v = f["x"], f["y"], f["z"], f["v"]
@@ -67,6 +77,16 @@ def frame_stats(frames: list[dict]) -> dict:
             sy.append(np.std(y[near]))
             sz.append(np.std(z[near]))
             sv.append(np.std(v[near]))
+            with np.errstate(invalid="ignore", divide="ignore"):
+                el = np.degrees(np.arcsin(np.clip(z[near] / r[near], -1.0, 1.0)))
+            sel.append(np.std(el))
+            edge[0] += int(np.sum(el >= EDGE_DEG))
+            edge[1] += int(np.sum(el <= -EDGE_DEG))
+            edge[2] += int(near.sum())
+            rng_p.append(float(np.median(r[near])))
+            for lo, hi in RANGE_BANDS_M:
+                if lo <= rng_p[-1] < hi:
+                    sz_band[f"{lo:g}-{hi:g} m"].append(float(np.std(z[near])))
         snr.append(np.nanmedian(f["snr"][near]) if np.isfinite(f["snr"][near]).any() else np.nan)
     return {
         "frames": len(frames),
@@ -75,6 +95,13 @@ def frame_stats(frames: list[dict]) -> dict:
         "spread_x_m": _q(sx),
         "spread_y_m": _q(sy),
         "spread_z_m": _q(sz),
+        "spread_elevation_deg": _q(sel),
+        "person_range_m": _q(rng_p),
+        "spread_z_by_range_m": {k: _q(v) for k, v in sz_band.items()},
+        # shares of the person's points at the top / bottom edge of a +-20 deg elevation view
+        "elevation_edge_share": (
+            {"top": edge[0] / edge[2], "bottom": edge[1] / edge[2]} if edge[2] else None
+        ),
         "doppler_spread_mps": _q(sv),
         "person_snr_db": _q(snr),
         "zero_doppler_fraction": {k: (c[0] / c[1] if c[1] else None) for k, c in zero.items()},
@@ -127,8 +154,14 @@ def _frames_of_cloud(pc, counts) -> list[dict]:
     return out
 
 
-def walker_scene(cfg: Path, frames: int, seed: int):
-    """A walking body back and forth between 1.5 and 6 m, 15 deg off boresight."""
+#: The walker's waypoints: between 1.5 and 6 m, 15 deg off boresight; :data:`NEAR`: between
+#: 0.6 and 2.2 m, the ranges of the people in the people-counting recordings (median 0.7 m).
+FAR = ((0.4, 1.5, 1.1), (1.5, 6.0, 1.1), (0.4, 1.5, 1.1), (1.5, 6.0, 1.1))
+NEAR = ((0.1, 0.6, 0.8), (0.5, 2.2, 0.8), (0.1, 0.6, 0.8), (0.5, 2.2, 0.8))
+
+
+def walker_scene(cfg: Path, frames: int, seed: int, waypoints: tuple = FAR):
+    """A walking body back and forth along ``waypoints`` (:data:`FAR` by default)."""
     from core.scene import Scene
 
     data = {
@@ -140,14 +173,7 @@ def walker_scene(cfg: Path, frames: int, seed: int):
         "persons": [
             {
                 "model": "walking",
-                "trajectory": {
-                    "waypoints": [
-                        [0.4, 1.5, 1.1],
-                        [1.5, 6.0, 1.1],
-                        [0.4, 1.5, 1.1],
-                        [1.5, 6.0, 1.1],
-                    ]
-                },
+                "trajectory": {"waypoints": [list(w) for w in waypoints]},
             }
         ],
     }
@@ -155,13 +181,13 @@ def walker_scene(cfg: Path, frames: int, seed: int):
     return scene, min(frames, scene.n_frames)
 
 
-def simulated(cfg_name: str, frames: int, seed: int = 5) -> dict:
+def simulated(cfg_name: str, frames: int, seed: int = 5, waypoints: tuple = FAR) -> dict:
     from core.formats.ti_cfg import read_ti_chain
     from core.pipeline import plan
 
     cfg = ROOT / "resources" / "radar" / cfg_name
     chain = read_ti_chain(cfg) if cfg_name != "paper.cfg" else None
-    scene, n = walker_scene(cfg, frames, seed)
+    scene, n = walker_scene(cfg, frames, seed, waypoints)
     p = plan(scene, chain=chain) if chain is not None else plan(scene)
     return frame_stats(cloud_frames(scene, p, n))
 
@@ -246,6 +272,11 @@ MMGAIT = tuple(f"mmgait_walkers/room2_1p_fixed_60GHz_{k}.csv" for k in ("002", "
 #: The recording the walls' loss is fitted on; the others are held out.
 TRAIN = MMGAIT[0]
 PC3 = "pc3_iwr6843/pc3_2023-06-21-12-27-01.csv"
+#: The other people-counting recordings (the 2021 ISK file, the overhead AOP one): checks.
+PC3_OTHERS = (
+    "pc3_iwr6843/pc3_2021-12-19-21-25-28.csv",
+    "pc3_iwr6843/pc3Aop2021-04-07-23-52-34.csv",
+)
 OOB_CFG = "oob_isk.cfg"
 PC_CFG = "people_counting_isk_static.cfg"
 
@@ -318,6 +349,9 @@ def run(quick: bool = False) -> dict:
         "people-counting": {
             "simulated, static chain on (people_counting_isk_static.cfg)": simulated(PC_CFG, n),
             "simulated, TI's file (static off)": simulated("people_counting_isk.cfg", n),
+            "simulated, walker at 0.6-2.2 m (the recordings' ranges)": simulated(
+                PC_CFG, n, waypoints=NEAR
+            ),
             "recorded: pc3_2023 (IWR6843ISK, TI people counting)": recorded_people_counting(),
         },
         "oob": {
@@ -337,6 +371,10 @@ def run(quick: bool = False) -> dict:
             "simulated in a room, fitted walls": fit["oob_fitted"],
             **result["oob"],
         }
+    for rel in PC3_OTHERS:
+        fr = recording_frames(rel)
+        if fr is not None:
+            result["people-counting"][f"recorded: {Path(rel).stem}"] = frame_stats(fr)
     for rel in MMGAIT:
         fr = recording_frames(rel)
         if fr is not None:
@@ -354,6 +392,8 @@ METRICS = (
     ("spread_x_m", "spread x (m)"),
     ("spread_y_m", "spread y (m)"),
     ("spread_z_m", "spread z (m)"),
+    ("spread_elevation_deg", "elevation spread (deg)"),
+    ("person_range_m", "person's range (m)"),
     ("doppler_spread_mps", "Doppler spread (m/s)"),
 )
 
@@ -498,6 +538,14 @@ def summary(result: dict) -> str:
                 f"{k} {v:.2f}" if v is not None else f"{k} -"
                 for k, v in s["zero_doppler_fraction"].items()
             )
+            zb = ", ".join(
+                f"{k} {q['median']:.2f} (n {q['n']})"
+                for k, q in s["spread_z_by_range_m"].items()
+                if q["median"] is not None
+            )
+            e = s["elevation_edge_share"]
+            if e is not None:
+                zb += f"; at the elevation edge: top {e['top']:.2f}, bottom {e['bottom']:.2f}"
             g = s["ghost_fraction"]
             ghost = "-" if g is None else f"{g:.3f}"
             rc = s["static_recurring_fraction"]
@@ -505,7 +553,9 @@ def summary(result: dict) -> str:
             lines.append(
                 f"  {label} ({s['frames']} frames): points/frame {f('points_per_frame', '.0f')}, "
                 f"person {f('person_points_per_frame', '.0f')}, spread x {f('spread_x_m')} "
-                f"y {f('spread_y_m')} z {f('spread_z_m')} m, Doppler {f('doppler_spread_mps')} "
+                f"y {f('spread_y_m')} z {f('spread_z_m')} m (elevation "
+                f"{f('spread_elevation_deg', '.1f')} deg; z by range: {zb}; person at "
+                f"{f('person_range_m')} m), Doppler {f('doppler_spread_mps')} "
                 f"m/s, SNR {f('person_snr_db', '.1f')} dB; zero-Doppler fraction {zero}; ghost "
                 f"fraction {ghost}"
             )

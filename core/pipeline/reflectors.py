@@ -23,6 +23,7 @@ from core.scene.walking import (
     default_gait_phase,
     gait_phase,
     heading_rates,
+    sit_transition,
     walking_scatterers,
 )
 
@@ -42,7 +43,7 @@ class Reflectors:
     extended: np.ndarray  # (n_persons,) bool: a body model (blob or walking) applies
     walking: np.ndarray  # (n_persons,) bool: the walking body (else the blob) where extended
     headings: dict[int, np.ndarray]
-    # walking: (phase, turn rate, height, seated frames or None)
+    # walking: (phase, turn rate, height, seated fraction and rate (F, 2) or None)
     gait: dict[int, tuple[np.ndarray, np.ndarray, float, np.ndarray | None]]
     run_rcs: bool
     run_clutter: bool
@@ -74,7 +75,7 @@ class Reflectors:
                 gait_phase(t_s[:n], q.trajectory.speed_mps, q.body_height_m, phase0),
                 heading_rates(t_s[:n], headings[i]),
                 q.body_height_m,
-                q.trajectory.seated,
+                sit_transition(t_s[:n], q.trajectory.seated),
             )
         fixed_rcs = np.array([np.nan if q.rcs_dbsm is None else q.rcs_dbsm for q in scene.persons])
         return cls(

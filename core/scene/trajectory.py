@@ -236,7 +236,8 @@ def stopping_waypoint_trajectory(
     """A drawn path with stops: waypoints ``[x_m, y_m, speed_mps]``, where a waypoint of speed
     0 is a stop of ``hold_s`` seconds (shape ``(W,)``; 0 elsewhere). ``sit`` (shape ``(W,)``
     bool, optional): the stops where the person sits for the hold (the trajectory's
-    ``seated`` frames are that hold's frames; the body sits down and stands up at once).
+    ``seated`` frames are that hold's frames; the body sits down over the first second of
+    the hold and stands up over its last, :func:`core.scene.walking.sit_transition`).
 
     Between stops the path is walked as :func:`waypoint_trajectory` walks it; a stop's own
     speed (0) is replaced by its walking neighbour's (the walk arrives and leaves at that

@@ -38,8 +38,11 @@ What is approximated (docs/decisions/scene-06-walking-body.md):
   the body comes to rest continuously; a standing person sways (the body above the ankles
   ``+-1 cm`` at ``0.2 Hz``, the legs following by inverse kinematics) and breathes (chest
   ``+-3 mm`` at ``0.25 Hz``), both fading in as the speed falls below 0.3 m/s.
-- Sitting (a ``sit`` stop, the trajectory's ``seated`` frames): the body is seated at once (no
-  sitting-down or standing-up motion) on a seat at knee height: the hip joints at ``0.285 H``
+- Sitting (a ``sit`` stop, the trajectory's ``seated`` frames): the body sits down over the first
+  :data:`SIT_TRANSITION_S` of the hold and stands up over its last (:func:`sit_transition`; each
+  joint moves from the standing to the seated pose along a straight line, the seated fraction a
+  smoothstep ``3 s^2 - 2 s^3`` of the elapsed share ``s``, so the motion starts and ends at rest
+  and its velocity enters the Doppler), on a seat at knee height: the hip joints at ``0.285 H``
   (0.50 m for 1.75 m), the thighs horizontal forward, the shins vertical to the ankles at
   ``0.039 H``, the feet flat; the torso, neck and head upright above the hips (the head's
   centre at ``(0.285 - 0.530 + 0.935) H = 0.690 H``, 1.21 m; :func:`seated_joints`), the upper
@@ -74,6 +77,11 @@ from typing import Any
 
 import numpy as np
 
+#: Duration of sitting down and of standing up (s): healthy adults take about 11-15 s for five
+#: sit-to-stand-to-sit cycles (R. W. Bohannon, "Reference values for the five-repetition
+#: sit-to-stand test", Percept. Mot. Skills 103 (2006) 215-222), i.e. about 1.1-1.5 s a
+#: transition; 1 s, shortened to half the hold for short holds.
+SIT_TRANSITION_S = 1.0
 #: Height of the radar above the floor (m): the segments' z is their height minus this.
 RADAR_HEIGHT_M = 1.0
 #: Default body height (m); the accepted range is core.limits.PERSON_HEIGHT_RANGE_M.
@@ -322,7 +330,9 @@ def body_frame_joints(
     height_m
         Body height, m.
     seated
-        ``None`` or shape ``(F,)`` bool: frames where the body sits (:func:`seated_joints`).
+        ``None``, shape ``(F,)`` bool (frames where the body sits, :func:`seated_joints`), or
+        shape ``(F,)`` float in ``[0, 1]``: the seated fraction (each joint at ``(1 - f)`` times
+        its standing place plus ``f`` times its seated place; :func:`sit_transition`).
 
     Returns
     -------
@@ -398,14 +408,50 @@ def body_frame_joints(
 
     j = _joints(h, phi, rv, rv_w, legs, pel_u + sway_u, pel_w + sway_w, pel_z, alpha_p, alpha_t)
     if seated is not None:
-        sit = np.asarray(seated, dtype=bool)
+        frac = np.asarray(seated, dtype=np.float64)
+        sit = frac > 0
         if sit.any():
             # seated: full sway of the body above the seat (the person is still)
             u = SWAY_AMPLITUDE_M * np.sin(two_pi * SWAY_HZ * t[sit])
             w = 0.5 * SWAY_AMPLITUDE_M * np.sin(two_pi * SWAY_HZ * 0.7 * t[sit] + 1.0)
+            f = frac[sit][:, None]
+            full = f == 1.0
             for name, rows in seated_joints(u, w, h).items():
-                j[name][sit] = rows
+                j[name][sit] = np.where(full, rows, (1.0 - f) * j[name][sit] + f * rows)
     return j
+
+
+def sit_transition(t_s: np.ndarray, seated: np.ndarray | None) -> np.ndarray | None:
+    """The seated fraction and its rate at frame times ``t_s`` (shape ``(F, 2)``: fraction in
+    ``[0, 1]``, rate in 1/s), or None when ``seated`` is None or has no seated frame.
+
+    ``seated`` (shape ``(F,)`` bool): the frames of each seated hold. Over the first
+    ``T = min(SIT_TRANSITION_S, D / 2)`` of a hold from ``t_a`` (its first seated frame) to
+    ``t_b`` (its last; ``D = t_b - t_a``) the fraction rises as ``3 s^2 - 2 s^3``,
+    ``s = (t - t_a) / T``, and over the last ``T`` falls symmetrically; 1 between, 0 outside.
+    """
+    if seated is None:
+        return None
+    m = np.asarray(seated, dtype=bool)
+    if not m.any():
+        return None
+    t = np.asarray(t_s, dtype=np.float64)
+    out = np.zeros((len(t), 2))
+    edges = np.diff(np.concatenate(([0], m.view(np.int8), [0])))
+    for a, b in zip(np.flatnonzero(edges == 1), np.flatnonzero(edges == -1) - 1):
+        ta, tb = t[a], t[b]
+        ramp = min(SIT_TRANSITION_S, 0.5 * (tb - ta))
+        rows = slice(a, b + 1)
+        if ramp <= 0:
+            out[rows, 0] = 1.0
+            continue
+        down = np.clip((t[rows] - ta) / ramp, 0.0, 1.0)
+        up = np.clip((tb - t[rows]) / ramp, 0.0, 1.0)
+        s = np.minimum(down, up)
+        sign = np.where(down <= up, 1.0, -1.0)
+        out[rows, 0] = s * s * (3.0 - 2.0 * s)
+        out[rows, 1] = sign * 6.0 * s * (1.0 - s) / ramp
+    return out
 
 
 def seated_joints(
@@ -586,7 +632,9 @@ def walking_scatterers(
     height_m
         Body height (m).
     seated
-        ``None`` or shape ``(F,)`` bool: frames where the body sits.
+        ``None``, shape ``(F,)`` bool (frames where the body sits at once), or shape ``(F, 2)``:
+        the seated fraction and its rate (1/s) from :func:`sit_transition`, the rate moving
+        the fraction of the neighbouring instants of the velocity's central difference.
 
     Returns
     -------
@@ -601,9 +649,15 @@ def walking_scatterers(
     speed = np.hypot(v[:, 0], v[:, 1])
     rate = 1.0 / cycle_duration_s(speed, height_m)  # dphi/dt
     dt = VELOCITY_STEP_S
-    local = body_frame_segments(phase, speed, t_s, height_m, seated)
-    ahead = body_frame_segments(phase + rate * dt, speed, t_s + dt, height_m, seated)
-    behind = body_frame_segments(phase - rate * dt, speed, t_s - dt, height_m, seated)
+    now = ahead_sit = behind_sit = seated
+    if seated is not None and np.ndim(seated) == 2:
+        sit = np.asarray(seated, dtype=np.float64)
+        now = sit[:, 0]
+        ahead_sit = np.clip(sit[:, 0] + sit[:, 1] * dt, 0.0, 1.0)
+        behind_sit = np.clip(sit[:, 0] - sit[:, 1] * dt, 0.0, 1.0)
+    local = body_frame_segments(phase, speed, t_s, height_m, now)
+    ahead = body_frame_segments(phase + rate * dt, speed, t_s + dt, height_m, ahead_sit)
+    behind = body_frame_segments(phase - rate * dt, speed, t_s - dt, height_m, behind_sit)
     d_local = (ahead - behind) / (2 * dt)
     sh, ch = np.sin(h)[:, None], np.cos(h)[:, None]
     lu, lw = local[..., 0], local[..., 1]

@@ -45,3 +45,20 @@ def test_stop_waypoints_show_and_edit_with_their_hold(qtbot) -> None:
     qtbot.addWidget(table)
     table.set_rows(rows)
     assert table.rows() == rows  # the blank hold cell ends the row: a plain waypoint again
+
+
+def test_seated_stop_shows_and_keeps_its_posture_on_a_drag(qtbot) -> None:
+    from app.views.top_view import TopView
+
+    view = TopView()
+    qtbot.addWidget(view)
+    scene = Scene.from_json(SCENES / "room_office.json")
+    rows = scene.to_dict()["persons"][0]["trajectory"]["waypoints"]
+    assert rows[0][4] == "sit"  # the person at the desk sits
+    view.set_waypoints(rows)  # a "sit" row once failed: float("sit")
+    assert [(i.pos().x(), i.pos().y()) for i in view._waypoint_items] == [(2.0, 4.7), (2.1, 4.6)]
+    got = []
+    view.waypoints_moved.connect(got.append)
+    view._waypoint_items[0].setPos(2.2, 4.8)
+    view._on_waypoint_dragged()
+    assert got == [[[2.2, 4.8, 0.0, 25.0, "sit"], [2.1, 4.6, 0.3]]]

@@ -28,6 +28,20 @@ def test_frame_stats_person_spread_and_zero_doppler_by_band():
     assert s["person_snr_db"]["median"] == 12.0
     zero = s["zero_doppler_fraction"]
     assert zero["2-4 m"] == 0.0 and zero["4-6 m"] == pytest.approx(4 / 5)
+    # the person at range sqrt(1 + 9) = 3.16 m: its z spread (sigma 0.05 m) is an elevation
+    # spread of 0.05 / 3.16 rad = 0.91 deg (median of 6 draws a little below), all in 2-4 m
+    assert s["person_range_m"]["median"] == pytest.approx(np.sqrt(10.0), abs=0.05)
+    assert s["spread_elevation_deg"]["median"] == pytest.approx(0.82, abs=0.15)
+    band = s["spread_z_by_range_m"]
+    assert band["2-4 m"]["n"] == 50 and band["0-2 m"]["n"] == 0 and band["4-6 m"]["n"] == 0
+    assert band["2-4 m"]["median"] == s["spread_z_m"]["median"]
+    # no point near 18 deg (z ~ 1 m at 3.16 m would be 20 sigma away)
+    assert s["elevation_edge_share"] == {"top": 0.0, "bottom": 0.0}
+    # a frame whose person's points all sit at +19 deg: all at the top edge
+    el = np.radians(19.0)
+    top = {k: np.full(3, val) for k, val in (("x", 0.0), ("v", 1.0), ("snr", 10.0))}
+    top["y"], top["z"] = np.full(3, np.cos(el)), np.full(3, np.sin(el))
+    assert frame_stats([top])["elevation_edge_share"] == {"top": 1.0, "bottom": 0.0}
 
 
 def test_static_recurrence_tells_furniture_from_scattered_false_alarms():
