@@ -18,11 +18,12 @@ from core.tracking.ekf import MIN_RANGE_M
 
 # indices into the float parameter vector
 (G_GAIN, G_WX, G_WY, G_WZ, G_V, A_SNR, A_SNR_OBS, A_VEL, A_DIST, A_VSPREAD, VRES, H_SENSOR,
- DISP_W, VMAX) = range(14)  # fmt: skip
+ DISP_W, VMAX, U_ALPHA, U_CONF, U_LOCK, V_INIT, T_FRAME) = range(19)  # fmt: skip
 # indices into the integer parameter vector
 (DIMS, MAX_TRACKS, DET2ACT, DET2FREE, ACT2FREE, STAT2FREE, EXIT2FREE, SLEEP2FREE,
  ALLOC_POINTS) = range(9)  # fmt: skip
 DETECT, ACTIVE = 1, 2
+RATE_FILTER, TRACKING, LOCKED = 1, 2, 3
 
 
 @njit(cache=True)
@@ -37,6 +38,23 @@ def _wrap(a):
 def _unroll(v, ref, vmax):
     span = 2.0 * vmax
     return v + span * math.floor((ref - v + vmax) / span)
+
+
+@njit(cache=True)
+def _velocity_stage(r_sum, v_bar, cnt, vr_pred, k, i, vst, rate, r_alloc, fp):
+    """The readable form's ``_velocity_stage`` for track slot i: r_sum the moving points' range
+    sum, v_bar their pilot-unrolled mean vr, k frames since allocation."""
+    if vst[i] == LOCKED:
+        return _unroll(v_bar, vr_pred, fp[VMAX])
+    inst = (r_sum / cnt - r_alloc[i]) / (k * fp[T_FRAME])
+    rate[i] = fp[U_ALPHA] * rate[i] + (1.0 - fp[U_ALPHA]) * inst
+    v = _unroll(v_bar, rate[i], fp[VMAX])
+    if vst[i] == RATE_FILTER:
+        if abs(inst - rate[i]) < fp[U_CONF] * abs(rate[i]):
+            vst[i] = TRACKING
+    elif abs(vr_pred - v) < fp[U_LOCK] * abs(v):
+        vst[i] = LOCKED
+    return v
 
 
 @njit(cache=True)
@@ -212,6 +230,9 @@ def gtrack_kernel(pts, off, M, F, Q, R, P0, fp, ip, boundary, static_box, presen
     sleeps = np.zeros(cap, np.int64)
     ids = np.zeros(cap, np.int64)
     birth = np.zeros(cap, np.int64)
+    vst = np.zeros(cap, np.int64)
+    rate = np.zeros(cap)
+    r_alloc = np.zeros(cap)
     nt = 0
     next_id = 0
     xp = np.zeros((cap, n))
@@ -324,6 +345,22 @@ def gtrack_kernel(pts, off, M, F, Q, R, P0, fp, ip, boundary, static_box, presen
             nu_bar = np.zeros(m)
             for k in range(m):
                 nu_bar[k] = np.mean(nus[:, k])
+            # the radial-velocity row: the moving points' centroid, unrolled by stage
+            n_mov = 0
+            r_sum = 0.0
+            v_sum = 0.0
+            pilot = 0.0
+            for j in range(k_pts):
+                if owner[j] == i and not static[j]:
+                    if n_mov == 0:
+                        pilot = z[j, m - 1]
+                    n_mov += 1
+                    r_sum += z[j, 0]
+                    v_sum += _unroll(z[j, m - 1], pilot, fp[VMAX])
+            if n_mov > 0:
+                vr_c = _velocity_stage(r_sum, v_sum / n_mov, n_mov, zps[i, m - 1], f - birth[i],
+                                       i, vst, rate, r_alloc, fp)  # fmt: skip
+                nu_bar[m - 1] = vr_c - zps[i, m - 1]
             Rc = R.copy()
             for k in range(m):
                 Rc[k, k] += D[i, k]
@@ -394,6 +431,8 @@ def gtrack_kernel(pts, off, M, F, Q, R, P0, fp, ip, boundary, static_box, presen
         bD = np.zeros((cap, m))
         bid = np.zeros(cap, np.int64)
         bgs = np.zeros((cap, 2, 2))
+        brate = np.zeros(cap)
+        bralloc = np.zeros(cap)
         nb = 0
         members = np.zeros(k_pts, np.int64)
         cvec = np.zeros(3)
@@ -456,8 +495,15 @@ def gtrack_kernel(pts, off, M, F, Q, R, P0, fp, ip, boundary, static_box, presen
             for k in range(d):
                 x[k] = cvec[k]
             rn = max(r_c, MIN_RANGE_M)
+            # TI's INIT stage: the set's vr unrolled to the initial radial velocity
+            rr = _unroll(cv, fp[V_INIT], fp[VMAX])
             for k in range(d):
-                x[d + k] = (M[k, 0] * cs[0] + M[k, 1] * cs[1] + M[k, 2] * cs[2]) * cv / rn
+                x[d + k] = (M[k, 0] * cs[0] + M[k, 1] * cs[1] + M[k, 2] * cs[2]) * rr / rn
+            brate[nb] = rr
+            rsum = 0.0
+            for q in range(nm):
+                rsum += z[members[q], 0]
+            bralloc[nb] = rsum / nm
             if nm > 1:
                 for k in range(m):
                     col = np.zeros(nm)
@@ -482,6 +528,7 @@ def gtrack_kernel(pts, off, M, F, Q, R, P0, fp, ip, boundary, static_box, presen
                 X[w], P[w], D[w] = X[i], P[i], D[i]
                 st[w], hits[w], misses[w], sleeps[w] = st[i], hits[i], misses[i], sleeps[i]
                 ids[w], birth[w] = ids[i], birth[i]
+                vst[w], rate[w], r_alloc[w] = vst[i], rate[i], r_alloc[i]
                 gc[w], gs[w], nas[w], nis[w] = gc[i], gs[i], nas[i], nis[i]
                 w += 1
         for q in range(nb):
@@ -489,6 +536,7 @@ def gtrack_kernel(pts, off, M, F, Q, R, P0, fp, ip, boundary, static_box, presen
             st[w] = ACTIVE if 1 >= ip[DET2ACT] else DETECT
             hits[w], misses[w], sleeps[w] = 1, 0, 0
             ids[w], birth[w] = bid[q], f
+            vst[w], rate[w], r_alloc[w] = RATE_FILTER, brate[q], bralloc[q]
             gc[w, 0], gc[w, 1] = bX[q, 0], bX[q, 1]
             gs[w], nas[w], nis[w] = bgs[q], 0, np.nan
             w += 1
