@@ -12,8 +12,10 @@ from core.tracking.gtrack import geometry as geo
 from core.tracking.gtrack.params import GtrackParams
 from core.tracking.gtrack.tracker import (
     DISPERSION_WEIGHT,
+    ERASURE_VELOCITY_FACTOR,
     INITIAL_RADIAL_VELOCITY_MPS,
     LOCK_TOLERANCE,
+    MIN_STATIC_VELOCITY_MPS,
     P0_SIGMA,
     UNROLL_ALPHA,
     UNROLL_CONFIDENCE,
@@ -54,6 +56,8 @@ def kernel_args(params: GtrackParams) -> tuple:
             LOCK_TOLERANCE,
             INITIAL_RADIAL_VELOCITY_MPS,
             p.frame_period_s,
+            MIN_STATIC_VELOCITY_MPS,
+            ERASURE_VELOCITY_FACTOR,
         ]  # fmt: skip
     )
     ip = np.array(

@@ -18,7 +18,7 @@ from core.tracking.ekf import MIN_RANGE_M
 
 # indices into the float parameter vector
 (G_GAIN, G_WX, G_WY, G_WZ, G_V, A_SNR, A_SNR_OBS, A_VEL, A_DIST, A_VSPREAD, VRES, H_SENSOR,
- DISP_W, VMAX, U_ALPHA, U_CONF, U_LOCK, V_INIT, T_FRAME) = range(19)  # fmt: skip
+ DISP_W, VMAX, U_ALPHA, U_CONF, U_LOCK, V_INIT, T_FRAME, V_STATIC, V_HALF) = range(21)  # fmt: skip
 # indices into the integer parameter vector
 (DIMS, MAX_TRACKS, DET2ACT, DET2FREE, ACT2FREE, STAT2FREE, EXIT2FREE, SLEEP2FREE,
  ALLOC_POINTS) = range(9)  # fmt: skip
@@ -233,6 +233,7 @@ def gtrack_kernel(pts, off, M, F, Q, R, P0, fp, ip, boundary, static_box, presen
     vst = np.zeros(cap, np.int64)
     rate = np.zeros(cap)
     r_alloc = np.zeros(cap)
+    still = np.zeros(cap, np.bool_)
     nt = 0
     next_id = 0
     xp = np.zeros((cap, n))
@@ -322,19 +323,36 @@ def gtrack_kernel(pts, off, M, F, Q, R, P0, fp, ip, boundary, static_box, presen
             gc[i, 0], gc[i, 1] = xp[i, 0], xp[i, 1]
             _gate_xy(zps[i], Cs[i], d, fp[G_GAIN], az_tilt, gs[i])
             cnt = 0
+            n_mov = 0
             for j in range(k_pts):
                 if owner[j] == i:
                     cnt += 1
+                    point_track[a + j] = ids[i]
+                    if not static[j]:
+                        n_mov += 1
             nas[i] = cnt
-            if cnt == 0:
+            if n_mov == 0:
+                # no moving point: no update; the track slows down or stops (TI's erasure)
                 X[i] = xp[i]
                 P[i] = Pp[i]
+                if not still[i]:
+                    speed = 0.0
+                    for k in range(d):
+                        speed += X[i, d + k] ** 2
+                    if math.sqrt(speed) < fp[V_STATIC]:
+                        fac = 0.0
+                        still[i] = cnt == 0 or cnt > 3
+                    else:
+                        fac = fp[V_HALF]
+                    for k in range(d):
+                        X[i, d + k] *= fac
+                        X[i, 2 * d + k] = 0.0
                 continue
+            still[i] = False
             nus = np.zeros((cnt, m))
             c = 0
             for j in range(k_pts):
                 if owner[j] == i:
-                    point_track[a + j] = ids[i]
                     for k in range(m):
                         nus[c, k] = z[j, k] - zps[i, k]
                     nus[c, 1] = _wrap(nus[c, 1])
@@ -357,10 +375,9 @@ def gtrack_kernel(pts, off, M, F, Q, R, P0, fp, ip, boundary, static_box, presen
                     n_mov += 1
                     r_sum += z[j, 0]
                     v_sum += _unroll(z[j, m - 1], pilot, fp[VMAX])
-            if n_mov > 0:
-                vr_c = _velocity_stage(r_sum, v_sum / n_mov, n_mov, zps[i, m - 1], f - birth[i],
-                                       i, vst, rate, r_alloc, fp)  # fmt: skip
-                nu_bar[m - 1] = vr_c - zps[i, m - 1]
+            vr_c = _velocity_stage(r_sum, v_sum / n_mov, n_mov, zps[i, m - 1], f - birth[i], i,
+                                   vst, rate, r_alloc, fp)  # fmt: skip
+            nu_bar[m - 1] = vr_c - zps[i, m - 1]
             Rc = R.copy()
             for k in range(m):
                 Rc[k, k] += D[i, k]
@@ -412,13 +429,9 @@ def gtrack_kernel(pts, off, M, F, Q, R, P0, fp, ip, boundary, static_box, presen
                     keep[i] = True
                 continue
             misses[i] += 1
-            speed = 0.0
-            for k in range(d):
-                speed += X[i, d + k] ** 2
-            speed = math.sqrt(speed)
             if not in_static:
                 limit = ip[EXIT2FREE]
-            elif speed <= fp[A_VEL]:
+            elif still[i]:
                 limit = ip[STAT2FREE]
             else:
                 limit = ip[ACT2FREE]
@@ -528,7 +541,7 @@ def gtrack_kernel(pts, off, M, F, Q, R, P0, fp, ip, boundary, static_box, presen
                 X[w], P[w], D[w] = X[i], P[i], D[i]
                 st[w], hits[w], misses[w], sleeps[w] = st[i], hits[i], misses[i], sleeps[i]
                 ids[w], birth[w] = ids[i], birth[i]
-                vst[w], rate[w], r_alloc[w] = vst[i], rate[i], r_alloc[i]
+                vst[w], rate[w], r_alloc[w], still[w] = vst[i], rate[i], r_alloc[i], still[i]
                 gc[w], gs[w], nas[w], nis[w] = gc[i], gs[i], nas[i], nis[i]
                 w += 1
         for q in range(nb):
@@ -536,7 +549,7 @@ def gtrack_kernel(pts, off, M, F, Q, R, P0, fp, ip, boundary, static_box, presen
             st[w] = ACTIVE if 1 >= ip[DET2ACT] else DETECT
             hits[w], misses[w], sleeps[w] = 1, 0, 0
             ids[w], birth[w] = bid[q], f
-            vst[w], rate[w], r_alloc[w] = RATE_FILTER, brate[q], bralloc[q]
+            vst[w], rate[w], r_alloc[w], still[w] = RATE_FILTER, brate[q], bralloc[q], False
             gc[w, 0], gc[w, 1] = bX[q, 0], bX[q, 1]
             gs[w], nas[w], nis[w] = bgs[q], 0, np.nan
             w += 1

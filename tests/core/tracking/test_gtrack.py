@@ -78,15 +78,17 @@ def test_detect_freed_after_det2free_misses():
 
 
 @pytest.mark.parametrize(
-    ("in_static_box", "expected_misses"), [(False, 4), (True, 9)]
-)  # exit2free outside the static box, active2free inside it (moving: obscured)
-def test_active_freed_after_misses_depends_on_static_box(in_static_box, expected_misses):
-    p = replace(GtrackParams(), det2act=2, exit2free=4, active2free=9, static2free=30)
+    ("in_static_box", "speed", "expected_misses"),
+    [(False, 0.5, 4), (True, 0.5, 30), (True, 4.0, 5)],
+)  # exit2free outside the static box; inside it a lost track's speed halves each miss, and
+# stops below 0.1 m/s: 0.5 m/s stops at the 4th miss (static2free), 4 m/s needs 7 (active2free 5)
+def test_active_freed_after_misses_depends_on_static_box(in_static_box, speed, expected_misses):
+    p = replace(GtrackParams(), det2act=2, exit2free=4, active2free=5, static2free=30)
     if not in_static_box:
         p = replace(p, static_y_min_m=6.0, static_y_max_m=7.5)
-    n = 3 + 12
-    present = [True] * 3 + [False] * 12
-    pts, off = walk(p, n, present=present)
+    n = 3 + 35
+    present = [True] * 3 + [False] * 35
+    pts, off = walk(p, n, v=(0.0, speed, 0.0), present=present)
     res = run_gtrack(pts, off, p)
     alive = [len(ft) for ft in res.frames]
     assert res.frames[2].confirmed[0]
@@ -95,19 +97,43 @@ def test_active_freed_after_misses_depends_on_static_box(in_static_box, expected
     assert alive[3 + expected_misses - 1 :] == [0] * (n - 3 - expected_misses + 1)
 
 
+def test_a_track_without_moving_points_slows_by_half_and_stops_below_a_tenth():
+    p = replace(GtrackParams(), det2act=2, static2free=50, active2free=50)
+    n = 3 + 6
+    pts, off = walk(p, n, v=(0.0, 0.8, 0.0), present=[True] * 3 + [False] * 6)
+    tr = GtrackTracker(p)
+    speeds, still = [], []
+    for f in range(n):
+        q = pts[off[f] : off[f + 1]]
+        tr.step(q[:, 0], q[:, 1], q[:, 2], q[:, 3], q[:, 4])
+        t = tr.tracks[0]
+        speeds.append(float(np.linalg.norm(t.x[3:6])))
+        still.append(t.still)
+        if f >= 3:
+            assert np.all(t.x[6:9] == 0.0)  # no acceleration while lost
+    # each miss halves the predicted speed (the first one's prediction still carries the last
+    # acceleration): about 0.8 → 0.4 → 0.2 → 0.1 (just below), and that one (< 0.1) stops it
+    assert speeds[3] == pytest.approx(speeds[2] / 2, rel=0.01)
+    np.testing.assert_allclose(speeds[4:6], np.array(speeds[3]) / [2, 4], rtol=1e-9)
+    assert speeds[5] < 0.1 and speeds[6:] == [0.0] * 3
+    assert still == [False] * 6 + [True] * 3
+
+
 def _still_track(tr: GtrackTracker, pos, vel) -> _Track:
     d = tr.dims
     x = np.zeros(3 * d)
     x[:d], x[d : 2 * d] = pos, vel
-    return _Track(id=0, x=x, P=tr.P0.copy(), D=np.zeros(tr.m), state=ACTIVE, birth=0)
+    t = _Track(id=0, x=x, P=tr.P0.copy(), D=np.zeros(tr.m), state=ACTIVE, birth=0)
+    t.still = bool(np.linalg.norm(vel) == 0.0)  # as after TI's erasure stopped it
+    return t
 
 
 @pytest.mark.parametrize(
     ("pos", "vel", "limit"),
     [
-        ((0.0, 3.0, 1.0), (0.0, 0.05, 0.0), "static2free"),  # still, in the static box
-        ((0.0, 3.0, 1.0), (0.0, 0.5, 0.0), "active2free"),  # moving in it: obscured
-        ((3.5, 3.0, 1.0), (0.0, 0.05, 0.0), "exit2free"),  # outside it
+        ((0.0, 3.0, 1.0), (0.0, 0.0, 0.0), "static2free"),  # stopped, in the static box
+        ((0.0, 3.0, 1.0), (0.0, 0.05, 0.0), "active2free"),  # moving in it: obscured
+        ((3.5, 3.0, 1.0), (0.0, 0.0, 0.0), "exit2free"),  # outside it
     ],
 )
 def test_active_miss_rules_on_constructed_tracks(pos, vel, limit):
