@@ -10,7 +10,17 @@ import numpy as np
 
 from core.tracking.gtrack import geometry as geo
 from core.tracking.gtrack.params import GtrackParams
-from core.tracking.gtrack.tracker import DISPERSION_WEIGHT, P0_SIGMA, GtrackResult
+from core.tracking.gtrack.tracker import (
+    DISPERSION_WEIGHT,
+    ERASURE_VELOCITY_FACTOR,
+    INITIAL_RADIAL_VELOCITY_MPS,
+    LOCK_TOLERANCE,
+    MIN_STATIC_VELOCITY_MPS,
+    P0_SIGMA,
+    UNROLL_ALPHA,
+    UNROLL_CONFIDENCE,
+    GtrackResult,
+)
 from core.tracking.results import FrameTracks
 
 __all__ = ["run_gtrack_compiled", "kernel_args"]
@@ -41,6 +51,13 @@ def kernel_args(params: GtrackParams) -> tuple:
             p.sensor_height_m if d == 3 else 0.0,
             DISPERSION_WEIGHT,
             p.max_radial_velocity_mps,
+            UNROLL_ALPHA,
+            UNROLL_CONFIDENCE,
+            LOCK_TOLERANCE,
+            INITIAL_RADIAL_VELOCITY_MPS,
+            p.frame_period_s,
+            MIN_STATIC_VELOCITY_MPS,
+            ERASURE_VELOCITY_FACTOR,
         ]  # fmt: skip
     )
     ip = np.array(

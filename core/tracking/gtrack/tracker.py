@@ -20,11 +20,17 @@ each rule with its source and every choice made where the documents are silent).
    ``points_thre`` points, centroid |vr| ≥ ``velocity_thre_mps`` and SNR sum ≥ ``snr_thre``
    (``snr_thre_obscured`` when a track is nearer the sensor at about its bearing) starts a
    track in DETECT, at the set's centroid moving radially with its mean vr.
-5. **Update** each track with the centroid of its m points: ``ν̄`` the mean innovation,
-   ``S = H P⁻ Hᵀ + (R + D)/m``, Kalman gain, Joseph form; D follows the points' spread.
+5. **Update** each track that took a moving point with the centroid of its m points: ``ν̄``
+   the mean innovation, ``S = H P⁻ Hᵀ + (R + D)/m``, Kalman gain, Joseph form; D follows the
+   points' spread. The
+   radial-velocity row is the moving points' centroid vr, unrolled in TI's stages
+   (:meth:`GtrackTracker._velocity_stage`): against a filtered range rate (the range change
+   since allocation) until that rate settles and the prediction agrees, then against the
+   prediction. A track without moving points is not updated: its prediction's acceleration is
+   zeroed and its velocity halved, or zeroed below 0.1 m/s (TI's erasure handling).
 6. **States.** DETECT → ACTIVE after ``det2act`` consecutive hits (allocation is the first),
    DETECT → FREE after ``det2free`` consecutive misses; an ACTIVE track is freed after
-   ``static2free`` misses in the static box when (nearly) still, ``active2free`` in the static box
+   ``static2free`` misses in the static box when stopped (step 5), ``active2free`` in the static box
    when moving (obscured), ``exit2free`` outside it, and after ``sleep2free`` consecutive frames
    of only static points in the static box.
 
@@ -48,6 +54,26 @@ from core.tracking.results import FrameTracks
 __all__ = ["DETECT", "ACTIVE", "GtrackResult", "run_gtrack", "GtrackTracker", "P0_SIGMA"]
 
 DETECT, ACTIVE = 1, 2
+#: A new track's radial-velocity stages (TI's velocity handling). The allocation frame is TI's
+#: INIT stage (the centroid's vr is the allocation's range rate); then RATE_FILTER (unroll
+#: against the filtered range rate), TRACKING (the same, until the prediction agrees), LOCKED
+#: (unroll against the prediction).
+RATE_FILTER, TRACKING, LOCKED = 1, 2, 3
+#: TI's unrolling parameters (its library's defaults; no .cfg line sets them): the range-rate
+#: filter's weight of the old estimate, and the relative error below which the rate is trusted.
+UNROLL_ALPHA = 0.5
+UNROLL_CONFIDENCE = 0.1
+#: Relative disagreement of the predicted and the unrolled vr below which the track locks (TI's
+#: constant).
+LOCK_TOLERANCE = 0.1
+#: TI's initialRadialVelocity for people counting (the module's configuration, no .cfg line):
+#: the reference a new track's vr is unrolled against.
+INITIAL_RADIAL_VELOCITY_MPS = 0.0
+#: TI's handling of a frame without moving points (its minStaticVelocityOne/Two, internal): below
+#: this speed the track stops (velocity and acceleration zero); above it the velocity is halved
+#: and the acceleration zeroed, and the track is not updated.
+MIN_STATIC_VELOCITY_MPS = 0.1
+ERASURE_VELOCITY_FACTOR = 0.5
 #: Initial state standard deviations (position m, velocity m/s, acceleration m/s²): a choice.
 P0_SIGMA = (0.5, 1.0, 1.0)
 #: Weight of one frame's sample spread in the group dispersion D (exponential forgetting).
@@ -65,6 +91,10 @@ class _Track:
     hits: int = 1
     misses: int = 0
     sleeps: int = 0
+    vstate: int = RATE_FILTER  # radial-velocity stage
+    rate: float = 0.0  # filtered range rate (m/s)
+    r_alloc: float = 0.0  # centroid range at allocation (m)
+    still: bool = False  # TI's static target: stopped on a frame without moving points
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -195,12 +225,20 @@ class GtrackTracker:
             x_pred, P_pred, H, zp, _ = preds[i]
             sel = np.flatnonzero(owner == i)
             n_assoc[i] = len(sel)
-            if len(sel) == 0:
-                t.x, t.P = x_pred, P_pred
-                continue
             point_track[sel] = t.id
+            mov = sel[~static[sel]]
+            if len(mov) == 0:
+                # no moving point: no update; the track slows down or stops
+                t.x, t.P = x_pred, P_pred
+                if not t.still:
+                    self._erasure(t, len(sel))
+                continue
+            t.still = False
             nu = self._innovations(z[sel], zp)
             nu_bar = nu.mean(axis=0)
+            # the radial-velocity row: the moving points' centroid, unrolled by stage
+            vr_c = self._velocity_stage(t, z[mov, 0], z[mov, -1], zp[-1])
+            nu_bar[-1] = vr_c - zp[-1]
             Rc = (self.R + np.diag(t.D)) / len(sel)
             # S = H P⁻ Hᵀ + (R + D)/m
             S = ekf.symmetrize(H @ P_pred @ H.T + Rc)
@@ -240,6 +278,48 @@ class GtrackTracker:
         )
         return ft, point_track, presence
 
+    def _erasure(self, t: _Track, n_static: int) -> None:
+        """TI's frame without moving points for a moving track (its state the prediction): the
+        acceleration zeroed and the velocity halved or, below ``MIN_STATIC_VELOCITY_MPS``,
+        zeroed; then the track is still, on static points only when more than 3 of them."""
+        d = self.dims
+        x = t.x.copy()
+        speed = float(np.linalg.norm(x[d : 2 * d]))
+        if speed < MIN_STATIC_VELOCITY_MPS:
+            x[d : 2 * d] = 0.0
+            t.still = n_static == 0 or n_static > 3
+        else:
+            x[d : 2 * d] *= ERASURE_VELOCITY_FACTOR
+        x[2 * d :] = 0.0
+        t.x = x
+
+    def _velocity_stage(self, t: _Track, r: np.ndarray, vr: np.ndarray, vr_pred: float) -> float:
+        """The centroid radial velocity of a track's moving points (ranges r, raw vr) after TI's
+        staged unrolling; advances the track's stage.
+
+        The points' vr are unrolled to the first one (TI's pilot) and averaged to ``v̄``, their
+        range to ``r̄``. With k frames since allocation, the instantaneous range rate is
+        ``ṙ = (r̄ − r_alloc)/(k T)`` and the filtered one ``ρ ← α ρ + (1 − α) ṙ``. RATE_FILTER
+        and TRACKING return ``v̄`` unrolled to ρ; RATE_FILTER moves on when
+        ``|ṙ − ρ| < confidence·|ρ|``, TRACKING when ``|v̂ − v| < 0.1 |v|`` (v̂ the predicted vr,
+        v the unrolled centroid). LOCKED unrolls ``v̄`` to the prediction.
+        """
+        vmax = self.p.max_radial_velocity_mps
+        pilot = float(vr[0])
+        v_bar = float(np.mean(unroll(vr, pilot, vmax)))
+        if t.vstate == LOCKED:
+            return float(unroll(v_bar, vr_pred, vmax))
+        k = self.frame - t.birth
+        inst = (float(np.mean(r)) - t.r_alloc) / (k * self.p.frame_period_s)
+        t.rate = UNROLL_ALPHA * t.rate + (1.0 - UNROLL_ALPHA) * inst
+        v = float(unroll(v_bar, t.rate, vmax))
+        if t.vstate == RATE_FILTER:
+            if abs(inst - t.rate) < UNROLL_CONFIDENCE * abs(t.rate):
+                t.vstate = TRACKING
+        elif abs(vr_pred - v) < LOCK_TOLERANCE * abs(v):
+            t.vstate = LOCKED
+        return v
+
     def _born_gate(self, t: _Track) -> np.ndarray:
         H = geo.jacobian(t.x, self.dims, self.M, self.h)
         C = H @ t.P @ H.T + self.R + np.diag(t.D)
@@ -278,10 +358,9 @@ class GtrackTracker:
             t.sleeps = 0
             return True
         t.misses += 1
-        speed = float(np.linalg.norm(t.x[self.dims : 2 * self.dims]))
         if not in_static:
             limit = p.exit2free
-        elif speed <= p.velocity_thre_mps:
+        elif t.still:
             limit = p.static2free
         else:
             limit = p.active2free
@@ -323,6 +402,7 @@ class GtrackTracker:
             sel = np.asarray(members)
             free[sel] = False
             t = self._new_track(c, cv, z[sel])
+            t.r_alloc = float(np.mean(z[sel, 0]))
             point_track[sel] = t.id
             born.append(t)
         return born
@@ -353,9 +433,12 @@ class GtrackTracker:
         x[:d] = c
         ps = self._to_sensor(c)
         u = ps / max(float(np.linalg.norm(ps)), ekf.MIN_RANGE_M)
-        x[d : 2 * d] = (self.M @ (vr * u))[:d]  # radial motion, back in world axes
+        # TI's INIT stage: the set's vr unrolled to the initial radial velocity is the range rate
+        rate = float(unroll(vr, INITIAL_RADIAL_VELOCITY_MPS, self.p.max_radial_velocity_mps))
+        x[d : 2 * d] = (self.M @ (rate * u))[:d]  # radial motion, back in world axes
         D = np.var(z, axis=0) if len(z) > 1 else np.zeros(self.m)
         t = _Track(id=self.next_id, x=x, P=self.P0.copy(), D=D, state=DETECT, birth=self.frame)
+        t.rate = rate
         self.next_id += 1
         if t.hits >= self.p.det2act:
             t.state = ACTIVE

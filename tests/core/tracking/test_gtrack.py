@@ -78,15 +78,17 @@ def test_detect_freed_after_det2free_misses():
 
 
 @pytest.mark.parametrize(
-    ("in_static_box", "expected_misses"), [(False, 4), (True, 9)]
-)  # exit2free outside the static box, active2free inside it (moving: obscured)
-def test_active_freed_after_misses_depends_on_static_box(in_static_box, expected_misses):
-    p = replace(GtrackParams(), det2act=2, exit2free=4, active2free=9, static2free=30)
+    ("in_static_box", "speed", "expected_misses"),
+    [(False, 0.5, 4), (True, 0.5, 30), (True, 4.0, 5)],
+)  # exit2free outside the static box; inside it a lost track's speed halves each miss, and
+# stops below 0.1 m/s: 0.5 m/s stops at the 4th miss (static2free), 4 m/s needs 7 (active2free 5)
+def test_active_freed_after_misses_depends_on_static_box(in_static_box, speed, expected_misses):
+    p = replace(GtrackParams(), det2act=2, exit2free=4, active2free=5, static2free=30)
     if not in_static_box:
         p = replace(p, static_y_min_m=6.0, static_y_max_m=7.5)
-    n = 3 + 12
-    present = [True] * 3 + [False] * 12
-    pts, off = walk(p, n, present=present)
+    n = 3 + 35
+    present = [True] * 3 + [False] * 35
+    pts, off = walk(p, n, v=(0.0, speed, 0.0), present=present)
     res = run_gtrack(pts, off, p)
     alive = [len(ft) for ft in res.frames]
     assert res.frames[2].confirmed[0]
@@ -95,19 +97,43 @@ def test_active_freed_after_misses_depends_on_static_box(in_static_box, expected
     assert alive[3 + expected_misses - 1 :] == [0] * (n - 3 - expected_misses + 1)
 
 
+def test_a_track_without_moving_points_slows_by_half_and_stops_below_a_tenth():
+    p = replace(GtrackParams(), det2act=2, static2free=50, active2free=50)
+    n = 3 + 6
+    pts, off = walk(p, n, v=(0.0, 0.8, 0.0), present=[True] * 3 + [False] * 6)
+    tr = GtrackTracker(p)
+    speeds, still = [], []
+    for f in range(n):
+        q = pts[off[f] : off[f + 1]]
+        tr.step(q[:, 0], q[:, 1], q[:, 2], q[:, 3], q[:, 4])
+        t = tr.tracks[0]
+        speeds.append(float(np.linalg.norm(t.x[3:6])))
+        still.append(t.still)
+        if f >= 3:
+            assert np.all(t.x[6:9] == 0.0)  # no acceleration while lost
+    # each miss halves the predicted speed (the first one's prediction still carries the last
+    # acceleration): about 0.8 → 0.4 → 0.2 → 0.1 (just below), and that one (< 0.1) stops it
+    assert speeds[3] == pytest.approx(speeds[2] / 2, rel=0.01)
+    np.testing.assert_allclose(speeds[4:6], np.array(speeds[3]) / [2, 4], rtol=1e-9)
+    assert speeds[5] < 0.1 and speeds[6:] == [0.0] * 3
+    assert still == [False] * 6 + [True] * 3
+
+
 def _still_track(tr: GtrackTracker, pos, vel) -> _Track:
     d = tr.dims
     x = np.zeros(3 * d)
     x[:d], x[d : 2 * d] = pos, vel
-    return _Track(id=0, x=x, P=tr.P0.copy(), D=np.zeros(tr.m), state=ACTIVE, birth=0)
+    t = _Track(id=0, x=x, P=tr.P0.copy(), D=np.zeros(tr.m), state=ACTIVE, birth=0)
+    t.still = bool(np.linalg.norm(vel) == 0.0)  # as after TI's erasure stopped it
+    return t
 
 
 @pytest.mark.parametrize(
     ("pos", "vel", "limit"),
     [
-        ((0.0, 3.0, 1.0), (0.0, 0.05, 0.0), "static2free"),  # still, in the static box
-        ((0.0, 3.0, 1.0), (0.0, 0.5, 0.0), "active2free"),  # moving in it: obscured
-        ((3.5, 3.0, 1.0), (0.0, 0.05, 0.0), "exit2free"),  # outside it
+        ((0.0, 3.0, 1.0), (0.0, 0.0, 0.0), "static2free"),  # stopped, in the static box
+        ((0.0, 3.0, 1.0), (0.0, 0.05, 0.0), "active2free"),  # moving in it: obscured
+        ((3.5, 3.0, 1.0), (0.0, 0.0, 0.0), "exit2free"),  # outside it
     ],
 )
 def test_active_miss_rules_on_constructed_tracks(pos, vel, limit):
@@ -263,6 +289,76 @@ def test_radial_velocity_unrolled_to_the_prediction():
         assert np.all(owner == tr.tracks[0].id)
         runs.append(ft.state[0])
     np.testing.assert_allclose(runs[0], runs[1], atol=1e-9)
+
+
+# -- a new track's radial velocity in stages ------------------------------------------------
+
+
+def _flat(**kw):
+    """TI's lines with the sensor at the origin looking along +y (range = distance)."""
+    return replace(GtrackParams(), sensor_height_m=0.0, sensor_elevation_tilt_deg=0.0,
+                   boundary_z_min_m=-3.0, boundary_z_max_m=3.0, static_z_min_m=-3.0,
+                   static_z_max_m=3.0, **kw)  # fmt: skip
+
+
+def test_velocity_stages_advance_when_the_range_rate_settles():
+    from core.tracking.gtrack.tracker import LOCKED, RATE_FILTER, TRACKING
+
+    # a walker receding at 1.5 m/s, vr aliased to 1.5 − 2·1 = −0.5 (v_max 1 m/s)
+    p = _flat(max_radial_velocity_mps=1.0, velocity_thre_mps=0.1)
+    T, v = p.frame_period_s, 1.5
+    tr = GtrackTracker(p)
+    stages, rates = [], []
+    for k in range(20):
+        pts = cluster(p, (0.0, 3.0 + v * k * T, 0.0), (0.0, v, 0.0), spread=0.0)
+        pts[:, 3] -= 2.0  # what the radar measures
+        step(tr, pts)
+        assert len(tr.tracks) == 1
+        stages.append(tr.tracks[0].vstate)
+        rates.append(tr.tracks[0].rate)
+    # born at the aliased vr; the filtered rate halves its error each frame: ρ_k = 1.5 − 2/2^k
+    assert rates[0] == pytest.approx(-0.5)
+    np.testing.assert_allclose(rates[1:5], [0.5, 1.0, 1.25, 1.375], atol=1e-9)
+    # RATE_FILTER until |ṙ − ρ| < 0.1 |ρ|: 2/2^k < 0.1 (1.5 − 2/2^k) first at k = 4
+    assert stages[:4] == [RATE_FILTER] * 4 and stages[4] == TRACKING
+    assert LOCKED in stages and stages == sorted(stages)
+    # the track follows the true (unrolled) velocity
+    np.testing.assert_allclose(tr.tracks[0].x[3:6], (0.0, v, 0.0), atol=0.1)
+
+
+def test_without_unrolling_by_range_rate_an_aliased_walker_is_lost():
+    """The same walker locked to its prediction from birth (no stages) keeps the aliased
+    velocity: the stages are what recovers it."""
+    from core.tracking.gtrack.tracker import LOCKED
+
+    p = _flat(max_radial_velocity_mps=1.0, velocity_thre_mps=0.1)
+    T, v = p.frame_period_s, 1.5
+    tr = GtrackTracker(p)
+    for k in range(20):
+        pts = cluster(p, (0.0, 3.0 + v * k * T, 0.0), (0.0, v, 0.0), spread=0.0)
+        pts[:, 3] -= 2.0
+        step(tr, pts)
+        for t in tr.tracks:
+            t.vstate = LOCKED
+    vy = [t.x[4] for t in tr.tracks if t.id == 0]
+    assert not vy or abs(vy[0] - v) > 0.5
+
+
+def test_new_track_on_a_standing_cluster_keeps_about_zero_velocity():
+    # a person stands: micro-Doppler ±0.3 m/s about zero, the first frame's mean 0.2 m/s
+    p = _flat(velocity_thre_mps=0.1)
+    tr = GtrackTracker(p)
+    rng = np.random.default_rng(0)
+    for k in range(40):
+        pts = cluster(p, (0.5, 2.5, 0.0), (0.0, 0.0, 0.0), spread=0.1)
+        pts[:, 3] = np.where(np.arange(len(pts)) % 2, 0.3, -0.3) + rng.normal(0, 0.02, len(pts))
+        if k == 0:
+            pts[:, 3] += 0.2
+        step(tr, pts)
+    t = tr.tracks[0]
+    assert t.id == 0 and t.state == ACTIVE
+    assert np.linalg.norm(t.x[3:6]) < 0.1
+    np.testing.assert_allclose(t.x[:2], (0.5, 2.5), atol=0.1)
 
 
 # -- gating ----------------------------------------------------------------------------------
@@ -469,6 +565,8 @@ def test_params_json_unknown_key_is_refused():
         (3, 1, {}),
         (3, 2, {"det2act": 1, "max_tracks": 5, "points_thre": 8, "exit2free": 2}),
         (2, 3, {"sensor_azimuth_tilt_deg": 10.0, "gating_velocity_mps": 0.0}),
+        # walkers at 1 m/s with v_max 0.6 m/s: aliased vr, the stages matter
+        (3, 4, {"max_radial_velocity_mps": 0.6, "velocity_thre_mps": 0.1}),
     ],
 )
 def test_compiled_equals_readable(dims, seed, overrides):
@@ -484,6 +582,15 @@ def test_compiled_equals_readable(dims, seed, overrides):
     np.testing.assert_array_equal(a.presence, b.presence)
     assert len(a.frames) == len(b.frames) == 80
     assert sum(len(ft) for ft in b.frames) > 80  # tracks to compare
+    if p.max_radial_velocity_mps < 1.0:
+        # the stages ran: the readable tracker's live tracks went through all three
+        tr = GtrackTracker(p)
+        seen = set()
+        for f in range(len(off) - 1):
+            q = pts[off[f] : off[f + 1]]
+            tr.step(q[:, 0], q[:, 1], q[:, 2], q[:, 3], q[:, 4])
+            seen |= {t.vstate for t in tr.tracks}
+        assert seen == {1, 2, 3}
     for fa, fb in zip(a.frames, b.frames):
         for k in ("ids", "confirmed", "birth_frame", "n_associated"):
             np.testing.assert_array_equal(getattr(fa, k), getattr(fb, k))
