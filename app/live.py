@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import threading
 import time
+from collections import OrderedDict
 
 import numpy as np
 from PySide6 import QtCore, QtGui
@@ -22,6 +23,43 @@ from app.errors import log_exception, one_line
 from core.live import LinkSettings, LiveLink
 from core.pointcloud import PointCloud
 from core.tracking.history import TrackHistory
+
+#: Arrival times kept for the latency measurement: the newest frames'. The view follows the
+#: newest frame, so a frame not drawn by the time this many newer ones arrived never will be.
+MAX_ARRIVALS = 256
+
+
+class ArrivalTimes:
+    """``time.perf_counter()`` of each frame's last byte, by frame index, for the newest
+    :data:`MAX_ARRIVALS` frames (``radartune bench gui`` pops a frame's time when it is drawn).
+
+    Bounded: the oldest time is let go when a new one would exceed the capacity, counted in
+    ``n_evicted``, so a long session keeps a constant few kB however many frames are never
+    drawn (the draw timer skips frames that arrive faster than it draws).
+    """
+
+    def __init__(self, capacity: int = MAX_ARRIVALS) -> None:
+        if capacity < 1:
+            raise ValueError(f"capacity must be >= 1, got {capacity}")
+        self.capacity = int(capacity)
+        self._times: OrderedDict[int, float] = OrderedDict()
+        self.n_evicted = 0
+
+    def add(self, index: int, t_s: float) -> None:
+        self._times[index] = t_s
+        while len(self._times) > self.capacity:
+            self._times.popitem(last=False)
+            self.n_evicted += 1
+
+    def pop(self, index: int, default: float | None = None) -> float | None:
+        return self._times.pop(index, default)
+
+    def clear(self) -> None:
+        self._times.clear()
+        self.n_evicted = 0
+
+    def __len__(self) -> int:
+        return len(self._times)
 
 
 class LiveTracks:
@@ -142,7 +180,7 @@ class LiveController(QtCore.QObject):
         self._edge = 0
         self._generation = -1
         #: frame index -> time.perf_counter() of its last byte (``radartune bench gui``)
-        self.received_s: dict[int, float] = {}
+        self.received_s = ArrivalTimes()
         self._tracks = LiveTracks()
         self._result: TrackingResult | None = None
         self.n_frames = self.n_dropped = self.n_damaged = 0
@@ -265,7 +303,7 @@ class LiveController(QtCore.QObject):
         w.cache.append(
             FrameData(index=frame.index, t_s=frame.t_s, cloud=frame.cloud, truth_xy_m=empty)
         )
-        self.received_s[frame.index] = frame.received_s
+        self.received_s.add(frame.index, frame.received_s)
         self.n_frames += 1
         self.n_dropped, self.n_damaged = frame.n_dropped, frame.n_damaged
         self._tracks.add(frame.index, frame.tracks)

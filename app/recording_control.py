@@ -267,7 +267,7 @@ class RecordingController(QtCore.QObject):
         w = self._w
         self.path = path
         ds = replay.dataset
-        self.facts = recording_facts(ds, Path(path).name if path else "")
+        self.facts = recording_facts(ds, Path(path).name if path else "", source=path)
         self.panel.show_facts(self.facts)
         self._reference = ReferenceLayer.of(ds) if ds.has_reference else None
         self._head_count = np.asarray(ds.people_count, dtype=np.int64)
@@ -279,6 +279,10 @@ class RecordingController(QtCore.QObject):
             i = w.colour_combo.findData("doppler")
             w.colour_combo.setCurrentIndex(i)  # its signal recolours the view
         w.psi_view.has_truth = replay.has_truth
+        w.top_view.set_has_truth(replay.has_truth)
+        w.psi_view.set_recording_counts(
+            counts, self._reference.counts() if self._reference is not None else None
+        )
         scene_dock, rec_dock = w.docks["Scene"], self.dock
         if w.dockWidgetArea(rec_dock) == QtCore.Qt.NoDockWidgetArea:
             w.addDockWidget(w.dockWidgetArea(scene_dock), rec_dock)
@@ -336,6 +340,8 @@ class RecordingController(QtCore.QObject):
         w.top_view.set_reference(None)
         self.reference_check.setEnabled(False)
         w.psi_view.has_truth = w.engine.has_truth
+        w.top_view.set_has_truth(w.engine.has_truth)
+        w.psi_view.set_recording_counts(None, None)
         if self._scene_dock_was_visible:
             w.docks["Scene"].show()
             w.docks["Scene"].raise_()

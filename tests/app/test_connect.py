@@ -65,6 +65,11 @@ def test_live_frames_are_tracked_drawn_and_stopped(window, qtbot, capture, tmp_p
         live = window.tracking_model.result
         assert live.params_key == "live" and live.n_frames >= 40
         assert np.isnan(live.running_loss).all() and np.isnan(live.ospa_m).all()
+        # nothing pops the arrival times here (only the latency benchmark does): they are
+        # bounded all the same, the oldest let go and counted
+        arrivals = window.live.received_s
+        assert len(arrivals) == min(window.live.n_frames, arrivals.capacity)
+        assert len(arrivals) + arrivals.n_evicted == window.live.n_frames
         window.live.stop()
         qtbot.waitUntil(window.live.act_connect.isEnabled, timeout=10000)
         assert em.commands[-1] == "sensorStop" and em.stopped.is_set()
