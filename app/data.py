@@ -246,7 +246,7 @@ class StudyProgress:
     best_params: dict = field(default_factory=dict)
     best_model: str = "cv"
     #: best-so-far loss against the study's busy time (s since its first trial started, the
-    #: idle gaps between runs left out: app.engine.studies.busy_time_s)
+    #: idle gaps between runs left out: core.optimization.progress.busy_time_s)
     curve_t_s: np.ndarray = field(default_factory=lambda: np.zeros(0))
     curve_best: np.ndarray = field(default_factory=lambda: np.zeros(0))
     #: why trials failed: (reason, number of trials), most frequent first
