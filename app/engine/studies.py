@@ -83,7 +83,8 @@ def start_study(form, dataset_path: str | None = None) -> StudyProcesses:
         dataset_path = resolve_dataset(None)
     url = storage_url(form.storage)
     settings = StudySettings(
-        model=form.model,
+        model=form.study_model,
+        mode=form.mode,
         n_trials=form.n_trials,
         n_jobs=form.n_jobs,
         storage=url,
@@ -144,11 +145,16 @@ def failure_reasons(summaries, n_max: int = 5) -> tuple[tuple[str, int], ...]:
 
 
 def enqueue_trial(form, values: dict[str, float], model: str) -> None:
+    """Queue ``values`` (flat, of the form's tracker with motion model ``model``) as the
+    study's next trial."""
     from core.optimization import enqueue_params
     from core.tracking.space import tracker_params_dict
 
+    study_model = "gtrack" if form.tracker == "gtrack" else model
     enqueue_params(
-        storage_url(form.storage), form.effective_name, tracker_params_dict(values, model)
+        storage_url(form.storage),
+        form.effective_name,
+        tracker_params_dict(values, study_model, form.mode),
     )
 
 

@@ -107,9 +107,15 @@ def enqueue_params(storage: str, name: str, params: dict[str, Any]) -> None:
     study = load_existing_study(store, name)
     if study is None:
         raise InputError(f"no study {name!r} in {redact(storage)}")
+    from core.tracking.space import GTRACK, search_space
+
     model = study.user_attrs.get("model")
-    if params.get("model", "cv") != model:
-        raise InputError(f"parameters are for model {params.get('model')!r}, study is {model!r}")
+    # gtrack's parameters (GtrackParams JSON) carry no "model": they are known by their names
+    gtrack_names = {p.name for p in search_space(GTRACK)}
+    is_gtrack = "model" not in params and gtrack_names <= set(params)
+    given = GTRACK if is_gtrack else params.get("model", "cv")
+    if given != model:
+        raise InputError(f"parameters are for model {given!r}, study is {model!r}")
     optuna.load_study(study_name=name, storage=store).enqueue_trial(flat_params(params))
 
 
