@@ -74,7 +74,9 @@ class LiveTracks:
     has no ground truth).
     """
 
-    def __init__(self) -> None:
+    def __init__(self, velocity_col: int = 2) -> None:
+        #: the first velocity column of the tracker's state (2: the IPDA's; gtrack's: its dims)
+        self.velocity_col = velocity_col
         self.frames: list[TrackFrame] = []
         self._est: list[tuple[float, float]] = []
         self._history = TrackHistory()
@@ -87,7 +89,7 @@ class LiveTracks:
         while len(self.frames) < index:
             self.frames.append(TrackFrame.empty())
             self._est.append((np.nan, np.nan))
-        tf = track_frame(tracks)
+        tf = track_frame(tracks, velocity_col=self.velocity_col)
         self.frames.append(tf)
         e = tracks.estimate
         self._est.append(tuple(tf.xy_m[e]) if e >= 0 else (np.nan, np.nan))
@@ -227,10 +229,11 @@ class LiveController(QtCore.QObject):
         if self.running:
             w.show_error("live sensor: a sensor is connected; stop it before connecting again")
             return
-        if w.params_model.tracker != "paper":  # core.live tracks frame by frame with the IPDA
+        if w.params_model.tracker == "room":  # core.live.stream_tracker: no room mode yet
             w.show_error(
-                f"live sensor: the live link tracks with the paper tracker, not "
-                f"{w.params_model.tracker}; choose 'paper' in the tracker panel"
+                "live sensor: the live link tracks with the paper tracker or gtrack, not the "
+                "room mode (it has no frame-by-frame form yet); choose 'paper' or 'gtrack' in "
+                "the tracker panel, and re-track the recording in the room mode afterwards"
             )
             return
         try:
@@ -243,7 +246,7 @@ class LiveController(QtCore.QObject):
         w.cache.clear(expected=0, truth_paths=())
         self._generation = w.cache.generation
         self.received_s.clear()
-        self._tracks = LiveTracks()
+        self._tracks = LiveTracks(velocity_col=getattr(params, "dims", 2))
         self._result = None
         self._edge = 0  # the newest frame the view was moved to: following while it is there
         self.n_frames = self.n_dropped = self.n_damaged = 0
