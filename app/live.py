@@ -198,6 +198,7 @@ class LiveController(QtCore.QObject):
             menu.insertAction(quit_action, action)
         menu.insertSeparator(quit_action)
         window.tracking_model.changed.connect(self._on_tracked)
+        window.scene_control.info_changed.connect(self._on_scene_info)
 
     @property
     def running(self) -> bool:
@@ -245,6 +246,7 @@ class LiveController(QtCore.QObject):
         w.tracker.invalidate()
         w.cache.clear(expected=0, truth_paths=())
         self._generation = w.cache.generation
+        self._set_live_face(True)
         self.received_s.clear()
         self._tracks = LiveTracks(velocity_col=getattr(params, "dims", 2))
         self._result = None
@@ -261,6 +263,27 @@ class LiveController(QtCore.QObject):
         self.act_connect.setEnabled(False)
         w.statusBar().showMessage(f"connecting to {settings.cli_port} …", 5000)
         worker.start()
+
+    def _set_live_face(self, live: bool) -> None:
+        """A sensor has no ground truth and no radar cube: no truth paths, loss, RMSE or OSPA
+        (the track counts instead) and the cube's views say why, until the scene is simulated
+        again."""
+        w = self._w
+        from app.recording_control import LIVE_SOURCE
+
+        truth = not live and w.engine.has_truth
+        w.psi_view.has_truth = truth
+        w.psi_view.set_recording_counts(None, None)
+        w.top_view.set_has_truth(truth)
+        if live:
+            w.top_view.set_truth_paths([])
+        w.recording._set_views_unavailable(live, LIVE_SOURCE)
+
+    def _on_scene_info(self, _info) -> None:
+        """The scene adopted again (its simulation replaces the sensor's frames)."""
+        if self._generation >= 0 and not self.running and not self._w.recording.replaying:
+            self._generation = -1
+            self._set_live_face(False)
 
     def stop(self) -> None:
         """Stop the sensor (``sensorStop``, sent by the worker as the link closes)."""

@@ -36,9 +36,11 @@ RECENT_KEY = "recording/recent"
 #: Suffixes a dropped file is taken as a recording by (a .json is a scene unless it is a replay).
 RECORDING_SUFFIXES = (".dat", ".bin", ".csv", ".txt", ".npz", ".json")
 NO_CUBE = (
-    "A recording of detected points has no {what}: the sensor sent its point cloud, not the "
+    "{source} has no {what}: the sensor sent its point cloud, not the "
     "radar cube. Simulate a scene, or import a DCA1000 capture of raw ADC samples, to see it."
 )
+RECORDING_SOURCE = "A recording of detected points"
+LIVE_SOURCE = "A live sensor's stream of detected points"
 
 
 def sibling_cfg(path: Path) -> Path | None:
@@ -315,7 +317,7 @@ class RecordingController(QtCore.QObject):
         except Exception as exc:  # the scene keeps its radar: the views still draw the points
             log_exception("the recording's radar does not fit the scene", exc)
 
-    def _set_views_unavailable(self, replay: bool) -> None:
+    def _set_views_unavailable(self, replay: bool, source: str = RECORDING_SOURCE) -> None:
         w = self._w
         views = w.views_control
         for view, what in (
@@ -325,7 +327,7 @@ class RecordingController(QtCore.QObject):
             (views.spectrogram_view, "micro-Doppler spectrogram (it is cut from the range-Doppler "
                                      "map at each person's range)"),
         ):  # fmt: skip
-            set_unavailable(view, NO_CUBE.format(what=what) if replay else None)
+            set_unavailable(view, NO_CUBE.format(source=source, what=what) if replay else None)
 
     def close_recording(self) -> None:
         """Back to simulating the scene."""
@@ -454,7 +456,7 @@ class RecordingController(QtCore.QObject):
             head_count=hc,
             truth_count=(
                 int(np.isfinite(frame.truth_xy_m).all(axis=1).sum())
-                if frame is not None and w.engine.has_truth
+                if frame is not None and w.psi_view.has_truth
                 else -1
             ),
             dropped_frames=dropped,

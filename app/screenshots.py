@@ -59,6 +59,8 @@ def open_window(out: Path, scene_path: str | None = None):
 
     from app.window import MainWindow
 
+    # as app.main: the 3-D view's GL items survive its dock being floated (a new top level)
+    QtCore.QCoreApplication.setAttribute(QtCore.Qt.AA_ShareOpenGLContexts)
     qa = QtWidgets.QApplication.instance() or QtWidgets.QApplication(sys.argv[:1])
     pg.setConfigOptions(imageAxisOrder="row-major")
     out.mkdir(parents=True, exist_ok=True)

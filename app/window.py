@@ -546,7 +546,7 @@ class MainWindow(QtWidgets.QMainWindow):
         self._update_fps()
 
     def _show_metrics(self, index: int, result) -> None:
-        if not self.engine.has_truth:
+        if not self.psi_view.has_truth:  # a recording without truth, or a live sensor
             self.metrics_label.setText("no ground truth: no loss, RMSE or OSPA")
             return
         if result is None or index >= result.n_frames:
@@ -564,7 +564,11 @@ class MainWindow(QtWidgets.QMainWindow):
         now = time.perf_counter()
         recent = [t for t in self._draw_times if now - t <= 1.0]
         rendered = len(recent)
-        source = "read" if self.recording.replaying else "simulated"
+        source = (
+            "received" if self.live.owns_frames
+            else "read" if self.recording.replaying
+            else "simulated"
+        )  # fmt: skip
         text = f" rendered {rendered:d} fps · {source} {self.sim.rate_fps:.1f} fps" + (
             " (done)" if self.cache.complete else ""
         )

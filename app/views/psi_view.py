@@ -101,6 +101,8 @@ class PsiView(pg.GraphicsLayoutWidget):
         no TI tracks), drawn while there is no ground truth."""
         self._points = np.zeros(0, dtype=np.int64) if points is None else np.asarray(points)
         self._ti_count = None if ti_count is None else np.asarray(ti_count)
+        self._truth_face = None  # the legend follows whether TI's counts are there
+        self._set_face()
 
     def _set_face(self) -> None:
         """The lower plot's face: running metrics with ground truth, track counts without."""
@@ -121,7 +123,8 @@ class PsiView(pg.GraphicsLayoutWidget):
             self.metric_plot.setTitle("tracks a frame (no ground truth)", size="9pt")
             self.metric_plot.setLabel("left", "tracks", units="")
             legend.addItem(self.count_curve, "confirmed tracks")
-            legend.addItem(self.ti_curve, "TI's tracks")
+            if self._ti_count is not None:
+                legend.addItem(self.ti_curve, "TI's tracks")
             self.rmse_curve.setData([], [])
             self.ospa_curve.setData([], [])
 

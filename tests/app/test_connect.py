@@ -65,6 +65,15 @@ def test_live_frames_are_tracked_drawn_and_stopped(window, qtbot, capture, tmp_p
         live = window.tracking_model.result
         assert live.params_key == "live" and live.n_frames >= 40
         assert np.isnan(live.running_loss).all() and np.isnan(live.ospa_m).all()
+        # a sensor's face: no truth (paths, marks, metrics), the track counts, no cube views
+        window.redraw()
+        assert not window.psi_view.has_truth and not window.top_view.has_truth
+        assert "no ground truth" in window.metrics_label.text()
+        rows = [label.text for _s, label in window.top_view.getPlotItem().legend.items]
+        assert not {"truth", "truth path", "estimate"} & set(rows)
+        assert window.psi_view.metric_plot.titleLabel.text.startswith("tracks a frame")
+        assert "received" in window.fps_label.text()
+        assert "truth" not in window.top_view.count_label.text()
         # nothing pops the arrival times here (only the latency benchmark does): they are
         # bounded all the same, the oldest let go and counted
         arrivals = window.live.received_s
@@ -103,6 +112,10 @@ def test_live_frames_are_tracked_drawn_and_stopped(window, qtbot, capture, tmp_p
     assert "sensor stopped after" in window.live.last_summary
     assert window.live.act_connect.isEnabled()
     assert window.errors == []
+    # the scene adopted again: its truth and metrics are back
+    window.scene_control.load_paper_scene()
+    qtbot.waitUntil(lambda: window.psi_view.has_truth, timeout=30000)
+    assert window.top_view.has_truth
 
 
 @pytest.mark.parametrize(
