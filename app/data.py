@@ -214,6 +214,10 @@ class StudyForm:
     seed: int = 0
     #: "scene": the current scene's cached point clouds; "paper": the paper's 35 trajectories
     dataset: str = "scene"
+    #: the tracker tuned: "paper" (the one-point IPDA with ``model``), "room" (the room mode with
+    #: ``model``) or "gtrack" (TI's tracker, its own table; ``model`` unused), as ``radartune
+    #: tune --mode room`` / ``--tracker gtrack``
+    tracker: str = "paper"
 
     def __post_init__(self) -> None:
         if self.model not in ("cv", "ca"):
@@ -224,14 +228,32 @@ class StudyForm:
             raise InputError(f"jobs must be >= 1, got {self.n_jobs}", "jobs")
         if not self.storage.strip():
             raise InputError("storage must not be empty", "storage")
+        if self.tracker not in ("paper", "room", "gtrack"):
+            raise InputError(
+                f"tracker must be 'paper', 'room' or 'gtrack', got {self.tracker!r}", "tracker"
+            )
         if self.dataset not in ("scene", "paper"):
             raise InputError(
                 f"data set must be 'scene' or 'paper', got {self.dataset!r}", "dataset"
             )
 
     @property
+    def study_model(self) -> str:
+        """The study's ``model`` (:class:`core.optimization.StudySettings`): ``gtrack`` for TI's
+        tracker, else the motion model."""
+        return "gtrack" if self.tracker == "gtrack" else self.model
+
+    @property
+    def mode(self) -> str:
+        """The IPDA's mode the study tunes (``room`` or ``paper``)."""
+        return "room" if self.tracker == "room" else "paper"
+
+    @property
     def effective_name(self) -> str:
-        return self.study_name or f"radartune-{self.model}"
+        """The study's name: ``radartune-<model>`` as the CLI's, ``-room`` for the room mode
+        (so that a paper study of the same model on the storage is not resumed as one)."""
+        suffix = "-room" if self.tracker == "room" else ""
+        return self.study_name or f"radartune-{self.study_model}{suffix}"
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -246,7 +268,7 @@ class StudyProgress:
     best_params: dict = field(default_factory=dict)
     best_model: str = "cv"
     #: best-so-far loss against the study's busy time (s since its first trial started, the
-    #: idle gaps between runs left out: app.engine.studies.busy_time_s)
+    #: idle gaps between runs left out: core.optimization.progress.busy_time_s)
     curve_t_s: np.ndarray = field(default_factory=lambda: np.zeros(0))
     curve_best: np.ndarray = field(default_factory=lambda: np.zeros(0))
     #: why trials failed: (reason, number of trials), most frequent first

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import threading
 import time
+from collections import OrderedDict
 
 import numpy as np
 from PySide6 import QtCore, QtGui
@@ -22,6 +23,43 @@ from app.errors import log_exception, one_line
 from core.live import LinkSettings, LiveLink
 from core.pointcloud import PointCloud
 from core.tracking.history import TrackHistory
+
+#: Arrival times kept for the latency measurement: the newest frames'. The view follows the
+#: newest frame, so a frame not drawn by the time this many newer ones arrived never will be.
+MAX_ARRIVALS = 256
+
+
+class ArrivalTimes:
+    """``time.perf_counter()`` of each frame's last byte, by frame index, for the newest
+    :data:`MAX_ARRIVALS` frames (``radartune bench gui`` pops a frame's time when it is drawn).
+
+    Bounded: the oldest time is let go when a new one would exceed the capacity, counted in
+    ``n_evicted``, so a long session keeps a constant few kB however many frames are never
+    drawn (the draw timer skips frames that arrive faster than it draws).
+    """
+
+    def __init__(self, capacity: int = MAX_ARRIVALS) -> None:
+        if capacity < 1:
+            raise ValueError(f"capacity must be >= 1, got {capacity}")
+        self.capacity = int(capacity)
+        self._times: OrderedDict[int, float] = OrderedDict()
+        self.n_evicted = 0
+
+    def add(self, index: int, t_s: float) -> None:
+        self._times[index] = t_s
+        while len(self._times) > self.capacity:
+            self._times.popitem(last=False)
+            self.n_evicted += 1
+
+    def pop(self, index: int, default: float | None = None) -> float | None:
+        return self._times.pop(index, default)
+
+    def clear(self) -> None:
+        self._times.clear()
+        self.n_evicted = 0
+
+    def __len__(self) -> int:
+        return len(self._times)
 
 
 class LiveTracks:
@@ -36,7 +74,9 @@ class LiveTracks:
     has no ground truth).
     """
 
-    def __init__(self) -> None:
+    def __init__(self, velocity_col: int = 2) -> None:
+        #: the first velocity column of the tracker's state (2: the IPDA's; gtrack's: its dims)
+        self.velocity_col = velocity_col
         self.frames: list[TrackFrame] = []
         self._est: list[tuple[float, float]] = []
         self._history = TrackHistory()
@@ -49,7 +89,7 @@ class LiveTracks:
         while len(self.frames) < index:
             self.frames.append(TrackFrame.empty())
             self._est.append((np.nan, np.nan))
-        tf = track_frame(tracks)
+        tf = track_frame(tracks, velocity_col=self.velocity_col)
         self.frames.append(tf)
         e = tracks.estimate
         self._est.append(tuple(tf.xy_m[e]) if e >= 0 else (np.nan, np.nan))
@@ -142,7 +182,7 @@ class LiveController(QtCore.QObject):
         self._edge = 0
         self._generation = -1
         #: frame index -> time.perf_counter() of its last byte (``radartune bench gui``)
-        self.received_s: dict[int, float] = {}
+        self.received_s = ArrivalTimes()
         self._tracks = LiveTracks()
         self._result: TrackingResult | None = None
         self.n_frames = self.n_dropped = self.n_damaged = 0
@@ -158,6 +198,7 @@ class LiveController(QtCore.QObject):
             menu.insertAction(quit_action, action)
         menu.insertSeparator(quit_action)
         window.tracking_model.changed.connect(self._on_tracked)
+        window.scene_control.info_changed.connect(self._on_scene_info)
 
     @property
     def running(self) -> bool:
@@ -189,10 +230,11 @@ class LiveController(QtCore.QObject):
         if self.running:
             w.show_error("live sensor: a sensor is connected; stop it before connecting again")
             return
-        if w.params_model.tracker != "paper":  # core.live tracks frame by frame with the IPDA
+        if w.params_model.tracker == "room":  # core.live.stream_tracker: no room mode yet
             w.show_error(
-                f"live sensor: the live link tracks with the paper tracker, not "
-                f"{w.params_model.tracker}; choose 'paper' in the tracker panel"
+                "live sensor: the live link tracks with the paper tracker or gtrack, not the "
+                "room mode (it has no frame-by-frame form yet); choose 'paper' or 'gtrack' in "
+                "the tracker panel, and re-track the recording in the room mode afterwards"
             )
             return
         try:
@@ -204,8 +246,9 @@ class LiveController(QtCore.QObject):
         w.tracker.invalidate()
         w.cache.clear(expected=0, truth_paths=())
         self._generation = w.cache.generation
+        self._set_live_face(True)
         self.received_s.clear()
-        self._tracks = LiveTracks()
+        self._tracks = LiveTracks(velocity_col=getattr(params, "dims", 2))
         self._result = None
         self._edge = 0  # the newest frame the view was moved to: following while it is there
         self.n_frames = self.n_dropped = self.n_damaged = 0
@@ -220,6 +263,27 @@ class LiveController(QtCore.QObject):
         self.act_connect.setEnabled(False)
         w.statusBar().showMessage(f"connecting to {settings.cli_port} …", 5000)
         worker.start()
+
+    def _set_live_face(self, live: bool) -> None:
+        """A sensor has no ground truth and no radar cube: no truth paths, loss, RMSE or OSPA
+        (the track counts instead) and the cube's views say why, until the scene is simulated
+        again."""
+        w = self._w
+        from app.recording_control import LIVE_SOURCE
+
+        truth = not live and w.engine.has_truth
+        w.psi_view.has_truth = truth
+        w.psi_view.set_recording_counts(None, None)
+        w.top_view.set_has_truth(truth)
+        if live:
+            w.top_view.set_truth_paths([])
+        w.recording._set_views_unavailable(live, LIVE_SOURCE)
+
+    def _on_scene_info(self, _info) -> None:
+        """The scene adopted again (its simulation replaces the sensor's frames)."""
+        if self._generation >= 0 and not self.running and not self._w.recording.replaying:
+            self._generation = -1
+            self._set_live_face(False)
 
     def stop(self) -> None:
         """Stop the sensor (``sensorStop``, sent by the worker as the link closes)."""
@@ -265,7 +329,7 @@ class LiveController(QtCore.QObject):
         w.cache.append(
             FrameData(index=frame.index, t_s=frame.t_s, cloud=frame.cloud, truth_xy_m=empty)
         )
-        self.received_s[frame.index] = frame.received_s
+        self.received_s.add(frame.index, frame.received_s)
         self.n_frames += 1
         self.n_dropped, self.n_damaged = frame.n_dropped, frame.n_damaged
         self._tracks.add(frame.index, frame.tracks)

@@ -36,9 +36,11 @@ RECENT_KEY = "recording/recent"
 #: Suffixes a dropped file is taken as a recording by (a .json is a scene unless it is a replay).
 RECORDING_SUFFIXES = (".dat", ".bin", ".csv", ".txt", ".npz", ".json")
 NO_CUBE = (
-    "A recording of detected points has no {what}: the sensor sent its point cloud, not the "
+    "{source} has no {what}: the sensor sent its point cloud, not the "
     "radar cube. Simulate a scene, or import a DCA1000 capture of raw ADC samples, to see it."
 )
+RECORDING_SOURCE = "A recording of detected points"
+LIVE_SOURCE = "A live sensor's stream of detected points"
 
 
 def sibling_cfg(path: Path) -> Path | None:
@@ -267,7 +269,7 @@ class RecordingController(QtCore.QObject):
         w = self._w
         self.path = path
         ds = replay.dataset
-        self.facts = recording_facts(ds, Path(path).name if path else "")
+        self.facts = recording_facts(ds, Path(path).name if path else "", source=path)
         self.panel.show_facts(self.facts)
         self._reference = ReferenceLayer.of(ds) if ds.has_reference else None
         self._head_count = np.asarray(ds.people_count, dtype=np.int64)
@@ -279,6 +281,10 @@ class RecordingController(QtCore.QObject):
             i = w.colour_combo.findData("doppler")
             w.colour_combo.setCurrentIndex(i)  # its signal recolours the view
         w.psi_view.has_truth = replay.has_truth
+        w.top_view.set_has_truth(replay.has_truth)
+        w.psi_view.set_recording_counts(
+            counts, self._reference.counts() if self._reference is not None else None
+        )
         scene_dock, rec_dock = w.docks["Scene"], self.dock
         if w.dockWidgetArea(rec_dock) == QtCore.Qt.NoDockWidgetArea:
             w.addDockWidget(w.dockWidgetArea(scene_dock), rec_dock)
@@ -311,7 +317,7 @@ class RecordingController(QtCore.QObject):
         except Exception as exc:  # the scene keeps its radar: the views still draw the points
             log_exception("the recording's radar does not fit the scene", exc)
 
-    def _set_views_unavailable(self, replay: bool) -> None:
+    def _set_views_unavailable(self, replay: bool, source: str = RECORDING_SOURCE) -> None:
         w = self._w
         views = w.views_control
         for view, what in (
@@ -321,7 +327,7 @@ class RecordingController(QtCore.QObject):
             (views.spectrogram_view, "micro-Doppler spectrogram (it is cut from the range-Doppler "
                                      "map at each person's range)"),
         ):  # fmt: skip
-            set_unavailable(view, NO_CUBE.format(what=what) if replay else None)
+            set_unavailable(view, NO_CUBE.format(source=source, what=what) if replay else None)
 
     def close_recording(self) -> None:
         """Back to simulating the scene."""
@@ -336,6 +342,8 @@ class RecordingController(QtCore.QObject):
         w.top_view.set_reference(None)
         self.reference_check.setEnabled(False)
         w.psi_view.has_truth = w.engine.has_truth
+        w.top_view.set_has_truth(w.engine.has_truth)
+        w.psi_view.set_recording_counts(None, None)
         if self._scene_dock_was_visible:
             w.docks["Scene"].show()
             w.docks["Scene"].raise_()
@@ -448,7 +456,7 @@ class RecordingController(QtCore.QObject):
             head_count=hc,
             truth_count=(
                 int(np.isfinite(frame.truth_xy_m).all(axis=1).sum())
-                if frame is not None and w.engine.has_truth
+                if frame is not None and w.psi_view.has_truth
                 else -1
             ),
             dropped_frames=dropped,

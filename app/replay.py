@@ -96,8 +96,22 @@ class RecordingFacts:
         ]
 
 
-def recording_facts(ds: Dataset, name: str = "") -> RecordingFacts:
-    """The facts of data set ``ds`` (an imported recording or a simulated data set)."""
+def short_notes(notes, sources) -> tuple[str, ...]:
+    """The reader's notes with each path of ``sources`` (the file as read, the file a data set
+    was imported from) shortened to its file name: the panel names the file once, in full
+    nowhere (a path says where the user keeps it, not what the recording holds)."""
+    paths = sorted({str(s) for s in sources if s and Path(str(s)).name != str(s)}, key=len)
+    out = []
+    for note in notes:
+        for p in reversed(paths):  # the longest first: a path may contain a shorter one
+            note = note.replace(p, Path(p).name)
+        out.append(note)
+    return tuple(out)
+
+
+def recording_facts(ds: Dataset, name: str = "", source: str | Path = "") -> RecordingFacts:
+    """The facts of data set ``ds`` (an imported recording or a simulated data set) read from
+    the file ``source`` (its path shortened to the file name in the notes)."""
     from core.formats.recording import has_truth
 
     scene = json.loads(ds.scene_json) if ds.scene_json else {}
@@ -106,7 +120,10 @@ def recording_facts(ds: Dataset, name: str = "") -> RecordingFacts:
     radar = RadarConfig.from_dict(radar_doc) if radar_doc else RadarConfig()
     if isinstance(imported, dict):
         fmt = str(imported.get("format", "recording"))
-        notes = tuple(str(n) for n in imported.get("notes", ()))
+        notes = short_notes(
+            (str(n) for n in imported.get("notes", ())),
+            (source, imported.get("imported_from", "")),
+        )
         assumed = any("radar assumed" in n for n in notes)
         device = str(imported.get("device") or "")
         if not device:
@@ -166,6 +183,10 @@ class ReferenceLayer:
     def count(self, frame: int) -> int:
         """TI's track count at ``frame``."""
         return len(self.at(frame)[0])
+
+    def counts(self) -> np.ndarray:
+        """TI's track count of every frame."""
+        return np.diff(self.offsets)
 
 
 def attach_recording(engine: Engine, replay: ReplayEngine) -> None:

@@ -33,6 +33,24 @@ def wait_until(qa, cond, timeout_s: float) -> bool:
     return cond()
 
 
+class Shots:
+    """The screenshot scripts' grab-and-save: :meth:`save` grabs a widget (after the pending
+    events, so that it shows its last state) into ``out/NAME`` and remembers the name;
+    :meth:`listing` is the paths written, one a line."""
+
+    def __init__(self, qa, out: Path) -> None:
+        self.qa, self.out = qa, out
+        self.names: list[str] = []
+
+    def save(self, widget, name: str) -> None:
+        self.qa.processEvents()
+        widget.grab().save(str(self.out / name))
+        self.names.append(name)
+
+    def listing(self) -> str:
+        return "\n".join(str(self.out / s) for s in self.names)
+
+
 def open_window(out: Path, scene_path: str | None = None):
     """The application, a main window on fresh settings (in a temporary folder, also returned)
     and the output folder ``out`` created: what both screenshot scripts start from."""
@@ -41,6 +59,8 @@ def open_window(out: Path, scene_path: str | None = None):
 
     from app.window import MainWindow
 
+    # as app.main: the 3-D view's GL items survive its dock being floated (a new top level)
+    QtCore.QCoreApplication.setAttribute(QtCore.Qt.AA_ShareOpenGLContexts)
     qa = QtWidgets.QApplication.instance() or QtWidgets.QApplication(sys.argv[:1])
     pg.setConfigOptions(imageAxisOrder="row-major")
     out.mkdir(parents=True, exist_ok=True)
@@ -70,12 +90,8 @@ def main(argv: list[str] | None = None) -> int:
         return 1
     wait_until(qa, lambda: w.tracking_model.result is not None, 120)
     wait_until(qa, lambda: w.tracker.idle, 60)
-    shots: list[str] = []
-
-    def save(widget, name: str) -> None:
-        qa.processEvents()
-        widget.grab().save(str(out / name))
-        shots.append(name)
+    shots = Shots(qa, out)
+    save = shots.save
 
     if args.study > 0:
         w.study_model.set_form(n_trials=args.study, storage=str(tmp / "study.db"))
@@ -117,7 +133,7 @@ def main(argv: list[str] | None = None) -> int:
     save(w.top_view, "top_view_waypoints.png")
     w.shutdown()
     shutil.rmtree(tmp, ignore_errors=True)
-    print("\n".join(str(out / s) for s in shots))
+    print(shots.listing())
     return 0
 
 

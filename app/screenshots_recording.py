@@ -18,7 +18,7 @@ import sys
 from pathlib import Path
 
 import app  # noqa: F401  (thread settings before numpy)
-from app.screenshots import open_window, wait_until
+from app.screenshots import Shots, open_window, wait_until
 
 DEFAULT_RECORDING = "pc3_iwr6843/pc3_2023-06-21-12-27-01.csv"
 
@@ -83,12 +83,7 @@ def main(argv: list[str] | None = None) -> int:
     wait_until(qa, lambda: w.cache.complete, 300)
     wait_until(qa, lambda: w.tracking_model.result is not None, 120)
     wait_until(qa, lambda: w.tracker.idle, 60)
-    shots: list[str] = []
-
-    def save(widget, name: str) -> None:
-        qa.processEvents()
-        widget.grab().save(str(out / name))
-        shots.append(name)
+    shots = Shots(qa, out)
 
     w.colour_combo.setCurrentIndex(w.colour_combo.findData(args.colour))
     w.playback.set_frame(min(args.frame, len(w.cache) - 1))
@@ -99,13 +94,13 @@ def main(argv: list[str] | None = None) -> int:
         view._stop_auto_fit()
         view.getPlotItem().vb.setRange(xRange=(-args.zoom, args.zoom), yRange=(-0.3, args.zoom))
     w.redraw()
-    save(w, "recording_window.png")
-    save(w.recording.dock, "recording_panel.png")
+    shots.save(w, "recording_window.png")
+    shots.save(w.recording.dock, "recording_panel.png")
     if args.compare:
         compare(w)
     w.shutdown()
     shutil.rmtree(tmp, ignore_errors=True)
-    print("\n".join(str(out / s) for s in shots))
+    print(shots.listing())
     return 0
 
 

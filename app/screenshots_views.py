@@ -16,7 +16,7 @@ from pathlib import Path
 
 import app  # noqa: F401  (thread settings before numpy)
 from app.engine import ROOT
-from app.screenshots import open_window, wait_until
+from app.screenshots import Shots, open_window, wait_until
 
 SHOTS = (
     ("ra_view", "views_range_azimuth.png"),
@@ -50,18 +50,15 @@ def main(argv: list[str] | None = None) -> int:
     w.redraw()
     index = w.playback.frame
     w.views_control.draw_all(index, w.cache.frames[index], w.tracking_model.result)
-    written = []
+    shots = Shots(qa, out)
     for attr, name in SHOTS:
         widget = getattr(w.views_control, attr)
         widget.resize(900, 300)
-        qa.processEvents()
-        widget.grab().save(str(out / name))
-        written.append(name)
-    w.top_view.grab().save(str(out / "views_top_view_identities.png"))
-    written.append("views_top_view_identities.png")
+        shots.save(widget, name)
+    shots.save(w.top_view, "views_top_view_identities.png")
     w.shutdown()
     shutil.rmtree(tmp, ignore_errors=True)
-    print("\n".join(str(out / s) for s in written))
+    print(shots.listing())
     return 0
 
 

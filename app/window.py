@@ -226,6 +226,9 @@ class MainWindow(QtWidgets.QMainWindow):
         )
         self.study_model.message.connect(lambda m: self.statusBar().showMessage(m, 8000))
         self.study_model.form_changed.connect(lambda _f: self.study.refresh())
+        # the study tunes the tracker the tracker panel shows (until one is chosen in the
+        # study panel; never while a study runs)
+        self.params_model.changed.connect(self._study_follows_tracker)
 
     def _dock(self, title: str, widget: QtWidgets.QWidget, area) -> None:
         scroll = QtWidgets.QScrollArea()
@@ -458,8 +461,10 @@ class MainWindow(QtWidgets.QMainWindow):
             self.show_error("no completed trial yet")
             return
         try:
-            self.params_model.set_tracker("paper")  # the study tunes the paper tracker
-            self.params_model.set_values(p.best_params, model=p.best_model)
+            form = self.study_model.form
+            self.params_model.set_tracker(form.tracker)  # the tracker the study tunes
+            model = None if form.tracker == "gtrack" else p.best_model
+            self.params_model.set_values(p.best_params, model=model)
             self.statusBar().showMessage(f"applied best trial (loss {p.best_loss:.4g} m²)", 5000)
         except InputError as exc:
             self.show_error(str(exc))
@@ -541,7 +546,7 @@ class MainWindow(QtWidgets.QMainWindow):
         self._update_fps()
 
     def _show_metrics(self, index: int, result) -> None:
-        if not self.engine.has_truth:
+        if not self.psi_view.has_truth:  # a recording without truth, or a live sensor
             self.metrics_label.setText("no ground truth: no loss, RMSE or OSPA")
             return
         if result is None or index >= result.n_frames:
@@ -559,7 +564,11 @@ class MainWindow(QtWidgets.QMainWindow):
         now = time.perf_counter()
         recent = [t for t in self._draw_times if now - t <= 1.0]
         rendered = len(recent)
-        source = "read" if self.recording.replaying else "simulated"
+        source = (
+            "received" if self.live.owns_frames
+            else "read" if self.recording.replaying
+            else "simulated"
+        )  # fmt: skip
         text = f" rendered {rendered:d} fps · {source} {self.sim.rate_fps:.1f} fps" + (
             " (done)" if self.cache.complete else ""
         )
@@ -608,10 +617,16 @@ class MainWindow(QtWidgets.QMainWindow):
             log_exception("cannot start study", exc)
             self.show_error(f"cannot start study: {one_line(exc)}")
 
+    def _study_follows_tracker(self) -> None:
+        tracker = self.params_model.tracker
+        if not self.study.running and self.study_model.form.tracker != tracker:
+            self.study_model.set_form(tracker=tracker)
+
     def enqueue_current(self) -> None:
-        if self.params_model.tracker != "paper":
+        tuned = self.study_model.form.tracker
+        if self.params_model.tracker != tuned:
             self.show_error(
-                "cannot enqueue: the study tunes the paper tracker; the tracker panel shows "
+                f"cannot enqueue: the study tunes the {tuned} tracker; the tracker panel shows "
                 f"{self.params_model.tracker}"
             )
             return
@@ -667,6 +682,7 @@ class MainWindow(QtWidgets.QMainWindow):
         s.setValue("tracker/extra", json.dumps(self.params_model.extra))
         f = self.study_model.form
         s.setValue("study/model", f.model)
+        s.setValue("study/tracker", f.tracker)
         s.setValue("study/n_trials", int(f.n_trials))
         s.setValue("study/n_jobs", int(f.n_jobs))
         s.setValue("study/storage", f.storage)
@@ -718,6 +734,7 @@ class MainWindow(QtWidgets.QMainWindow):
                 n_jobs=s.value("study/n_jobs", 1, type=int),
                 storage=s.value("study/storage", self.study_model.form.storage, type=str),
                 dataset=s.value("study/dataset", "scene", type=str),
+                tracker=s.value("study/tracker", self.params_model.tracker, type=str),
             )
         except InputError as exc:
             self.statusBar().showMessage(f"stored study settings ignored: {exc}", 8000)

@@ -19,6 +19,7 @@ import numpy as np
 from app.data import FrameData
 from app.engine.scenes import ROOT
 from core.errors import InputError
+from core.optimization.progress import busy_time_s
 
 
 class StudyProcesses:
@@ -82,7 +83,8 @@ def start_study(form, dataset_path: str | None = None) -> StudyProcesses:
         dataset_path = resolve_dataset(None)
     url = storage_url(form.storage)
     settings = StudySettings(
-        model=form.model,
+        model=form.study_model,
+        mode=form.mode,
         n_trials=form.n_trials,
         n_jobs=form.n_jobs,
         storage=url,
@@ -131,49 +133,6 @@ def study_progress(form):
     )
 
 
-#: an idle gap between trials is left out of the busy time when it is longer than this many
-#: median trial durations (and than :data:`IDLE_GAP_MIN_S`): a study resumed an hour later
-IDLE_GAP_TRIALS = 5.0
-IDLE_GAP_MIN_S = 10.0
-
-
-def busy_time_s(summaries, at) -> np.ndarray:
-    """The study's busy time (s) at each datetime of ``at``: the time since its first trial
-    started with the idle gaps between runs left out.
-
-    Each finished trial spans [start, complete]; spans that overlap (parallel workers) or follow
-    one another within an idle threshold (a worker's sampling between trials) are one busy
-    stretch. A gap longer than ``IDLE_GAP_TRIALS`` median trial durations and longer than
-    ``IDLE_GAP_MIN_S`` (the study stopped and resumed, or a second run on its storage) counts
-    zero, so a second run continues the first one's time axis instead of drawing the pause.
-    """
-    spans = sorted(
-        (s.datetime_start, s.datetime_complete)
-        for s in summaries
-        if s.datetime_start is not None and s.datetime_complete is not None
-    )
-    at = list(at)
-    if not spans or not at:
-        return np.zeros(len(at))
-    t0 = spans[0][0]
-    a = np.array([(s0 - t0).total_seconds() for s0, _ in spans])
-    b = np.maximum(a, [(s1 - t0).total_seconds() for _, s1 in spans])
-    max_gap = max(IDLE_GAP_TRIALS * float(np.median(b - a)), IDLE_GAP_MIN_S)
-    # merge into busy stretches [lo, hi]
-    lo, hi = [a[0]], [b[0]]
-    for ai, bi in zip(a[1:], b[1:], strict=True):
-        if ai - hi[-1] <= max_gap:
-            hi[-1] = max(hi[-1], bi)
-        else:
-            lo.append(ai)
-            hi.append(bi)
-    lo_a, hi_a = np.array(lo), np.array(hi)
-    before = np.concatenate([[0.0], np.cumsum(hi_a - lo_a)])  # busy time before each stretch
-    t = np.array([(x - t0).total_seconds() for x in at])
-    k = np.clip(np.searchsorted(lo_a, t, side="right") - 1, 0, len(lo_a) - 1)
-    return before[k] + np.clip(t - lo_a[k], 0.0, hi_a[k] - lo_a[k])
-
-
 def failure_reasons(summaries, n_max: int = 5) -> tuple[tuple[str, int], ...]:
     """The distinct reasons of the FAIL trials with how many trials each, most frequent first
     (at most ``n_max``); a trial without a recorded reason counts as "no reason recorded"."""
@@ -186,11 +145,16 @@ def failure_reasons(summaries, n_max: int = 5) -> tuple[tuple[str, int], ...]:
 
 
 def enqueue_trial(form, values: dict[str, float], model: str) -> None:
+    """Queue ``values`` (flat, of the form's tracker with motion model ``model``) as the
+    study's next trial."""
     from core.optimization import enqueue_params
     from core.tracking.space import tracker_params_dict
 
+    study_model = "gtrack" if form.tracker == "gtrack" else model
     enqueue_params(
-        storage_url(form.storage), form.effective_name, tracker_params_dict(values, model)
+        storage_url(form.storage),
+        form.effective_name,
+        tracker_params_dict(values, study_model, form.mode),
     )
 
 

@@ -36,6 +36,15 @@ class StudyPanel(QtWidgets.QWidget):
         outer = QtWidgets.QVBoxLayout(self)
         form_box = QtWidgets.QGroupBox("Study")
         form = QtWidgets.QFormLayout(form_box)
+        self.tracker_combo = QtWidgets.QComboBox()
+        self.tracker_combo.setObjectName("studyTracker")
+        self.tracker_combo.addItem("paper (one-point IPDA)", "paper")
+        self.tracker_combo.addItem("room mode (groups, static, ghosts)", "room")
+        self.tracker_combo.addItem("gtrack (TI's people tracker)", "gtrack")
+        self.tracker_combo.setToolTip(
+            "the tracker tuned, as radartune tune (--mode room, --tracker gtrack); "
+            "follows the tracker panel"
+        )
         self.model_combo = QtWidgets.QComboBox()
         self.model_combo.setObjectName("studyModel")
         self.model_combo.addItem("CV", "cv")
@@ -62,6 +71,7 @@ class StudyPanel(QtWidgets.QWidget):
         storage_row.addWidget(self.browse)
         for w in (self.trials, self.jobs):
             w.setKeyboardTracking(False)
+        form.addRow("tracker", self.tracker_combo)
         form.addRow("motion model", self.model_combo)
         form.addRow("trials", self.trials)
         form.addRow("processes", self.jobs)
@@ -132,6 +142,9 @@ class StudyPanel(QtWidgets.QWidget):
         self.model_combo.currentIndexChanged.connect(
             lambda i: self._set(model=self.model_combo.itemData(i))
         )
+        self.tracker_combo.currentIndexChanged.connect(
+            lambda i: self._set(tracker=self.tracker_combo.itemData(i))
+        )
         self.trials.valueChanged.connect(lambda v: self._set(n_trials=int(v)))
         self.jobs.valueChanged.connect(lambda v: self._set(n_jobs=int(v)))
         self.dataset.currentIndexChanged.connect(
@@ -164,9 +177,13 @@ class StudyPanel(QtWidgets.QWidget):
 
     def sync(self) -> None:
         f = self.model.form
-        widgets = (self.model_combo, self.trials, self.jobs, self.dataset, self.storage)
+        widgets = (
+            self.tracker_combo, self.model_combo, self.trials, self.jobs, self.dataset,
+            self.storage,
+        )  # fmt: skip
         for w in widgets:
             w.blockSignals(True)
+        self.tracker_combo.setCurrentIndex(self.tracker_combo.findData(f.tracker))
         self.model_combo.setCurrentIndex(0 if f.model == "cv" else 1)
         self.trials.setValue(f.n_trials)
         self.jobs.setValue(f.n_jobs)
@@ -176,8 +193,10 @@ class StudyPanel(QtWidgets.QWidget):
         for w in widgets:
             w.blockSignals(False)
         running = self.model.running
-        for w in (self.model_combo, self.trials, self.jobs, self.dataset, self.storage):
+        for w in widgets:
             w.setEnabled(not running)
+        # gtrack has its own table: no motion model to choose
+        self.model_combo.setEnabled(not running and f.tracker != "gtrack")
         self.start_button.setEnabled(not running)
         if not running:
             self.stopping = False

@@ -100,6 +100,8 @@ class TopView(pg.PlotWidget):
         self.draw_mode = False
         self.scene().sigMouseClicked.connect(self._on_click)
 
+        #: False for a recording without ground truth (:meth:`set_has_truth`)
+        self.has_truth = True
         self.colour_by = "snr"  # a key of COLOUR_MODES
         self.persistence = 5
         self.trail_length = 25
@@ -117,6 +119,13 @@ class TopView(pg.PlotWidget):
             "background: rgba(0, 0, 0, 150); color: white; padding: 4px 8px; border-radius: 4px"
         )
         self.count_label.hide()
+        self._label_samples = {
+            k: pg.ScatterPlotItem(brush=self._label_brushes[k], pen=None, size=8)
+            for k in ("person", "clutter", "false alarm")
+        }
+        legend = self.getPlotItem().legend
+        self._legend_order = [(sample.item, label.text) for sample, label in legend.items]
+        self._refresh_legend()
         self.set_colour_by(self.colour_by)
 
     def _make_brushes(self) -> None:
@@ -180,16 +189,29 @@ class TopView(pg.PlotWidget):
         self._reference_sorted: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
         self.show_reference = True
         self._reference_labels: list[pg.TextItem] = []
-        self.legend_entry_visible("TI's tracks", False)
+        self._legend_hidden = {"TI's tracks"}
 
     def legend_entry_visible(self, name: str, visible: bool) -> None:
-        """Show or hide one legend row by its name (items without data keep no row)."""
+        """Show or hide one legend row by its name (the legend is rebuilt without the hidden
+        rows, so that no gap is left where one was)."""
+        if visible:
+            self._legend_hidden.discard(name)
+        else:
+            self._legend_hidden.add(name)
+        self._rebuild_legend()
+
+    def _rebuild_legend(self) -> None:
+        order = getattr(self, "_legend_order", None)
+        if order is None:  # still being built: __init__ rebuilds it at its end
+            return
         legend = self.getPlotItem().legend
-        for sample, label in legend.items:
-            if label.text == name:
-                sample.setVisible(visible)
-                label.setVisible(visible)
-        legend.updateSize()
+        legend.clear()
+        for item, name in order:
+            if name not in self._legend_hidden:
+                legend.addItem(item, name)
+        if self.colour_by == "label":  # the label colours (app.colours)
+            for name, sample in self._label_samples.items():
+                legend.addItem(sample, f"point: {name}")
 
     def _add_colour_bar(self) -> None:
         """The radar (a marker at the origin, boresight along y) and the points' colour bar."""
@@ -279,10 +301,12 @@ class TopView(pg.PlotWidget):
         """The room's walls and furniture footprints, one NaN-separated outline (m)."""
         xy = np.asarray(outline_xy_m, dtype=float).reshape(-1, 2)
         self.room.setData(xy[:, 0], xy[:, 1], connect="finite")
+        self._refresh_legend()
 
     def set_reflectors(self, xy_m: np.ndarray) -> None:
         xy = np.asarray(xy_m, dtype=float).reshape(-1, 2)
         self.reflectors.setData(xy[:, 0], xy[:, 1])
+        self._refresh_legend()
 
     def set_truth_paths(self, paths_m: Sequence[np.ndarray]) -> None:
         """Full ground-truth path of every person, each ``(F_i, 2)`` in m, one colour each."""
@@ -297,8 +321,39 @@ class TopView(pg.PlotWidget):
                 item.setData(paths[k][:, 0], paths[k][:, 1], connect="finite")
             else:
                 item.setData([], [])
-        self._n_persons = len(paths)
+        self._n_persons = sum(len(p) > 0 for p in paths)
         self._style_person_paths()
+        self._refresh_legend()
+
+    def set_has_truth(self, on: bool) -> None:
+        """False for a recording without ground truth: no truth marks, no scene estimate (the
+        paper's loss scores it against the truth; the tracks are drawn as ever) and no legend
+        rows for them."""
+        self.has_truth = bool(on)
+        if not self.has_truth:
+            self.estimate.setData([], [])
+            self.truth_now.setData([], [])
+        self._refresh_legend()
+
+    def _refresh_legend(self) -> None:
+        """The legend lists only what the data on show can draw: walls, reflectors and truth
+        paths of a scene that has them; truth and the estimate only with ground truth."""
+        if not hasattr(self, "has_truth"):
+            return  # still being built
+        walls = self.room.getData()[0]
+        rows = {
+            "walls": walls is not None and len(walls) > 0,
+            "static reflector": len(self.reflectors.data) > 0,
+            "truth path": self._n_persons > 0,
+            "truth": self.has_truth,
+            "estimate": self.has_truth,
+        }
+        for name, visible in rows.items():
+            if visible:
+                self._legend_hidden.discard(name)
+            else:
+                self._legend_hidden.add(name)
+        self._rebuild_legend()
 
     def set_selected_person(self, index: int) -> None:
         """Draw the selected person's path wider (the one the editor edits)."""
@@ -365,17 +420,8 @@ class TopView(pg.PlotWidget):
             self.colour_bar.setColorMap(pg.colormap.get(cmap))
             self.colour_bar.setLevels(span)
             self.colour_bar.axis.setLabel(f"{title.split(' (')[0]} ({unit})")
-        # legend of the label colours (app.colours), shown while points are coloured by label
-        legend = self.getPlotItem().legend
-        if not hasattr(self, "_label_samples"):
-            self._label_samples = {
-                k: pg.ScatterPlotItem(brush=self._label_brushes[k], pen=None, size=8)
-                for k in ("person", "clutter", "false alarm")
-            }
-        for name, sample in self._label_samples.items():
-            legend.removeItem(sample)
-            if mode == "label":
-                legend.addItem(sample, f"point: {name}")
+        # the label colours' legend rows, shown while points are coloured by label
+        self._rebuild_legend()
 
     def _point_brushes(
         self, frames: Sequence[FrameData]
@@ -431,7 +477,7 @@ class TopView(pg.PlotWidget):
         self.points.setData(x=x, y=y, brush=brushes)
         self.last_n_points = len(x)
         truth = frames[index].truth_xy_m
-        ok = np.isfinite(truth).all(axis=1)
+        ok = np.isfinite(truth).all(axis=1) & self.has_truth
         pens = [self._truth_brushes[k % MAX_PERSONS] for k in np.flatnonzero(ok)]
         self.truth_now.setData(truth[ok, 0], truth[ok, 1], pen=pens)
         if tracking is not None and index < tracking.n_frames:
@@ -541,7 +587,7 @@ class TopView(pg.PlotWidget):
                 )
                 item.setData(t[:, 0], t[:, 1], connect="finite")
             est = tracking.estimate_xy_m[index]
-            if np.isfinite(est).all():
+            if self.has_truth and np.isfinite(est).all():
                 self.estimate.setData([est[0]], [est[1]])
             else:
                 self.estimate.setData([], [])

@@ -7,8 +7,8 @@ to overlay drawn (median, ms; target ≤ 100 on the paper scene), playback redra
 4× and 8× (target ≥ 45), and the event loop's longest gap and gaps over 100 ms while a study runs
 (target: none over 100 ms), with an idle probe of the same run as reference; a live link at 20
 frames/s over the sensor emulator (target: last byte to drawn ≤ 50 ms median, no dropped frame);
-the 3-D view's redraws per second with 2 000 points (target ≥ 30; xcb only, offscreen has no
-OpenGL).
+the 3-D view's redraws per second with 2 000 points, docked and floated at 1280 x 800 px
+(target ≥ 30; xcb only, offscreen has no OpenGL).
 """
 
 from __future__ import annotations
@@ -123,6 +123,14 @@ def summary(result: dict) -> str:
                 f"({c3['snr_cpu_ms_per_redraw']} ms CPU each), {c3['track_redraws_per_s']} by "
                 f"track ({c3['track_cpu_ms_per_redraw']} ms CPU)"
             )
+            full = c3.get("full")
+            if full:
+                lines.append(
+                    f"{platform} 3-D view at {full['gl_px'][0]}x{full['gl_px'][1]} px: "
+                    f"{full['snr_redraws_per_s']} redraws/s by SNR "
+                    f"({full['snr_cpu_ms_per_redraw']} ms CPU), {full['track_redraws_per_s']} "
+                    f"by track ({full['track_cpu_ms_per_redraw']} ms CPU)"
+                )
         lv = r.get("live")
         if lv:
             lines.append(_live_line(f"{platform} live link", lv))

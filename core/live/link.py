@@ -7,8 +7,10 @@ them to the same streaming parser that reads UART log files
 (:func:`core.formats.ti_uart.iter_uart_frames`): damaged packets and garbage between packets are
 skipped and counted the same way, and frame-number gaps count dropped frames. Every chunk is
 written unchanged to the recording (:class:`core.live.recorder.Recorder`) before it is parsed.
-Each frame's points are tracked at once (:class:`core.tracking.tracker.StreamTracker`) and
-yielded as a :class:`LiveFrame`.
+Each frame's points are tracked at once, frame by frame (:func:`stream_tracker`: the paper's
+IPDA, :class:`core.tracking.tracker.StreamTracker`, or gtrack,
+:class:`core.tracking.gtrack.tracker.GtrackTracker`, as the parameters say) and yielded as a
+:class:`LiveFrame`.
 
 Frames are placed on the frame grid the importer uses
 (:func:`core.formats.recording.frames_from_numbers`): a gap of up to
@@ -50,6 +52,7 @@ from core.live.dialogue import (
 )
 from core.live.recorder import Recorder
 from core.pointcloud import PointCloud
+from core.tracking.gtrack import GtrackParams
 from core.tracking.params import TrackerParams
 from core.tracking.results import FrameTracks
 from core.tracking.tracker import StreamTracker
@@ -113,6 +116,52 @@ class LiveFrame:
     n_damaged: int
 
 
+class _GtrackStream:
+    """gtrack fed one frame at a time (its tracker keeps its state between frames)."""
+
+    def __init__(self, params: GtrackParams, frame_period_s: float) -> None:
+        from core.limits import FRAME_PERIOD_RANGE_S
+        from core.tracking.gtrack.tracker import GtrackTracker
+
+        lo, hi = FRAME_PERIOD_RANGE_S
+        if lo <= frame_period_s <= hi:  # the cfg's frame period is the data's
+            params = replace(params, frame_period_s=frame_period_s)
+        self._tracker = GtrackTracker(params)
+
+    def step(self, cloud: PointCloud) -> FrameTracks:
+        snr = 10.0 ** (np.asarray(cloud.snr_db, dtype=float) / 10.0)
+        ft, _, _ = self._tracker.step(
+            cloud.range_m, cloud.azimuth_rad, cloud.elevation_rad, cloud.radial_velocity_mps, snr
+        )
+        return ft
+
+
+class _IpdaStream:
+    def __init__(self, params: TrackerParams, frame_period_s: float) -> None:
+        self._tracker = StreamTracker(params, frame_period_s)
+
+    def step(self, cloud: PointCloud) -> FrameTracks:
+        return self._tracker.step(cloud.measurements())
+
+
+def stream_tracker(
+    params: TrackerParams | GtrackParams, frame_period_s: float
+) -> _IpdaStream | _GtrackStream:
+    """A tracker fed one frame at a time, ``.step(cloud) -> FrameTracks``: the paper's IPDA
+    (``TrackerParams`` of the paper mode) or gtrack (``GtrackParams``); each gives, frame by
+    frame, what its batch run (:func:`~core.tracking.run_tracker`,
+    :func:`~core.tracking.gtrack.run_gtrack`) gives over the whole run. The room mode has no
+    frame-by-frame form yet: one :class:`~core.errors.InputError`."""
+    if isinstance(params, GtrackParams):
+        return _GtrackStream(params, frame_period_s)
+    if params.mode != "paper":
+        raise InputError(
+            f"the live link tracks with the paper tracker or gtrack, not the {params.mode} mode "
+            "(it has no frame-by-frame form yet): track the recording afterwards"
+        )
+    return _IpdaStream(params, frame_period_s)
+
+
 def open_serial(port: str, baud: int, what: str) -> Port:
     """Open ``port`` with pyserial (8N1, no flow control); one line naming it if it cannot."""
     import serial
@@ -145,13 +194,14 @@ class LiveLink:
     def __init__(
         self,
         settings: LinkSettings,
-        params: TrackerParams | None = None,
+        params: TrackerParams | GtrackParams | None = None,
         *,
         record: str | Path | None = None,
         opener: Callable[[str, int, str], Port] = open_serial,
     ) -> None:
         self.settings = settings
         self.params = params if params is not None else TrackerParams.default("cv")
+        stream_tracker(self.params, 0.05)  # a tracker the link cannot run: said now, in one line
         self.record_path = Path(record) if record is not None else None
         self._opener = opener
         text = read_text(Path(settings.cfg), what="TI configuration")
@@ -278,11 +328,11 @@ class LiveLink:
     def frames(self) -> Iterator[LiveFrame]:
         """Each frame as it arrives, tracked (see the module docstring)."""
         period = self.radar.frame_period_s
-        tracker = StreamTracker(self.params, period)
+        tracker = stream_tracker(self.params, period)
         index = -1
         id_shift = next_id = 0
         last_number: int | None = None
-        empty = np.zeros((0, 3))
+        empty = PointCloud.empty()
         it = ti_uart.iter_uart_frames(
             self._chunks(), radar=self.radar, report=self.report, name=self.settings.data_port
         )
@@ -298,13 +348,13 @@ class LiveLink:
                 elif d == 1:
                     index += 1
                 else:  # the sensor restarted (number back) or a long gap: a new run
-                    tracker = StreamTracker(self.params, period)
+                    tracker = stream_tracker(self.params, period)
                     id_shift = next_id
                     index += 1
                 last_number = fn
                 p = uf.points
                 cloud, _ = points_to_cloud(p.x_m, p.y_m, p.z_m, p.velocity_mps, p.snr_db)
-                tracks = tracker.step(cloud.measurements())
+                tracks = tracker.step(cloud)
                 if len(tracks):
                     # ids unique over the link: a new run's ids follow the last run's
                     tracks = replace(tracks, ids=tracks.ids + id_shift)

@@ -8,9 +8,11 @@ only queues a trial for the workers to run.
 from __future__ import annotations
 
 import datetime as dt
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from typing import Any
+
+import numpy as np
 
 from core.errors import InputError
 from core.optimization.storage import load_existing_study, open_storage, redact
@@ -105,12 +107,62 @@ def enqueue_params(storage: str, name: str, params: dict[str, Any]) -> None:
     study = load_existing_study(store, name)
     if study is None:
         raise InputError(f"no study {name!r} in {redact(storage)}")
+    from core.tracking.space import GTRACK, search_space
+
     model = study.user_attrs.get("model")
-    if params.get("model", "cv") != model:
-        raise InputError(f"parameters are for model {params.get('model')!r}, study is {model!r}")
+    # gtrack's parameters (GtrackParams JSON) carry no "model": they are known by their names
+    gtrack_names = {p.name for p in search_space(GTRACK)}
+    is_gtrack = "model" not in params and gtrack_names <= set(params)
+    given = GTRACK if is_gtrack else params.get("model", "cv")
+    if given != model:
+        raise InputError(f"parameters are for model {given!r}, study is {model!r}")
     optuna.load_study(study_name=name, storage=store).enqueue_trial(flat_params(params))
 
 
 def counted(summaries: Sequence[TrialSummary]) -> int:
     """Trials that count toward the total: COMPLETE and PRUNED."""
     return sum(1 for s in summaries if s.state in ("COMPLETE", "PRUNED"))
+
+
+#: an idle gap between trials is left out of the busy time when it is longer than this many
+#: median trial durations (and than :data:`IDLE_GAP_MIN_S`): a study resumed an hour later
+IDLE_GAP_TRIALS = 5.0
+IDLE_GAP_MIN_S = 10.0
+
+
+def busy_time_s(summaries: Iterable[TrialSummary], at: Iterable[dt.datetime]) -> np.ndarray:
+    """The study's busy time (s) at each datetime of ``at``: the time since its first trial
+    started with the idle gaps between runs left out.
+
+    Each finished trial spans [start, complete]; spans that overlap (parallel workers) or follow
+    one another within an idle threshold (a worker's sampling between trials) are one busy
+    stretch. A gap longer than ``IDLE_GAP_TRIALS`` median trial durations and longer than
+    ``IDLE_GAP_MIN_S`` (the study stopped and resumed, or a second run on its storage) counts
+    zero, so a second run continues the first one's time axis instead of drawing the pause.
+    The app's study panel and the report's loss-against-time plots both use it.
+    """
+    spans = sorted(
+        (s.datetime_start, s.datetime_complete)
+        for s in summaries
+        if s.datetime_start is not None and s.datetime_complete is not None
+    )
+    at = list(at)
+    if not spans or not at:
+        return np.zeros(len(at))
+    t0 = spans[0][0]
+    a = np.array([(s0 - t0).total_seconds() for s0, _ in spans])
+    b = np.maximum(a, [(s1 - t0).total_seconds() for _, s1 in spans])
+    max_gap = max(IDLE_GAP_TRIALS * float(np.median(b - a)), IDLE_GAP_MIN_S)
+    # merge into busy stretches [lo, hi]
+    lo, hi = [a[0]], [b[0]]
+    for ai, bi in zip(a[1:], b[1:], strict=True):
+        if ai - hi[-1] <= max_gap:
+            hi[-1] = max(hi[-1], bi)
+        else:
+            lo.append(ai)
+            hi.append(bi)
+    lo_a, hi_a = np.array(lo), np.array(hi)
+    before = np.concatenate([[0.0], np.cumsum(hi_a - lo_a)])  # busy time before each stretch
+    t = np.array([(x - t0).total_seconds() for x in at])
+    k = np.clip(np.searchsorted(lo_a, t, side="right") - 1, 0, len(lo_a) - 1)
+    return before[k] + np.clip(t - lo_a[k], 0.0, hi_a[k] - lo_a[k])

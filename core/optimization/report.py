@@ -10,8 +10,9 @@ second data set of another seed with the best parameters, and writes into one fo
   and the metrics of every person, generalisation, the CV-vs-CA conclusion and the studies' run
   times;
 - ``best_cv.json`` / ``best_ca.json`` — TrackerParams JSON of the best trial;
-- ``loss_vs_time_<model>.png`` — best loss so far against wall-clock seconds for every study of
-  the model (TPE / random sampling, with / without pruning);
+- ``loss_vs_time_<model>.png`` — best loss so far against the study's busy time (idle gaps
+  between runs left out, as the app's study panel plots it) for every study of the model
+  (TPE / random sampling, with / without pruning);
 - ``tracks.png`` — truth and CV / CA estimates on maneuvering trajectories (classes c, d, e);
 - ``test_sets.png`` — the per-set L_t of the chosen parameters on the test data sets
   (:mod:`core.optimization.testsets`; chosen by validation when the studies were validated),
@@ -83,17 +84,22 @@ class StudyRecord:
         return sum(1 for t in self.trials if t.state in ("COMPLETE", "PRUNED"))
 
     def best_against_time(self) -> tuple[np.ndarray, np.ndarray]:
-        """Seconds since the study's first trial started, and the best loss so far (m²)."""
-        starts = [t.datetime_start for t in self.trials if t.datetime_start is not None]
+        """The study's busy time at each completed trial (s; :func:`~core.optimization.
+        progress.busy_time_s`: idle gaps between runs left out) and the best loss so far."""
+        from core.optimization.progress import busy_time_s
+
         done = sorted(
-            (t for t in self.trials if t.state == "COMPLETE" and t.value is not None),
-            key=lambda t: t.datetime_complete,
+            (
+                (t.datetime_complete, t.value)
+                for t in self.trials
+                if t.state == "COMPLETE" and t.value is not None and t.datetime_complete
+            ),
+            key=lambda d: d[0],
         )
-        if not starts or not done:
+        if not done:
             return np.zeros(0), np.zeros(0)
-        t0 = min(starts)
-        secs = np.array([(t.datetime_complete - t0).total_seconds() for t in done])
-        best = np.minimum.accumulate(np.array([t.value for t in done]))
+        secs = busy_time_s(self.trials, [at for at, _ in done])
+        best = np.minimum.accumulate(np.array([v for _, v in done]))
         return secs, best
 
     def wall_s(self) -> float:
@@ -173,7 +179,7 @@ def evaluate_params(dataset: Any, params: dict[str, Any]) -> tuple[Any, Any]:
 
 # ---- figures ----------------------------------------------------------------------------------
 def plot_loss_vs_time(studies: Sequence[StudyRecord], model: str, path: Path) -> bool:
-    """Best loss so far against wall-clock seconds, one line per study of ``model``."""
+    """Best loss so far against the study's busy time, one line per study of ``model``."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -198,7 +204,7 @@ def plot_loss_vs_time(studies: Sequence[StudyRecord], model: str, path: Path) ->
             label=f"{s.sampler.upper()} + {s.pruner} ({s.counted()} trials, {s.name})",
         )
     ax.set_yscale("log")
-    ax.set_xlabel("wall-clock time since the study started (s)")
+    ax.set_xlabel("busy time since the study started (s; idle gaps between runs left out)")
     ax.set_ylabel("best L_t so far (×10⁻³)")
     ax.set_title(f"{model.upper()}: best loss against run time")
     ax.grid(True, which="both", alpha=0.3)

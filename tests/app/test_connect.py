@@ -65,6 +65,20 @@ def test_live_frames_are_tracked_drawn_and_stopped(window, qtbot, capture, tmp_p
         live = window.tracking_model.result
         assert live.params_key == "live" and live.n_frames >= 40
         assert np.isnan(live.running_loss).all() and np.isnan(live.ospa_m).all()
+        # a sensor's face: no truth (paths, marks, metrics), the track counts, no cube views
+        window.redraw()
+        assert not window.psi_view.has_truth and not window.top_view.has_truth
+        assert "no ground truth" in window.metrics_label.text()
+        rows = [label.text for _s, label in window.top_view.getPlotItem().legend.items]
+        assert not {"truth", "truth path", "estimate"} & set(rows)
+        assert window.psi_view.metric_plot.titleLabel.text.startswith("tracks a frame")
+        assert "received" in window.fps_label.text()
+        assert "truth" not in window.top_view.count_label.text()
+        # nothing pops the arrival times here (only the latency benchmark does): they are
+        # bounded all the same, the oldest let go and counted
+        arrivals = window.live.received_s
+        assert len(arrivals) == min(window.live.n_frames, arrivals.capacity)
+        assert len(arrivals) + arrivals.n_evicted == window.live.n_frames
         window.live.stop()
         qtbot.waitUntil(window.live.act_connect.isEnabled, timeout=10000)
         assert em.commands[-1] == "sensorStop" and em.stopped.is_set()
@@ -98,6 +112,10 @@ def test_live_frames_are_tracked_drawn_and_stopped(window, qtbot, capture, tmp_p
     assert "sensor stopped after" in window.live.last_summary
     assert window.live.act_connect.isEnabled()
     assert window.errors == []
+    # the scene adopted again: its truth and metrics are back
+    window.scene_control.load_paper_scene()
+    qtbot.waitUntil(lambda: window.psi_view.has_truth, timeout=30000)
+    assert window.top_view.has_truth
 
 
 @pytest.mark.parametrize(
@@ -157,3 +175,37 @@ def test_connect_dialog_under_xcb_fits_the_screen(qtbot, monkeypatch, tmp_path) 
     for w in (d.cli_combo, d.data_combo, d.data_baud, d.error_label.parentWidget()):
         assert w.isVisible() and w.width() > 0 and w.height() > 0
     d.reject()
+
+
+def test_live_link_tracks_with_gtrack_when_chosen(window, qtbot, capture) -> None:
+    """gtrack chosen in the tracker panel: the link tracks each frame with gtrack, and the
+    re-track after Stop (the app's batch gtrack) gives the same tracks."""
+    data, cfg = capture
+    w = window
+    w.params_model.set_tracker("gtrack")
+    # the capture's walker is two points a frame: allocation thresholds that small a cluster
+    # passes (below the sliders' range, set as a parameter file could)
+    w.params_model.set_values({"points_thre": 1, "snr_thre": 1.0, "max_distance_thre_m2": 2.0})
+    with SensorEmulator(data, faults=Faults(frame_period_s=0.02)) as em:
+        settings = LinkSettings(cli_port=em.cli_port, data_port=em.data_port, cfg=str(cfg))
+        w.live.start(settings)
+        assert w.live.running, w.errors
+        qtbot.waitUntil(lambda: w.live.n_frames >= 40, timeout=30000)
+        w.live.stop()
+        qtbot.waitUntil(w.live.act_connect.isEnabled, timeout=10000)
+    live = w.live._tracks.result(w.live.frame_period_s)
+    assert live.n_frames >= 40
+    assert sum(int(f.confirmed.sum()) for f in live.frames[20:]) > 0  # the walker is tracked
+    qtbot.waitUntil(
+        lambda: (
+            w.tracking_model.result.params_key != "live"
+            and w.tracking_model.result.n_frames == len(w.cache)
+        ),
+        timeout=60000,
+    )
+    retracked = w.tracking_model.result
+    for a, b in zip(live.frames, retracked.frames):
+        np.testing.assert_array_equal(a.track_id, b.track_id)
+        np.testing.assert_allclose(a.xy_m, b.xy_m, rtol=0, atol=1e-6)
+        np.testing.assert_allclose(a.velocity_xy_mps, b.velocity_xy_mps, rtol=0, atol=1e-6)
+    assert w.errors == []

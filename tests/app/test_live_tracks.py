@@ -8,7 +8,7 @@ import numpy as np
 
 from app import engine
 from app.data import FrameData
-from app.live import LiveTracks
+from app.live import ArrivalTimes, LiveTracks
 from core.formats.recording import points_to_cloud
 from core.formats.ti_uart import iter_uart_frames
 from core.tracking import TrackerParams
@@ -50,3 +50,15 @@ def test_frames_that_never_arrived_are_empty(tmp_path) -> None:
     r = live.result(period)
     assert r.n_frames == 4 and len(r.frames[1]) == 0 and len(r.frames[2]) == 0
     assert list(r.trail_t_index) == [0, 3]
+
+
+def test_arrival_times_keep_the_newest_frames_only() -> None:
+    arrivals = ArrivalTimes(capacity=16)
+    for k in range(1000):  # a long session none of whose frames is drawn
+        arrivals.add(k, 0.05 * k)
+    assert len(arrivals) == 16 and arrivals.n_evicted == 1000 - 16
+    assert arrivals.pop(983) is None  # let go: older than the 16 newest
+    assert arrivals.pop(984) == 0.05 * 984 and arrivals.pop(984) is None  # popped once
+    assert arrivals.pop(999) == 0.05 * 999 and len(arrivals) == 14
+    arrivals.clear()  # the next Connect
+    assert len(arrivals) == 0 and arrivals.n_evicted == 0

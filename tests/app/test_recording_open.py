@@ -219,6 +219,58 @@ def test_reference_layer_colour_by_and_head_count(qtbot, window, tmp_path) -> No
     assert len(w.top_view.reference.getData()[0]) == 0
 
 
+def _legend_rows(plot) -> list[str]:
+    return [label.text for _s, label in plot.legend.items]
+
+
+def test_replay_face_without_truth(qtbot, window, tmp_path) -> None:
+    """No truth, no estimate and no scene rows in the top view's legend; the lower plot of the
+    ψ view counts tracks (RadarTune's confirmed ones against TI's) instead of metrics; the
+    notes name the file, not where it lives; back to the scene, all as before."""
+    w = window
+    w.scene_control.load_paper_scene()
+    qtbot.waitUntil(lambda: w.cache.complete and w.tracking_model.result is not None, timeout=60000)
+    scene_rows = _legend_rows(w.top_view.getPlotItem())
+    assert {"truth", "truth path", "estimate"} <= set(scene_rows)
+    assert _legend_rows(w.psi_view.metric_plot) == ["RMSE", "OSPA"]
+    path = _dataset_with_reference(tmp_path / "ref.npz")
+    _open(qtbot, w, path)
+    qtbot.waitUntil(
+        lambda: (
+            w.tracking_model.result is not None and w.tracking_model.result.n_frames == N_FRAMES
+        ),
+        timeout=30000,
+    )
+    w.playback.set_frame(N_FRAMES - 1)
+    w.redraw()
+    rows = _legend_rows(w.top_view.getPlotItem())
+    assert not {"truth", "truth path", "estimate", "static reflector"} & set(rows)
+    assert {"points", "tracks", "TI's tracks", "radar"} <= set(rows)
+    assert len(w.top_view.estimate.data) == 0
+    psi = w.psi_view
+    assert _legend_rows(psi.metric_plot) == ["confirmed tracks", "TI's tracks"]
+    assert psi.rmse_curve.getData()[0] is None or len(psi.rmse_curve.getData()[0]) == 0
+    result = w.tracking_model.result
+    confirmed = [int(f.confirmed.sum()) for f in result.frames]
+    np.testing.assert_array_equal(psi.count_curve.getData()[1], confirmed)
+    np.testing.assert_array_equal(psi.ti_curve.getData()[1], np.ones(N_FRAMES))  # track 7
+    text = psi.metric_text.text
+    assert "2 points" in text and f"confirmed tracks {confirmed[-1]}" in text and "TI 1" in text
+    w.recording.close_recording()
+    qtbot.waitUntil(lambda: w.cache.complete and w.tracking_model.result is not None, timeout=60000)
+    w.redraw()
+    assert _legend_rows(w.top_view.getPlotItem()) == scene_rows
+    assert _legend_rows(w.psi_view.metric_plot) == ["RMSE", "OSPA"]
+
+
+def test_notes_name_the_file_not_its_folder(tmp_path) -> None:
+    from app.replay import short_notes
+
+    src = str(tmp_path / "deep" / "run.csv")
+    notes = short_notes([f"{src}: 12 points", "frame period 50 ms"], (src, ""))
+    assert notes == ("run.csv: 12 points", "frame period 50 ms")
+
+
 def test_slow_radar_warning() -> None:
     from app.panels.recording_panel import slow_radar_warning
 

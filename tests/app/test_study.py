@@ -177,3 +177,51 @@ def test_a_study_refuses_the_frames_of_a_live_link_in_one_line(
     assert "\n" not in window.errors[0]
     fill_cache(window, long_scene_doc, frames)  # the scene simulated again: a new generation
     assert not window.live.owns_frames
+
+
+@pytest.mark.parametrize("tracker", ["room", "gtrack"])
+def test_a_study_of_the_room_mode_or_gtrack_from_the_panel(
+    window, qtbot, tmp_path, long_scene_frames, long_scene_doc, fill_cache, tracker
+) -> None:
+    """The panel's tracker follows the tracker panel; the study tunes that tracker's search
+    space (as radartune tune --mode room / --tracker gtrack), under its own name; Apply best
+    and Enqueue work on that tracker's sliders."""
+    from core.optimization import study_progress
+    from core.optimization.storage import absolute_url
+
+    scene, frames = long_scene_frames
+    fill_cache(window, long_scene_doc, frames)
+    window.params_model.set_tracker(tracker)
+    panel = window.study_panel
+    form = window.study_model.form
+    assert form.tracker == tracker and panel.tracker_combo.currentData() == tracker
+    assert panel.model_combo.isEnabled() == (tracker != "gtrack")
+    storage = tmp_path / "study.db"
+    window.study_model.set_form(n_trials=2, n_jobs=1, storage=str(storage))
+    name = {"room": "radartune-cv-room", "gtrack": "radartune-gtrack"}[tracker]
+    assert window.study_model.form.effective_name == name
+    qtbot.waitUntil(lambda: window.tracker.n_runs >= 1 and window.tracker.idle, timeout=60000)
+    finished = []
+    window.study.finished.connect(lambda: finished.append(True))
+    panel.start_button.click()
+    assert window.study_model.running
+    qtbot.waitUntil(lambda: bool(finished), timeout=300000)
+    p = window.study_model.progress
+    assert p.n_complete >= 1, (window.errors, p.failures)
+    specs = window.engine.param_specs("gtrack") if tracker == "gtrack" else (
+        window.engine.param_specs("cv", "room")
+    )  # fmt: skip
+    assert set(p.best_params) == {s.name for s in specs}
+    summaries, best = study_progress(absolute_url(str(storage)), name)
+    assert len(summaries) == 2 and best is not None
+    # Apply best: the tracker panel shows that tracker with the best values
+    window.params_model.reset()
+    panel.apply_button.click()
+    assert window.params_model.tracker == tracker
+    for k, v in p.best_params.items():
+        assert window.params_model.values[k] == pytest.approx(v)
+    messages: list[str] = []
+    window.study_model.message.connect(messages.append)
+    panel.enqueue_button.click()
+    qtbot.waitUntil(lambda: any("enqueued" in m for m in messages), timeout=30000)
+    assert not window.errors

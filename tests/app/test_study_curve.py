@@ -54,6 +54,23 @@ def test_parallel_trials_count_once() -> None:
     np.testing.assert_allclose(t, [3.0, 4.0])
 
 
+def test_the_report_plots_the_same_busy_time() -> None:
+    """The exported report's loss-against-time curve and the study panel's: one time axis."""
+    from core.optimization.report import StudyRecord
+
+    trials = _two_runs()
+    record = StudyRecord(
+        name="s", model="cv", sampler="tpe", pruner="asha", dataset="", trials=tuple(trials)
+    )
+    secs, best = record.best_against_time()
+    done = sorted((s for s in trials if s.state == "COMPLETE"), key=lambda s: s.datetime_complete)
+    np.testing.assert_allclose(
+        secs, studies.busy_time_s(trials, [s.datetime_complete for s in done])
+    )
+    assert secs[-1] < 60.0  # not the idle hour
+    np.testing.assert_allclose(best, np.minimum.accumulate([s.value for s in done]))
+
+
 def test_study_progress_and_panel_plot_the_busy_time(qtbot, tmp_path, monkeypatch) -> None:
     import core.optimization as opt
     from app.panels.study_panel import StudyPanel

@@ -146,11 +146,18 @@ def test_parameter_files_and_workspaces_keep_the_tracker(window, tmp_path) -> No
 
 
 def test_study_and_live_link_refuse_another_tracker(window) -> None:
-    """The study and the live link run the paper tracker: with gtrack chosen they say so in
-    one line instead of failing inside (the live link is not started)."""
+    """The study panel tunes the tracker the tracker panel shows (it follows a switch); the
+    sliders of another tracker are not enqueued into it: one line. The live link tracks with
+    the paper tracker or gtrack: with the room mode chosen it says so in one line (the link is
+    not started)."""
     w = window
     w.params_model.set_tracker("gtrack")
+    assert w.study_model.form.tracker == "gtrack"
+    assert w.study_model.form.effective_name == "radartune-gtrack"
+    w.study_model.set_form(tracker="room")  # chosen in the study panel
     w.enqueue_current()
-    assert "study tunes the paper tracker" in w.errors[-1]
+    assert "study tunes the room tracker; the tracker panel shows gtrack" in w.errors[-1]
+    w.params_model.set_tracker("room")
     w.live.start(None)  # refused before the settings are looked at
-    assert "choose 'paper'" in w.errors[-1] and not w.live.running
+    assert "not the room mode" in w.errors[-1] and "choose 'paper' or 'gtrack'" in w.errors[-1]
+    assert not w.live.running

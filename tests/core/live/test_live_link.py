@@ -3,9 +3,12 @@ tracked as they arrive, the recording byte for byte, sensorStop, and each fault.
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 
+from core.errors import InputError
 from core.formats.recording import to_dataset
 from core.live import LinkError, LinkSettings, LiveLink
 from core.live.dialogue import classify
@@ -226,3 +229,54 @@ def test_no_answer_names_the_line_and_the_likely_cause(capture) -> None:
         f"{cfg}:{first}: no answer from the sensor to 'sensorStop' within 0.3 s (got: 'nothing'); "
         "is this the CLI port (not the data port), at its baud rate (115200 by default)?"
     )
+
+
+def test_gtrack_tracks_live_as_on_the_imported_recording(capture, tmp_path) -> None:
+    """With gtrack's parameters the link tracks frame by frame with gtrack: the tracks of every
+    frame are those of gtrack run over the recording's import (same ids, states to 1e-9 m)."""
+    from core.tracking.gtrack import GtrackParams, run_gtrack
+    from core.tracking.gtrack.batch import dataset_points
+
+    data, cfg = capture
+    rec = tmp_path / "rec.dat"
+    # the capture's walker is two points a frame in the ground plane (SNR 15 dB each): gtrack
+    # in 2-D with allocation thresholds that small a cluster passes (its defaults ask 20 points)
+    params = GtrackParams(dims=2, points_thre=1, snr_thre=1.0, max_distance_thre_m2=2.0)
+    with SensorEmulator(data, faults=Faults(frame_period_s=FAST)) as em:
+        link = LiveLink(
+            LinkSettings(cli_port=em.cli_port, data_port=em.data_port, cfg=str(cfg)),
+            params,
+            record=rec,
+        )
+        frames = []
+        try:
+            link.start()
+            for f in link.frames():
+                frames.append(f)
+                if len(frames) >= 60:
+                    break
+        finally:
+            link.close()
+    ds = to_dataset(read_recording(rec, fmt=None, cfg=cfg), source_name=str(rec))
+    assert ds.n_frames == 60
+    period = link.radar.frame_period_s
+    ref = run_gtrack(
+        dataset_points(ds), ds.frame_offsets, dataclasses.replace(params, frame_period_s=period)
+    )
+    for f, r in zip(frames, ref.frames, strict=True):
+        np.testing.assert_array_equal(f.tracks.ids, r.ids)
+        np.testing.assert_allclose(f.tracks.state, r.state, rtol=0, atol=1e-9)
+        np.testing.assert_array_equal(f.tracks.confirmed, r.confirmed)
+    # the walker is tracked: an active (confirmed) gtrack track within 0.3 m of the truth
+    last = frames[-1].tracks
+    d = np.hypot(*(last.state[last.confirmed, :2] - person_xy(frames[-1].t_s)).T)
+    assert d.size and d.min() < 0.3
+
+
+def test_the_room_mode_is_refused_in_one_line(capture) -> None:
+    data, cfg = capture
+    with pytest.raises(InputError, match="not the room mode"):
+        LiveLink(
+            LinkSettings(cli_port="/dev/null-a", data_port="/dev/null-b", cfg=str(cfg)),
+            TrackerParams(mode="room"),
+        )
