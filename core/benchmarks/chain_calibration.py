@@ -29,7 +29,7 @@ from typing import Any
 
 import numpy as np
 
-from core.benchmarks.clouds import real_data_dir
+from core.benchmarks.clouds import cloud_frames, real_data_dir
 
 ROOT = Path(__file__).resolve().parents[2]
 RANGE_BANDS_M = ((0.0, 2.0), (2.0, 4.0), (4.0, 6.0), (6.0, 10.0))
@@ -190,27 +190,6 @@ def simulated(cfg_name: str, frames: int, seed: int = 5, waypoints: tuple = FAR)
     scene, n = walker_scene(cfg, frames, seed, waypoints)
     p = plan(scene, chain=chain) if chain is not None else plan(scene)
     return frame_stats(cloud_frames(scene, p, n))
-
-
-def cloud_frames(scene, the_plan, n: int, *, path_order: bool = False) -> list[dict]:
-    """The first ``n`` frames of ``scene`` simulated through ``the_plan``, each a dict of the
-    point cloud's arrays x, y, z, v, snr (and ``path_order`` when asked)."""
-    from core.pipeline.frames import iter_frames
-
-    out = []
-    for fr in iter_frames(scene, the_plan=the_plan, frames=range(n)):
-        pc = fr.point_cloud
-        frame: dict[str, Any] = {
-            "x": pc.x_m,
-            "y": pc.y_m,
-            "z": pc.z_m,
-            "v": pc.radial_velocity_mps,
-            "snr": pc.snr_db,
-        }
-        if path_order:
-            frame["path_order"] = pc.path_order
-        out.append(frame)
-    return out
 
 
 def recorded_people_counting() -> dict | None:

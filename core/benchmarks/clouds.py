@@ -23,6 +23,7 @@ from __future__ import annotations
 import math
 import os
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -491,3 +492,24 @@ def summary(result: dict) -> str:
             f"{e['reach_abs_velocity_median_mps']:.2f} (p95 {e['reach_abs_velocity_p95_mps']:.2f})"
         )
     return "\n".join(lines)
+
+
+def cloud_frames(scene, the_plan, n: int, *, path_order: bool = False) -> list[dict]:
+    """The first ``n`` frames of ``scene`` simulated through ``the_plan``, each a dict of the
+    point cloud's arrays x, y, z, v, snr (and ``path_order`` when asked)."""
+    from core.pipeline.frames import iter_frames
+
+    out = []
+    for fr in iter_frames(scene, the_plan=the_plan, frames=range(n)):
+        pc = fr.point_cloud
+        frame: dict[str, Any] = {
+            "x": pc.x_m,
+            "y": pc.y_m,
+            "z": pc.z_m,
+            "v": pc.radial_velocity_mps,
+            "snr": pc.snr_db,
+        }
+        if path_order:
+            frame["path_order"] = pc.path_order
+        out.append(frame)
+    return out

@@ -141,7 +141,7 @@ def fit_scene(cfg: str, reflection_db: float, seed: int):
 def simulated_frames(scene, cfg: str, frames: int | None = None) -> list[dict]:
     """The scene through the chain of ``cfg``: per frame x, y (room), z (room), v, snr and the
     path order."""
-    from core.benchmarks.chain_calibration import cloud_frames
+    from core.benchmarks.clouds import cloud_frames
     from core.formats.ti_cfg import read_ti_chain
     from core.pipeline import plan
 
